@@ -1,0 +1,31 @@
+#pragma once
+/// Helpers shared by the subcommands: exit codes, error printing, JSON of library types.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "mesh/mass_properties.hpp"
+#include "mesh/topology.hpp"
+
+namespace clumpforge::cli {
+
+/// Documented exit codes (README.md).
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;  ///< bad input or a step that could not be done
+inline constexpr int kExitUsage = 2;    ///< the command line itself is wrong
+
+/// Prints "clumpforge <command>: error: <message>" to stderr and returns kExitFailure.
+int report_error(std::string_view command, const Error& error);
+void report_warning(std::string_view command, const std::string& message);
+
+nlohmann::json to_json(const Eigen::Vector3d& v);
+nlohmann::json to_json(const Eigen::Matrix3d& m);  ///< list of rows
+nlohmann::json to_json(const MeshStats& stats);
+nlohmann::json to_json(const MassProperties& props);
+
+/// Progress on stderr while a long step runs, only when stderr is a terminal.
+void print_progress(std::string_view stage, double fraction);
+bool stderr_is_terminal();
+
+}  // namespace clumpforge::cli

@@ -1,0 +1,17 @@
+#pragma once
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace clumpforge::cli {
+
+/// A registered subcommand: its CLI11 app and what runs it (returns the exit code).
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+Command add_repair_command(CLI::App& app);
+Command add_props_command(CLI::App& app);
+
+}  // namespace clumpforge::cli

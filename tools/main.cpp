@@ -1,0 +1,25 @@
+// clumpforge: from a particle scan to a calibrated multi-sphere DEM clump.
+#include <CLI/CLI.hpp>
+#include <vector>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "core/version.hpp"
+
+int main(int argc, char** argv) {
+  using namespace clumpforge::cli;
+  CLI::App app{"clumpforge: turn a particle scan into a measured multi-sphere DEM clump"};
+  app.set_version_flag("--version", std::string(clumpforge::kVersion));
+  app.require_subcommand(1);
+  const std::vector<Command> commands{add_repair_command(app), add_props_command(app)};
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  for (const auto& command : commands) {
+    if (command.app->parsed()) return command.run();
+  }
+  return kExitUsage;
+}
