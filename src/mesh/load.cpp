@@ -100,7 +100,7 @@ Result<LoadResult> load_mesh(const fs::path& path, const LoadOptions& options) {
   }
   result.file_triangles = static_cast<int>(result.soup.faces.size());
   result.file_vertices = static_cast<int>(result.soup.points.size());
-  result.weld_tolerance = options.weld_tolerance_relative * bounding_box(result.soup).diagonal();
+  result.weld_tolerance = weld_tolerance_for(result.soup, options.weld_tolerance_relative);
   result.welded_vertices = weld_points(result.soup, result.weld_tolerance);
   result.notes = check_plausible_size(result.soup, options.unit);
   return result;

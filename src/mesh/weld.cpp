@@ -5,8 +5,8 @@
 
 namespace clumpforge {
 
-double default_weld_tolerance(const TriangleSoup& soup) {
-  return 1e-5 * bounding_box(soup).diagonal();
+double weld_tolerance_for(const TriangleSoup& soup, double relative) {
+  return relative * bounding_box(soup).diagonal();
 }
 
 namespace {

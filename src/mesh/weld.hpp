@@ -9,7 +9,7 @@ namespace clumpforge {
 /// shared vertices this way.
 int weld_points(TriangleSoup& soup, double tolerance);
 
-/// The default weld tolerance for a soup: 1e-5 of its bounding-box diagonal.
-double default_weld_tolerance(const TriangleSoup& soup);
+/// A weld tolerance tied to the mesh size: `relative` times the bounding-box diagonal [m].
+double weld_tolerance_for(const TriangleSoup& soup, double relative = 1e-5);
 
 }  // namespace clumpforge

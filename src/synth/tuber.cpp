@@ -6,44 +6,10 @@
 
 #include "core/rng.hpp"
 #include "mesh/topology.hpp"
-#include "mesh/weld.hpp"
+#include "synth/shapes.hpp"
 
 namespace clumpforge {
 namespace {
-
-// Icosahedron subdivided `frequency` times along each edge, projected on the unit sphere.
-TriangleSoup geodesic_sphere(int frequency) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  const std::array<Eigen::Vector3d, 12> corners{{{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
-                                                  {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
-                                                  {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}}};
-  const std::array<std::array<int, 3>, 20> icosahedron{{{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11},
-                                                       {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                                       {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9},
-                                                       {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}}};
-  TriangleSoup soup;
-  const int n = frequency;
-  for (const auto& tri : icosahedron) {
-    const Eigen::Vector3d a = corners[tri[0]], b = corners[tri[1]], c = corners[tri[2]];
-    const int base = static_cast<int>(soup.points.size());
-    auto index = [&](int i, int j) { return base + i * (n + 1) - i * (i - 1) / 2 + j; };
-    for (int i = 0; i <= n; ++i) {
-      for (int j = 0; j <= n - i; ++j) soup.points.push_back(a + (b - a) * i / n + (c - a) * j / n);
-    }
-    for (int i = 0; i < n; ++i) {
-      for (int j = 0; j < n - i; ++j) {
-        soup.faces.push_back({index(i, j), index(i + 1, j), index(i, j + 1)});
-        if (j + 1 <= n - i - 1) soup.faces.push_back({index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)});
-      }
-    }
-  }
-  weld_points(soup, 1e-9);
-  for (auto& p : soup.points) p.normalize();
-  if (signed_volume(soup) < 0.0) {
-    for (auto& f : soup.faces) std::swap(f[1], f[2]);
-  }
-  return soup;
-}
 
 Eigen::Vector3d random_direction(Rng& rng) {
   Eigen::Vector3d d(rng.normal(), rng.normal(), rng.normal());
@@ -77,7 +43,7 @@ TriangleSoup make_tuber(const TuberOptions& options) {
   const int dents = options.dents >= 0 ? options.dents : 1 + static_cast<int>(rng.below(3));
   for (int i = 0; i < dents; ++i) bumps.push_back({random_direction(rng), rng.uniform(0.25, 0.4), -rng.uniform(0.04, 0.08)});
 
-  TriangleSoup soup = geodesic_sphere(options.frequency);
+  TriangleSoup soup = make_ellipsoid(Eigen::Vector3d::Ones(), options.frequency);
   for (auto& p : soup.points) {
     const double r = radial_factor(p, bumps);
     p = Eigen::Vector3d(p.x() * r, p.y() * r * width, p.z() * r * flatness);

@@ -1,0 +1,102 @@
+// End-to-end: the repair and props commands, their exit codes, files and JSON.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "support/test_support.hpp"
+
+namespace clumpforge {
+namespace fs = std::filesystem;
+
+namespace {
+std::string default_scan() { return (test::source_dir() / "meshes" / "tuber-default.stl").string(); }
+}  // namespace
+
+TEST(Cli, RepairJsonReportsBeforeAfterAndSteps) {
+  test::ScratchDir dir("cli");
+  const auto out = dir / "tuber.stl";
+  const auto run = test::run_clumpforge(fmt::format("repair '{}' -o '{}' --json", default_scan(), out.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto report = nlohmann::json::parse(run.out);
+  for (const char* block : {"before", "after"}) {
+    for (const char* key : {"vertices", "faces", "components", "boundary_loops", "non_manifold_edges",
+                            "self_intersecting_pairs", "degenerate_faces", "closed", "volume_m3", "area_m2", "bbox_m"}) {
+      EXPECT_TRUE(report[block].contains(key)) << block << "." << key;
+    }
+  }
+  EXPECT_EQ(report["units"], "mm");
+  EXPECT_FALSE(report["before"]["closed"].get<bool>());
+  EXPECT_TRUE(report["before"]["volume_m3"].is_null());
+  EXPECT_TRUE(report["after"]["closed"].get<bool>());
+  EXPECT_EQ(report["after"]["self_intersecting_pairs"], 0);
+  const std::vector<std::string> order{"duplicate_and_degenerate_faces", "unused_vertices", "non_manifold", "debris",
+                                       "orientation", "holes", "self_intersections"};
+  ASSERT_EQ(report["steps"].size(), order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) EXPECT_EQ(report["steps"][i]["name"], order[i]);
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_EQ(test::count_files(dir.path()), 1);  // no temporary left behind
+}
+
+TEST(Cli, PropsJsonOfRepairedScanMatchesReference) {
+  test::ScratchDir dir("cli");
+  const auto out = dir / "tuber.ply";
+  ASSERT_EQ(test::run_clumpforge(fmt::format("repair '{}' -o '{}'", default_scan(), out.string())).exit_code, 0);
+  const auto run = test::run_clumpforge(fmt::format("props '{}' --density 1085 --json", out.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto props = nlohmann::json::parse(run.out);
+  for (const char* key : {"volume_m3", "mass_kg", "centroid_m", "inertia_kg_m2", "principal_moments_kg_m2", "principal_axes"}) {
+    EXPECT_TRUE(props.contains(key)) << key;
+  }
+  EXPECT_EQ(props["centroid_m"].size(), 3u);
+  EXPECT_EQ(props["inertia_kg_m2"].size(), 3u);
+  const auto reference = nlohmann::json::parse(test::read_text(test::source_dir() / "meshes" / "tuber-default.json"))["reference"];
+  EXPECT_NEAR(props["mass_kg"].get<double>(), reference["mass_kg"].get<double>(), 0.005 * reference["mass_kg"].get<double>());
+  const auto moments = props["principal_moments_kg_m2"];
+  EXPECT_LE(moments[0].get<double>(), moments[1].get<double>());
+  EXPECT_LE(moments[1].get<double>(), moments[2].get<double>());
+}
+
+TEST(Cli, HumanOutputOfRepairAndProps) {
+  test::ScratchDir dir("cli");
+  const auto out = dir / "tuber.obj";
+  const auto repair = test::run_clumpforge(fmt::format("repair '{}' -o '{}'", default_scan(), out.string()));
+  ASSERT_EQ(repair.exit_code, 0) << repair.err;
+  EXPECT_NE(repair.out.find("step holes"), std::string::npos);
+  const auto props = test::run_clumpforge(fmt::format("props '{}' --density 1085", out.string()));
+  ASSERT_EQ(props.exit_code, 0) << props.err;
+  EXPECT_NE(props.out.find("principal moments"), std::string::npos);
+}
+
+TEST(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(test::run_clumpforge("").exit_code, 2);
+  EXPECT_EQ(test::run_clumpforge("frobnicate").exit_code, 2);
+  EXPECT_EQ(test::run_clumpforge(fmt::format("props '{}'", default_scan())).exit_code, 2);  // no --density
+  EXPECT_EQ(test::run_clumpforge(fmt::format("repair '{}'", default_scan())).exit_code, 2);  // no -o
+}
+
+TEST(Cli, BadOptionsAreClearErrorsAndWriteNothing) {
+  test::ScratchDir dir("cli");
+  const auto units = test::run_clumpforge(fmt::format("repair '{}' -o '{}' --units mn", default_scan(), (dir / "a.stl").string()));
+  EXPECT_EQ(units.exit_code, 1);
+  EXPECT_NE(units.err.find("did you mean 'mm'"), std::string::npos) << units.err;
+  const auto extension = test::run_clumpforge(fmt::format("repair '{}' -o '{}'", default_scan(), (dir / "a.xyz").string()));
+  EXPECT_EQ(extension.exit_code, 1);
+  EXPECT_NE(extension.err.find(".xyz"), std::string::npos);
+  const auto missing_dir = test::run_clumpforge(fmt::format("repair '{}' -o '{}'", default_scan(), (dir / "no" / "a.stl").string()));
+  EXPECT_EQ(missing_dir.exit_code, 1);
+  EXPECT_NE(missing_dir.err.find("does not exist"), std::string::npos);
+  const auto density = test::run_clumpforge(fmt::format("props '{}' --density -5", default_scan()));
+  EXPECT_EQ(density.exit_code, 1);
+  EXPECT_NE(density.err.find("density"), std::string::npos);
+  EXPECT_EQ(test::count_files(dir.path()), 0);
+}
+
+TEST(Cli, PropsRefusesOpenScanPointingAtRepair) {
+  const auto run = test::run_clumpforge(fmt::format("props '{}' --density 1085", default_scan()));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("tuber-default.stl"), std::string::npos);
+  EXPECT_NE(run.err.find("clumpforge repair"), std::string::npos);
+}
+
+}  // namespace clumpforge
