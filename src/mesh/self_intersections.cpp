@@ -87,8 +87,12 @@ std::vector<std::pair<int, int>> self_intersecting_pairs(const TriangleSoup& sou
     const int g = std::max(a.info(), b.info());
     if (tester.intersect(f, g)) pairs.emplace_back(f, g);
   };
-  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), report);
+  // Below this many boxes the segment tree scans directly (CGAL PMP uses the same value).
+  constexpr std::ptrdiff_t kCutoff = 2000;
+  // Sequential: CGAL's parallel variant copies the boxes four times and was slower here.
+  CGAL::box_self_intersection_d<CGAL::Sequential_tag>(boxes.begin(), boxes.end(), report, kCutoff);
   std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   return pairs;
 }
 

@@ -1,0 +1,56 @@
+// Repair + mass properties on the bundled default scan (~19k triangles) and on a
+// 200k-triangle scan generated here with the same damage. Reports median wall time
+// over repetitions: build/bench/bench_repair (add --benchmark_repetitions=N to change).
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+
+#include "io/mesh_writer.hpp"
+#include "mesh/load.hpp"
+#include "mesh/mass_properties.hpp"
+#include "mesh/repair.hpp"
+#include "synth/tuber.hpp"
+
+namespace {
+using namespace clumpforge;
+namespace fs = std::filesystem;
+
+// The 200k-triangle scan: the default tuber at geodesic frequency 100, damaged like
+// the bundled ones, written once as binary STL in mm.
+const fs::path& large_scan() {
+  static const fs::path path = [] {
+    const fs::path file = fs::temp_directory_path() / "clumpforge-bench-tuber-200k.stl";
+    const TriangleSoup body = make_tuber({.seed = 2026, .frequency = 100});
+    const DamagedScan scan = damage_scan(body, {.seed = 2027});
+    if (!write_mesh(file, scan.soup, LengthUnit::Millimetre)) std::abort();
+    return file;
+  }();
+  return path;
+}
+
+void repair_and_props(benchmark::State& state, const fs::path& path) {
+  std::size_t faces = 0;
+  for (auto _ : state) {
+    auto loaded = load_mesh(path, {.unit = LengthUnit::Millimetre});
+    auto repaired = repair_mesh(loaded->soup);
+    if (!repaired) {
+      state.SkipWithError(repaired.error().message.c_str());
+      return;
+    }
+    const auto props = compute_mass_properties(repaired->soup, 1085.0);
+    benchmark::DoNotOptimize(props.volume);
+    faces = loaded->soup.faces.size();
+  }
+  state.counters["triangles"] = static_cast<double>(faces);
+}
+
+void BM_RepairProps_DefaultScan(benchmark::State& state) {
+  repair_and_props(state, fs::path(CLUMPFORGE_SOURCE_DIR) / "meshes" / "tuber-default.stl");
+}
+void BM_RepairProps_200kScan(benchmark::State& state) { repair_and_props(state, large_scan()); }
+
+BENCHMARK(BM_RepairProps_DefaultScan)->Unit(benchmark::kMillisecond)->UseRealTime()->Repetitions(5)->ReportAggregatesOnly(true);
+BENCHMARK(BM_RepairProps_200kScan)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)->Repetitions(5)->ReportAggregatesOnly(true);
+}  // namespace
+
+BENCHMARK_MAIN();
