@@ -1,0 +1,177 @@
+// clumpforge fill MESH -o OUT.h5 [--method lattice|adaptive] [--diameter 2mm | --diameters 1,2,4mm]
+//                  [--max-spheres N] [--target-error X] [--json]
+#include <fmt/format.h>
+
+#include <chrono>
+#include <iostream>
+#include <memory>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "core/atomic_file.hpp"
+#include "core/text.hpp"
+#include "fill/fill.hpp"
+#include "fill_report.hpp"
+#include "mesh/load.hpp"
+
+namespace clumpforge::cli {
+namespace {
+
+struct FillArgs {
+  std::string input;
+  std::string output;
+  std::string method = "lattice";
+  std::string diameter;
+  std::string diameters;
+  int max_spheres = 0;
+  double target_error = 0.0;
+  std::string min_radius;
+  std::string voxel;
+  std::string units = "mm";
+  double density = 1085.0;
+  bool json = false;
+};
+
+// "1,2,4mm" or "1mm,2mm" -> metres; the unit of the last item applies to bare numbers.
+Result<std::vector<double>> parse_diameter_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const auto comma = text.find(',', start);
+    items.emplace_back(trim(std::string_view(text).substr(start, comma - start)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  std::string unit;
+  const std::string& last = items.back();
+  const auto unit_start = last.find_first_not_of("0123456789.eE+- ");
+  if (unit_start != std::string::npos) unit = last.substr(unit_start);
+  std::vector<double> values;
+  for (auto& item : items) {
+    const bool has_unit = item.find_first_not_of("0123456789.eE+- ") != std::string::npos;
+    auto value = parse_length(has_unit ? item : item + unit);
+    if (!value) return std::unexpected(value.error());
+    values.push_back(*value);
+  }
+  return values;
+}
+
+int run_fill(const FillArgs& args) {
+  constexpr std::string_view kCommand = "fill";
+  FillOptions base;
+  if (args.method == "lattice") {
+    base.method = FillMethod::Lattice;
+  } else if (args.method == "adaptive") {
+    base.method = FillMethod::Adaptive;
+  } else {
+    return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("unknown method '{}'{} (lattice or adaptive)", args.method,
+                                                                            did_you_mean(args.method, {"lattice", "adaptive"}))});
+  }
+  std::vector<double> diameters{2e-3};
+  if (!args.diameter.empty() && !args.diameters.empty()) {
+    return report_error(kCommand, {ErrorCode::InvalidArgument, "give --diameter or --diameters, not both"});
+  }
+  if (!args.diameter.empty() || !args.diameters.empty()) {
+    auto parsed = parse_diameter_list(args.diameter.empty() ? args.diameters : args.diameter);
+    if (!parsed) return report_error(kCommand, parsed.error());
+    diameters = *parsed;
+  }
+  for (double d : diameters) {
+    if (!(d > 0.0)) return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("diameter {} m must be positive", d)});
+  }
+  if (!args.min_radius.empty()) {
+    auto r = parse_length(args.min_radius);
+    if (!r) return report_error(kCommand, r.error());
+    base.min_radius = *r;
+  }
+  base.max_spheres = args.max_spheres;
+  base.target_error = args.target_error;
+  if (args.max_spheres < 0) return report_error(kCommand, {ErrorCode::InvalidArgument, "--max-spheres must not be negative"});
+  if (!(args.density > 0.0)) return report_error(kCommand, {ErrorCode::InvalidArgument, "--density must be positive"});
+  auto unit = parse_length_unit(args.units);
+  if (!unit) return report_error(kCommand, unit.error());
+  if (auto ok = check_writable(args.output); !ok) return report_error(kCommand, ok.error());
+
+  auto loaded = load_mesh(args.input, {.unit = *unit});
+  if (!loaded) return report_error(kCommand, loaded.error());
+  remove_unused_points(loaded->soup);
+  if (auto ok = check_closed_body(loaded->soup, args.input); !ok) return report_error(kCommand, ok.error());
+
+  SdfOptions sdf;
+  sdf.feature_size = base.method == FillMethod::Lattice ? *std::min_element(diameters.begin(), diameters.end()) : 1e-3;
+  if (!args.voxel.empty()) {
+    auto v = parse_length(args.voxel);
+    if (!v) return report_error(kCommand, v.error());
+    sdf.voxel_size = *v;
+  }
+  RunContext context;
+  const auto started = std::chrono::steady_clock::now();
+  if (!args.json && stderr_is_terminal()) {
+    context.progress = [started](std::string_view stage, double fraction) {
+      if (std::chrono::steady_clock::now() - started > std::chrono::seconds(1)) print_progress(stage, fraction);
+    };
+  }
+  auto body = prepare_body(loaded->soup, args.density, sdf, context);
+  if (!body) return report_error(kCommand, Error{body.error().code, fmt::format("'{}': {}", args.input, body.error().message)});
+
+  nlohmann::json report;
+  report["input"] = args.input;
+  report["output"] = args.output;
+  report["sdf_voxel_m"] = body->sdf.voxel_size();
+  report["clumps"] = nlohmann::json::array();
+  std::vector<Clump> clumps;
+  const auto runs = base.method == FillMethod::Lattice ? diameters.size() : 1;
+  for (std::size_t i = 0; i < runs; ++i) {
+    FillOptions options = base;
+    options.diameter = diameters[i];
+    const auto t0 = std::chrono::steady_clock::now();
+    auto filled = fill_body(*body, options, context);
+    if (!filled) return report_error(kCommand, Error{filled.error().code, fmt::format("'{}': {}", args.input, filled.error().message)});
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    filled->clump.name = options.method == FillMethod::Lattice
+                             ? fmt::format("lattice-{:g}mm", options.diameter * 1e3)
+                             : fmt::format("adaptive-{}", filled->clump.spheres.size());
+    nlohmann::json entry = clump_to_json(filled->clump);
+    entry["fill_seconds"] = seconds;
+    report["clumps"].push_back(entry);
+    clumps.push_back(std::move(filled->clump));
+  }
+  if (report["clumps"].size() == 1) report.update(report["clumps"][0]);
+  if (args.json) {
+    std::cout << report.dump(2) << "\n";
+  } else {
+    fmt::print("fill {} -> {} (signed distance voxel {:.3g} mm)\n", args.input, args.output, body->sdf.voxel_size() * 1e3);
+    fmt::print("  {:<16} {:>7} {:>9} {:>10} {:>28} {:>28} {:>8} {:>9} {:>9} {:>6}\n", "clump", "spheres", "mass err",
+               "COM [mm]", "moment err (density)", "moment err (mass-matched)", "axis deg", "surf RMS", "surf max", "dice");
+    for (const auto& c : clumps) {
+      const auto& e = c.error;
+      fmt::print("  {:<16} {:>7} {:>8.1f}% {:>10.3f} {:>8.1f}% {:>8.1f}% {:>8.1f}% {:>8.2f}% {:>8.2f}% {:>8.2f}% {:>8.2f} {:>6.3f}mm {:>6.3f}mm {:>6.3f}\n",
+                 c.name, e.sphere_count, 100 * e.mass_error, e.com_offset_norm * 1e3, 100 * e.principal_moment_errors[0],
+                 100 * e.principal_moment_errors[1], 100 * e.principal_moment_errors[2],
+                 100 * e.principal_moment_errors_mass_matched[0], 100 * e.principal_moment_errors_mass_matched[1],
+                 100 * e.principal_moment_errors_mass_matched[2], e.axis_error_deg, e.surface_rms * 1e3, e.surface_max * 1e3, e.dice);
+    }
+  }
+  return kExitOk;
+}
+}  // namespace
+
+Command add_fill_command(CLI::App& app) {
+  auto args = std::make_shared<FillArgs>();
+  CLI::App* sub = app.add_subcommand("fill", "Fill a closed body with spheres and report the clump's error");
+  sub->add_option("mesh", args->input, "A closed mesh (run 'repair' first on a raw scan)")->required();
+  sub->add_option("-o,--output", args->output, "Output clump library (.h5)")->required();
+  sub->add_option("--method", args->method, "lattice (the study's fixed-diameter filling) or adaptive")->capture_default_str();
+  sub->add_option("--diameter", args->diameter, "Lattice sphere diameter, e.g. 2mm");
+  sub->add_option("--diameters", args->diameters, "Several lattice diameters, e.g. 1,2,4mm (one clump each)");
+  sub->add_option("--max-spheres", args->max_spheres, "Adaptive: sphere budget");
+  sub->add_option("--target-error", args->target_error, "Adaptive: stop when this fraction of the volume is uncovered");
+  sub->add_option("--min-radius", args->min_radius, "Adaptive: smallest sphere radius, e.g. 0.3mm");
+  sub->add_option("--voxel", args->voxel, "Signed-distance voxel size, e.g. 0.1mm (default: smallest diameter / 8)");
+  sub->add_option("--density", args->density, "Bulk density [kg/m^3] (default: the Corydalis tuber's)")->capture_default_str();
+  sub->add_option("--units", args->units, "Length unit of the mesh file: mm, cm or m")->capture_default_str();
+  sub->add_flag("--json", args->json, "Print one JSON report on stdout");
+  return {sub, [args] { return run_fill(*args); }};
+}
+
+}  // namespace clumpforge::cli
