@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs every Debian package clumpforge needs to build, test and run.
+# Installs every Debian package clumpforge needs to build, test and run, including the
+# real DEM engines the export tests load clumps into (LIGGGHTS, YADE) and HDF5's tools.
 # Idempotent: a second run installs nothing new. Needs root (or sudo).
 set -euo pipefail
 SUDO=""
@@ -10,6 +11,8 @@ packages=(
   libcgal-dev libassimp-dev libopenvdb-dev libboost-iostreams-dev libtbb-dev
   libeigen3-dev libhdf5-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
+  hdf5-tools python3-h5py python3-numpy
+  liggghts yade
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -9,6 +9,8 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "core/atomic_file.hpp"
+#include "core/sha256.hpp"
+#include "io/clump_library.hpp"
 #include "core/text.hpp"
 #include "fill/fill.hpp"
 #include "fill_report.hpp"
@@ -94,6 +96,8 @@ int run_fill(const FillArgs& args) {
 
   auto loaded = load_mesh(args.input, {.unit = *unit});
   if (!loaded) return report_error(kCommand, loaded.error());
+  auto digest = sha256_file(args.input);
+  if (!digest) return report_error(kCommand, digest.error());
   remove_unused_points(loaded->soup);
   if (auto ok = check_closed_body(loaded->soup, args.input); !ok) return report_error(kCommand, ok.error());
 
@@ -131,11 +135,13 @@ int run_fill(const FillArgs& args) {
     filled->clump.name = options.method == FillMethod::Lattice
                              ? fmt::format("lattice-{:g}mm", options.diameter * 1e3)
                              : fmt::format("adaptive-{}", filled->clump.spheres.size());
+    filled->clump.source_sha256 = *digest;
     nlohmann::json entry = clump_to_json(filled->clump);
     entry["fill_seconds"] = seconds;
     report["clumps"].push_back(entry);
     clumps.push_back(std::move(filled->clump));
   }
+  if (auto ok = write_clump_library(args.output, clumps); !ok) return report_error(kCommand, ok.error());
   if (report["clumps"].size() == 1) report.update(report["clumps"][0]);
   if (args.json) {
     std::cout << report.dump(2) << "\n";

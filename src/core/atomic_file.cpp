@@ -33,8 +33,7 @@ Result<void> check_writable(const fs::path& path) {
   return {};
 }
 
-Result<void> write_file_atomically(const fs::path& path,
-                                   const std::function<Result<void>(std::ostream&)>& write) {
+Result<void> write_path_atomically(const fs::path& path, const std::function<Result<void>(const fs::path&)>& write) {
   if (auto ok = check_writable(path); !ok) return ok;
   // A name unique to this process and call, in the target's directory so that the
   // final rename stays on one file system and is atomic.
@@ -42,18 +41,7 @@ Result<void> write_file_atomically(const fs::path& path,
   const fs::path temporary = directory_of(path) /
       ("." + path.filename().string() + ".tmp." + std::to_string(::getpid()) + "." +
        std::to_string(counter.fetch_add(1)));
-  Result<void> outcome;
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      return fail(ErrorCode::IoError, "cannot create temporary file '" + temporary.string() + "'");
-    }
-    outcome = write(out);
-    out.flush();
-    if (outcome && !out) {
-      outcome = fail(ErrorCode::IoError, "writing '" + path.string() + "' failed (disk full?)");
-    }
-  }
+  const Result<void> outcome = write(temporary);
   std::error_code ec;
   if (!outcome) {
     fs::remove(temporary, ec);
@@ -63,6 +51,49 @@ Result<void> write_file_atomically(const fs::path& path,
   if (ec) {
     fs::remove(temporary, ec);
     return fail(ErrorCode::IoError, "cannot rename temporary file onto '" + path.string() + "'");
+  }
+  return {};
+}
+
+Result<void> write_file_atomically(const fs::path& path, const std::function<Result<void>(std::ostream&)>& write) {
+  return write_path_atomically(path, [&](const fs::path& temporary) -> Result<void> {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) return fail(ErrorCode::IoError, "cannot create temporary file '" + temporary.string() + "'");
+    auto outcome = write(out);
+    out.flush();
+    if (outcome && !out) return fail(ErrorCode::IoError, "writing '" + path.string() + "' failed (disk full?)");
+    return outcome;
+  });
+}
+
+Result<void> write_files_atomically(const std::vector<std::pair<fs::path, std::string>>& files) {
+  for (const auto& [path, content] : files) {
+    if (auto ok = check_writable(path); !ok) return ok;
+  }
+  static std::atomic<unsigned> counter{0};
+  std::vector<fs::path> temporaries;
+  auto discard = [&] {
+    std::error_code ec;
+    for (const auto& t : temporaries) fs::remove(t, ec);
+  };
+  for (const auto& [path, content] : files) {
+    temporaries.push_back(directory_of(path) / ("." + path.filename().string() + ".tmp." + std::to_string(::getpid()) +
+                                                "." + std::to_string(counter.fetch_add(1))));
+    std::ofstream out(temporaries.back(), std::ios::binary | std::ios::trunc);
+    out << content;
+    out.flush();
+    if (!out) {
+      discard();
+      return fail(ErrorCode::IoError, "writing '" + path.string() + "' failed");
+    }
+  }
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    std::error_code ec;
+    fs::rename(temporaries[i], files[i].first, ec);
+    if (ec) {
+      discard();
+      return fail(ErrorCode::IoError, "cannot rename a temporary file onto '" + files[i].first.string() + "'");
+    }
   }
   return {};
 }

@@ -1,0 +1,245 @@
+#include "io/exports.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cctype>
+
+#include "core/atomic_file.hpp"
+#include "core/text.hpp"
+#include "core/version.hpp"
+
+namespace clumpforge {
+namespace fs = std::filesystem;
+
+namespace {
+constexpr std::array<std::pair<std::string_view, ExportFormat>, 8> kFormats{{{"liggghts", ExportFormat::Liggghts},
+                                                                             {"yade", ExportFormat::Yade},
+                                                                             {"edem", ExportFormat::Edem},
+                                                                             {"pfc", ExportFormat::Pfc},
+                                                                             {"mercurydpm", ExportFormat::MercuryDpm},
+                                                                             {"chrono", ExportFormat::Chrono},
+                                                                             {"vtk", ExportFormat::Vtk},
+                                                                             {"csv", ExportFormat::Csv}}};
+
+using Files = std::vector<std::pair<fs::path, std::string>>;
+
+std::string number(double value) { return fmt::format("{:.17g}", value); }
+
+// A name usable as a LIGGGHTS fix ID or a Python identifier.
+std::string identifier(const std::string& name) {
+  std::string id;
+  for (char c : name) id += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  if (id.empty() || std::isdigit(static_cast<unsigned char>(id[0]))) id = "clump_" + id;
+  return id;
+}
+
+fs::path sibling(const fs::path& output, const std::string& suffix) {
+  return output.parent_path() / (output.stem().string() + suffix);
+}
+
+std::string provenance(const Clump& c) {
+  return fmt::format("clumpforge {} clump '{}' ({} method, {} spheres); source mesh sha256 {}; frame: principal axes, "
+                     "centre of mass at the origin; SI units",
+                     kVersion, c.name, to_string(c.method), c.spheres.size(), c.source_sha256.empty() ? "unknown" : c.source_sha256);
+}
+
+Files liggghts(const Clump& c, const fs::path& output) {
+  // LIGGGHTS-PUBLIC fix particletemplate/multisphere: one "x y z r" line per sphere, '#'
+  // comments allowed, as many lines as nspheres; `scale` is mandatory after `file`.
+  std::string spheres = "# " + provenance(c) + "\n";
+  for (const auto& s : c.spheres) spheres += fmt::format("{} {} {} {}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  const std::string id = identifier(c.name);
+  const Eigen::Matrix3d& I = c.inertia;
+  std::string snippet = fmt::format(
+      "# {}\n"
+      "# The body's true mass and inertia tensor (about the centre of mass, in the file's frame) override\n"
+      "# LIGGGHTS' Monte-Carlo estimate; with use_density the volume is mass / density and the spheres are\n"
+      "# taken as already centred on the centre of mass, as they are.\n"
+      "fix pts_{} all particletemplate/multisphere 15485863 atom_type 1 density constant {} nspheres {} ntry 1000000 "
+      "spheres file {} scale 1.0 type 1 mass {} inertia_tensor {} {} {} {} {} {} use_density\n",
+      provenance(c), id, number(c.density), c.spheres.size(), output.filename().string(), number(c.mass), number(I(0, 0)),
+      number(I(0, 1)), number(I(0, 2)), number(I(1, 1)), number(I(1, 2)), number(I(2, 2)));
+  return {{output, spheres}, {fs::path(output.string() + ".in"), snippet}};
+}
+
+Files yade(const Clump& c, const fs::path& output) {
+  // YADE ymport.textClumps: whitespace-separated "x y z r clumpId", '#' lines skipped, no
+  // blank lines (they crash the reader).
+  std::string text = "#format x_y_z_r_clumpId\n# " + provenance(c) + "\n";
+  for (const auto& s : c.spheres) text += fmt::format("{} {} {} {} 0\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  const Eigen::Vector3d& m = c.principal_moments;
+  std::string script = fmt::format(
+      "# {}\n"
+      "# Builds the clump in YADE with the body's true mass and inertia. Use inside a YADE script:\n"
+      "#   exec(open('{}').read()); clump_id = add_clump(material=my_material, position=Vector3(0, 0, 0.1))\n"
+      "# ymport.textClumps sums the spheres' volumes (overlaps counted twice), so the mass and inertia it\n"
+      "# computes are replaced here. YADE keeps a diagonal inertia in the clump's own frame, which it\n"
+      "# chooses from the spheres; the body's tensor is expressed in that frame and its diagonal is used.\n"
+      "import os\n"
+      "from yade import ymport\n"
+      "from yade.minieigenHP import Vector3, Matrix3, Quaternion\n"
+      "CF_SPHERES_FILE = os.path.join(os.path.dirname(os.path.abspath(globals().get('__file__', '{}'))), '{}')\n"
+      "CF_MASS = {}  # kg\n"
+      "CF_PRINCIPAL_MOMENTS = Vector3({}, {}, {})  # kg m^2, about the principal axes x, y, z\n"
+      "CF_DENSITY = {}  # kg/m^3\n"
+      "\n"
+      "def add_clump(material=None, position=Vector3(0, 0, 0), spheres_file=None):\n"
+      "    kw = {{}} if material is None else {{'material': material}}\n"
+      "    path = spheres_file or CF_SPHERES_FILE\n"
+      "    if not os.path.exists(path):\n"
+      "        path = os.path.join(os.getcwd(), '{}')\n"
+      "    clump_id = ymport.textClumps(path, shift=position, **kw)[0][0]\n"
+      "    state = O.bodies[clump_id].state\n"
+      "    rotation = state.ori.toRotationMatrix()\n"
+      "    body = Matrix3(CF_PRINCIPAL_MOMENTS[0], 0, 0, 0, CF_PRINCIPAL_MOMENTS[1], 0, 0, 0, CF_PRINCIPAL_MOMENTS[2])\n"
+      "    local = rotation.transpose() * body * rotation\n"
+      "    state.mass = CF_MASS\n"
+      "    state.inertia = Vector3(local[0, 0], local[1, 1], local[2, 2])\n"
+      "    return clump_id\n",
+      provenance(c), sibling(output, ".py").filename().string(), sibling(output, ".py").filename().string(),
+      output.filename().string(), number(c.mass), number(m.x()), number(m.y()), number(m.z()), number(c.density),
+      output.filename().string());
+  return {{output, text}, {sibling(output, ".py"), script}};
+}
+
+Files edem(const Clump& c, const fs::path& output) {
+  // EDEM Creator, multi-sphere particle: a sphere table to paste (position and physical /
+  // contact radius, mm, centred on the centre of mass and aligned to the principal axes).
+  std::string table = "X (mm)\tY (mm)\tZ (mm)\tPhysical Radius (mm)\tContact Radius (mm)\n";
+  for (const auto& s : c.spheres) {
+    table += fmt::format("{:.9g}\t{:.9g}\t{:.9g}\t{:.9g}\t{:.9g}\n", s.centre.x() * 1e3, s.centre.y() * 1e3, s.centre.z() * 1e3,
+                         s.radius * 1e3, s.radius * 1e3);
+  }
+  const Eigen::Vector3d& m = c.principal_moments;
+  std::string summary = fmt::format(
+      "{}\n\nEnter these in EDEM's particle properties (override 'Calculate Properties'):\n"
+      "mass_kg = {}\nvolume_m3 = {}\nvolume_mm3 = {}\ndensity_kg_m3 = {}\n"
+      "moment_of_inertia_kg_m2 = {} {} {}\nmoment_of_inertia_kg_mm2 = {} {} {}\n"
+      "The spheres are centred on the centre of mass and aligned with the principal axes (x, y, z above).\n",
+      provenance(c), number(c.mass), number(c.body_volume), number(c.body_volume * 1e9), number(c.density), number(m.x()),
+      number(m.y()), number(m.z()), number(m.x() * 1e6), number(m.y() * 1e6), number(m.z() * 1e6));
+  return {{output, table}, {sibling(output, "-properties.txt"), summary}};
+}
+
+Files pfc(const Clump& c, const fs::path& output) {
+  // Itasca PFC 3D `clump template create`: pebbles given as radius and position; templates
+  // have unit density, so the inertia given is the tensor divided by the density.
+  std::string text = "; " + provenance(c) + "\n";
+  text += fmt::format("clump template create name '{}' ...\n    pebbles {} ...\n", identifier(c.name), c.spheres.size());
+  for (const auto& s : c.spheres) {
+    text += fmt::format("        {} {} {} {} ...\n", number(s.radius), number(s.centre.x()), number(s.centre.y()), number(s.centre.z()));
+  }
+  const Eigen::Matrix3d unit = c.inertia / c.density;
+  text += fmt::format("    volume {} ...\n    inertia {} {} {} {} {} {}\n", number(c.body_volume), number(unit(0, 0)),
+                      number(unit(1, 1)), number(unit(2, 2)), number(unit(0, 1)), number(unit(0, 2)), number(unit(1, 2)));
+  return {{output, text}};
+}
+
+Files mercurydpm(const Clump& c, const fs::path& output) {
+  // MercuryDPM MultiParticle clumps (the MClump tool's layout, read by clump/ClumpIO.h):
+  // <name>/clump/clump.txt "x,y,z,r" lines; <name>/inertia/mass.txt, toi.txt (3 rows of 3),
+  // pd.txt (principal directions, 3 rows).
+  const fs::path root = output / identifier(c.name);
+  std::string pebbles;
+  for (const auto& s : c.spheres) pebbles += fmt::format("{},{},{},{}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  std::string toi;
+  for (int r = 0; r < 3; ++r) toi += fmt::format("{},{},{}\n", number(c.inertia(r, 0)), number(c.inertia(r, 1)), number(c.inertia(r, 2)));
+  return {{root / "clump" / "clump.txt", pebbles},
+          {root / "inertia" / "mass.txt", number(c.mass) + "\n"},
+          {root / "inertia" / "toi.txt", toi},
+          {root / "inertia" / "pd.txt", "1,0,0\n0,1,0\n0,0,1\n"}};
+}
+
+Files chrono(const Clump& c, const fs::path& output) {
+  // Chrono DEM-Engine LoadClumpType(mass, moi, "clump.csv", material): a CSV with header
+  // "x,y,z,r"; mass and principal moments go beside it.
+  std::string csv = "x,y,z,r\n";
+  for (const auto& s : c.spheres) csv += fmt::format("{},{},{},{}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  const Eigen::Vector3d& m = c.principal_moments;
+  std::string props = fmt::format(
+      "{{\n  \"comment\": \"{}\",\n  \"clump_file\": \"{}\",\n  \"mass_kg\": {},\n  \"moi_kg_m2\": [{}, {}, {}],\n"
+      "  \"usage\": \"DEMSim.LoadClumpType(mass_kg, make_float3(moi...), clump_file, material)\"\n}}\n",
+      provenance(c), output.filename().string(), number(c.mass), number(m.x()), number(m.y()), number(m.z()));
+  return {{output, csv}, {sibling(output, "-properties.json"), props}};
+}
+
+Files vtk(const Clump& c, const fs::path& output) {
+  // VTK XML PolyData: one vertex per sphere centre with "radius" point data; in ParaView
+  // apply Glyph (sphere, scale by radius, factor 2 for diameter-sized glyphs).
+  std::string points, radii, offsets, connectivity;
+  for (std::size_t i = 0; i < c.spheres.size(); ++i) {
+    const auto& s = c.spheres[i];
+    points += fmt::format("{} {} {}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()));
+    radii += number(s.radius) + "\n";
+    connectivity += fmt::format("{}\n", i);
+    offsets += fmt::format("{}\n", i + 1);
+  }
+  std::string text = fmt::format(
+      "<?xml version=\"1.0\"?>\n<!-- {} -->\n"
+      "<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n"
+      "    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
+      "      <PointData Scalars=\"radius\">\n        <DataArray type=\"Float64\" Name=\"radius\" format=\"ascii\">\n{}        </DataArray>\n"
+      "      </PointData>\n      <Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n{}        </DataArray>\n"
+      "      </Points>\n      <Verts>\n        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n{}        </DataArray>\n"
+      "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n{}        </DataArray>\n      </Verts>\n"
+      "    </Piece>\n  </PolyData>\n</VTKFile>\n",
+      provenance(c), c.spheres.size(), c.spheres.size(), radii, points, connectivity, offsets);
+  return {{output, text}};
+}
+
+Files csv(const Clump& c, const fs::path& output) {
+  std::string text = "x_m,y_m,z_m,r_m\n";
+  for (const auto& s : c.spheres) text += fmt::format("{},{},{},{}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  return {{output, text}};
+}
+}  // namespace
+
+Result<ExportFormat> parse_export_format(std::string_view name) {
+  for (const auto& [key, format] : kFormats) {
+    if (key == name) return format;
+  }
+  return fail(ErrorCode::InvalidArgument,
+              fmt::format("unknown export format '{}'{} (liggghts, yade, edem, pfc, mercurydpm, chrono, vtk, csv)", name,
+                          did_you_mean(name, {"liggghts", "yade", "edem", "pfc", "mercurydpm", "chrono", "vtk", "csv"})));
+}
+
+std::string_view to_string(ExportFormat format) {
+  for (const auto& [key, value] : kFormats) {
+    if (value == format) return key;
+  }
+  return "unknown";
+}
+
+Result<ExportResult> export_clump(const Clump& clump, ExportFormat format, const fs::path& output) {
+  if (clump.spheres.empty() || !(clump.mass > 0.0) || !(clump.density > 0.0)) {
+    return fail(ErrorCode::InvalidArgument, fmt::format("clump '{}' has no spheres or no mass", clump.name));
+  }
+  Files files;
+  switch (format) {
+    case ExportFormat::Liggghts: files = liggghts(clump, output); break;
+    case ExportFormat::Yade: files = yade(clump, output); break;
+    case ExportFormat::Edem: files = edem(clump, output); break;
+    case ExportFormat::Pfc: files = pfc(clump, output); break;
+    case ExportFormat::MercuryDpm: {
+      std::error_code ec;
+      if (fs::exists(output, ec) && !fs::is_directory(output, ec)) {
+        return fail(ErrorCode::InvalidArgument, fmt::format("mercurydpm export: '{}' must be a directory", output.string()));
+      }
+      const fs::path root = output / identifier(clump.name);
+      for (const char* sub : {"clump", "inertia"}) fs::create_directories(root / sub, ec);
+      if (ec) return fail(ErrorCode::IoError, fmt::format("cannot create '{}'", root.string()));
+      files = mercurydpm(clump, output);
+      break;
+    }
+    case ExportFormat::Chrono: files = chrono(clump, output); break;
+    case ExportFormat::Vtk: files = vtk(clump, output); break;
+    case ExportFormat::Csv: files = csv(clump, output); break;
+  }
+  if (auto ok = write_files_atomically(files); !ok) return std::unexpected(ok.error());
+  ExportResult result;
+  for (const auto& [path, content] : files) result.files.push_back(path);
+  return result;
+}
+
+}  // namespace clumpforge

@@ -1,0 +1,130 @@
+// The HDF5 clump library: bit-exact round trip, readable by plain tools, clear errors.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+#include <hdf5.h>
+
+#include "io/clump_library.hpp"
+#include "support/test_support.hpp"
+
+namespace clumpforge {
+namespace {
+Clump sample_clump(const std::string& name, int spheres) {
+  Clump c;
+  c.name = name;
+  c.method = spheres % 2 ? FillMethod::Adaptive : FillMethod::Lattice;
+  for (int i = 0; i < spheres; ++i) c.spheres.push_back({{0.1 * i / 3.0, -1e-3 / 7.0 * i, 1e-4 * i}, 1e-3 + 1e-5 / 3.0 * i});
+  c.density = 1085.0;
+  c.mass = 0.0037143881418471576;
+  c.body_volume = c.mass / c.density;
+  c.principal_moments = {1.0982e-7 / 3.0, 1.4065e-7, 1.8135e-7};
+  c.inertia = c.principal_moments.asDiagonal();
+  c.parameters = {{"diameter_m", 2e-3}, {"sdf_voxel_m", 2.5e-4 / 3.0}};
+  c.source_sha256 = "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef";
+  c.error.sphere_count = spheres;
+  c.error.volume_error = -0.4771234567891234;
+  c.error.mass_error = c.error.volume_error;
+  c.error.com_offset = {1e-4 / 3.0, -2e-5, 3e-6};
+  c.error.com_offset_norm = c.error.com_offset.norm();
+  c.error.principal_moment_errors = {-0.47, -0.474, -0.484};
+  c.error.principal_moment_errors_mass_matched = {0.0102, 0.0058, -0.0123};
+  c.error.axis_error_deg = 0.64;
+  c.error.surface_rms = 4.7e-4;
+  c.error.surface_max = 1.2e-3;
+  c.error.dice = 0.644;
+  c.error.union_properties.volume = 1.79e-6;
+  c.error.union_properties.principal_axes = Eigen::Matrix3d::Identity();
+  return c;
+}
+
+void expect_identical(const Clump& a, const Clump& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.method, b.method);
+  ASSERT_EQ(a.spheres.size(), b.spheres.size());
+  for (std::size_t i = 0; i < a.spheres.size(); ++i) {
+    EXPECT_EQ(a.spheres[i].centre, b.spheres[i].centre);  // bit for bit
+    EXPECT_EQ(a.spheres[i].radius, b.spheres[i].radius);
+  }
+  EXPECT_EQ(a.mass, b.mass);
+  EXPECT_EQ(a.density, b.density);
+  EXPECT_EQ(a.body_volume, b.body_volume);
+  EXPECT_EQ(a.inertia, b.inertia);
+  EXPECT_EQ(a.principal_moments, b.principal_moments);
+  EXPECT_EQ(a.parameters, b.parameters);
+  EXPECT_EQ(a.source_sha256, b.source_sha256);
+  EXPECT_EQ(a.error.volume_error, b.error.volume_error);
+  EXPECT_EQ(a.error.com_offset, b.error.com_offset);
+  EXPECT_EQ(a.error.principal_moment_errors_mass_matched, b.error.principal_moment_errors_mass_matched);
+  EXPECT_EQ(a.error.dice, b.error.dice);
+  EXPECT_EQ(a.error.sphere_count, b.error.sphere_count);
+}
+}  // namespace
+
+TEST(ClumpLibrary, RoundTripIsBitExactAndKeepsOrder) {
+  test::ScratchDir dir("h5");
+  const std::vector<Clump> clumps{sample_clump("lattice-2mm", 10), sample_clump("adaptive-7", 7), sample_clump("a-first", 2)};
+  ASSERT_TRUE(write_clump_library(dir / "lib.h5", clumps));
+  const auto read = read_clump_library(dir / "lib.h5");
+  ASSERT_TRUE(read) << read.error().message;
+  ASSERT_EQ(read->size(), 3u);
+  for (std::size_t i = 0; i < clumps.size(); ++i) expect_identical(clumps[i], (*read)[i]);
+  EXPECT_EQ(test::count_files(dir.path()), 1);
+}
+
+TEST(ClumpLibrary, ReadableByH5dumpAndH5py) {
+  test::ScratchDir dir("h5");
+  ASSERT_TRUE(write_clump_library(dir / "lib.h5", std::vector<Clump>{sample_clump("lattice-2mm", 4)}));
+  const auto dump = test::run_command(fmt::format("h5dump -d /clumps/lattice-2mm/spheres '{}'", (dir / "lib.h5").string()));
+  ASSERT_EQ(dump.exit_code, 0) << dump.err;
+  EXPECT_NE(dump.out.find("DATASPACE  SIMPLE { ( 4, 4 ) / ( 4, 4 ) }"), std::string::npos) << dump.out;
+  const auto py = test::run_command(fmt::format(
+      "/usr/bin/python3 -c \"import h5py; f = h5py.File('{}', 'r'); c = f['clumps/lattice-2mm']; "
+      "print(f.attrs['schema_version'], c['spheres'].shape, c.attrs['mass_kg'], c['error'].attrs['dice'])\"",
+      (dir / "lib.h5").string()));
+  ASSERT_EQ(py.exit_code, 0) << py.err;
+  EXPECT_EQ(py.out, "1 (4, 4) 0.0037143881418471576 0.644\n");
+}
+
+TEST(ClumpLibrary, ForeignDamagedAndMissingFilesAreClearErrors) {
+  test::ScratchDir dir("h5");
+  test::write_text(dir / "text.h5", "not hdf5 at all");
+  const auto text = read_clump_library(dir / "text.h5");
+  ASSERT_FALSE(text);
+  EXPECT_NE(text.error().message.find("not an HDF5 file"), std::string::npos);
+
+  {
+    const hid_t file = H5Fcreate((dir / "foreign.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    H5Fclose(file);
+  }
+  const auto foreign = read_clump_library(dir / "foreign.h5");
+  ASSERT_FALSE(foreign);
+  EXPECT_NE(foreign.error().message.find("not a clumpforge clump library"), std::string::npos);
+
+  ASSERT_TRUE(write_clump_library(dir / "good.h5", std::vector<Clump>{sample_clump("c", 50)}));
+  const std::string bytes = test::read_text(dir / "good.h5");
+  test::write_text(dir / "truncated.h5", bytes.substr(0, bytes.size() / 2));
+  const auto truncated = read_clump_library(dir / "truncated.h5");
+  ASSERT_FALSE(truncated);
+  EXPECT_NE(truncated.error().message.find("truncated.h5"), std::string::npos) << truncated.error().message;
+
+  EXPECT_EQ(read_clump_library(dir / "missing.h5").error().code, ErrorCode::NotFound);
+}
+
+TEST(ClumpLibrary, RefusesDuplicateNamesAndUnwritablePaths) {
+  test::ScratchDir dir("h5");
+  const std::vector<Clump> twins{sample_clump("same", 2), sample_clump("same", 3)};
+  EXPECT_FALSE(write_clump_library(dir / "lib.h5", twins));
+  EXPECT_FALSE(write_clump_library(dir / "no" / "lib.h5", std::vector<Clump>{sample_clump("c", 2)}));
+  EXPECT_EQ(test::count_files(dir.path()), 0);
+}
+
+TEST(ClumpLibrary, SelectsByNameOrTheOnlyOne) {
+  std::vector<Clump> two{sample_clump("a", 2), sample_clump("b", 3)};
+  EXPECT_EQ(select_clump(two, "b", "f.h5")->name, "b");
+  const auto ambiguous = select_clump(two, "", "f.h5");
+  ASSERT_FALSE(ambiguous);
+  EXPECT_NE(ambiguous.error().message.find("--clump"), std::string::npos);
+  EXPECT_EQ(select_clump({sample_clump("only", 2)}, "", "f.h5")->name, "only");
+}
+
+}  // namespace clumpforge
