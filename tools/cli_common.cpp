@@ -5,6 +5,12 @@
 #include <cstdio>
 #include <fmt/format.h>
 
+#include <chrono>
+
+#include "core/sha256.hpp"
+#include "core/units.hpp"
+#include "mesh/load.hpp"
+
 namespace clumpforge::cli {
 
 int report_error(std::string_view command, const Error& error) {
@@ -53,6 +59,35 @@ nlohmann::json to_json(const MassProperties& props) {
           {"inertia_kg_m2", to_json(props.inertia)},
           {"principal_moments_kg_m2", to_json(props.principal_moments)},
           {"principal_axes", to_json(props.principal_axes)}};
+}
+
+Result<LoadedBody> load_closed_body(const std::string& path, const std::string& units, double density, const SdfOptions& sdf,
+                                    const RunContext& context) {
+  auto unit = parse_length_unit(units);
+  if (!unit) return std::unexpected(unit.error());
+  if (!(density > 0.0) || density > 1e5) {
+    return fail(ErrorCode::InvalidArgument, fmt::format("--density {} is not a plausible density in kg/m^3", density));
+  }
+  auto loaded = load_mesh(path, {.unit = *unit});
+  if (!loaded) return std::unexpected(loaded.error());
+  auto digest = sha256_file(path);
+  if (!digest) return std::unexpected(digest.error());
+  remove_unused_points(loaded->soup);
+  if (auto ok = check_closed_body(loaded->soup, path); !ok) return std::unexpected(ok.error());
+  auto body = prepare_body(loaded->soup, density, sdf, context);
+  if (!body) return fail(body.error().code, fmt::format("'{}': {}", path, body.error().message));
+  return LoadedBody{std::move(*body), *digest};
+}
+
+RunContext progress_context(bool json) {
+  RunContext context;
+  if (!json && stderr_is_terminal()) {
+    const auto started = std::chrono::steady_clock::now();
+    context.progress = [started](std::string_view stage, double fraction) {
+      if (std::chrono::steady_clock::now() - started > std::chrono::seconds(1)) print_progress(stage, fraction);
+    };
+  }
+  return context;
 }
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }

@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "mesh/mass_properties.hpp"
 #include "mesh/topology.hpp"
+#include "fill/body.hpp"
 
 namespace clumpforge::cli {
 
@@ -23,6 +24,18 @@ nlohmann::json to_json(const Eigen::Vector3d& v);
 nlohmann::json to_json(const Eigen::Matrix3d& m);  ///< list of rows
 nlohmann::json to_json(const MeshStats& stats);
 nlohmann::json to_json(const MassProperties& props);
+
+/// Loads a closed mesh file, records its SHA-256 and prepares it for filling (principal
+/// frame, signed distance). Errors name the file.
+struct LoadedBody {
+  PreparedBody body;
+  std::string sha256;
+};
+Result<LoadedBody> load_closed_body(const std::string& path, const std::string& units, double density, const SdfOptions& sdf,
+                                    const RunContext& context);
+
+/// Progress on stderr after the first second, when stderr is a terminal and not --json.
+RunContext progress_context(bool json);
 
 /// Progress on stderr while a long step runs, only when stderr is a terminal.
 void print_progress(std::string_view stage, double fraction);

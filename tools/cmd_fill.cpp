@@ -2,6 +2,7 @@
 //                  [--max-spheres N] [--target-error X] [--json]
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <memory>
@@ -9,12 +10,11 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "core/atomic_file.hpp"
-#include "core/sha256.hpp"
 #include "io/clump_library.hpp"
 #include "core/text.hpp"
+#include "core/units.hpp"
 #include "fill/fill.hpp"
 #include "fill_report.hpp"
-#include "mesh/load.hpp"
 
 namespace clumpforge::cli {
 namespace {
@@ -89,18 +89,7 @@ int run_fill(const FillArgs& args) {
   base.max_spheres = args.max_spheres;
   base.target_error = args.target_error;
   if (args.max_spheres < 0) return report_error(kCommand, {ErrorCode::InvalidArgument, "--max-spheres must not be negative"});
-  if (!(args.density > 0.0)) return report_error(kCommand, {ErrorCode::InvalidArgument, "--density must be positive"});
-  auto unit = parse_length_unit(args.units);
-  if (!unit) return report_error(kCommand, unit.error());
   if (auto ok = check_writable(args.output); !ok) return report_error(kCommand, ok.error());
-
-  auto loaded = load_mesh(args.input, {.unit = *unit});
-  if (!loaded) return report_error(kCommand, loaded.error());
-  auto digest = sha256_file(args.input);
-  if (!digest) return report_error(kCommand, digest.error());
-  remove_unused_points(loaded->soup);
-  if (auto ok = check_closed_body(loaded->soup, args.input); !ok) return report_error(kCommand, ok.error());
-
   SdfOptions sdf;
   sdf.feature_size = base.method == FillMethod::Lattice ? *std::min_element(diameters.begin(), diameters.end()) : 1e-3;
   if (!args.voxel.empty()) {
@@ -108,15 +97,11 @@ int run_fill(const FillArgs& args) {
     if (!v) return report_error(kCommand, v.error());
     sdf.voxel_size = *v;
   }
-  RunContext context;
-  const auto started = std::chrono::steady_clock::now();
-  if (!args.json && stderr_is_terminal()) {
-    context.progress = [started](std::string_view stage, double fraction) {
-      if (std::chrono::steady_clock::now() - started > std::chrono::seconds(1)) print_progress(stage, fraction);
-    };
-  }
-  auto body = prepare_body(loaded->soup, args.density, sdf, context);
-  if (!body) return report_error(kCommand, Error{body.error().code, fmt::format("'{}': {}", args.input, body.error().message)});
+  const RunContext context = progress_context(args.json);
+  auto loaded = load_closed_body(args.input, args.units, args.density, sdf, context);
+  if (!loaded) return report_error(kCommand, loaded.error());
+  const PreparedBody* body = &loaded->body;
+  const std::string& digest = loaded->sha256;
 
   nlohmann::json report;
   report["input"] = args.input;
@@ -135,7 +120,7 @@ int run_fill(const FillArgs& args) {
     filled->clump.name = options.method == FillMethod::Lattice
                              ? fmt::format("lattice-{:g}mm", options.diameter * 1e3)
                              : fmt::format("adaptive-{}", filled->clump.spheres.size());
-    filled->clump.source_sha256 = *digest;
+    filled->clump.source_sha256 = digest;
     nlohmann::json entry = clump_to_json(filled->clump);
     entry["fill_seconds"] = seconds;
     report["clumps"].push_back(entry);

@@ -15,5 +15,6 @@ Command add_repair_command(CLI::App& app);
 Command add_props_command(CLI::App& app);
 Command add_fill_command(CLI::App& app);
 Command add_export_command(CLI::App& app);
+Command add_study_command(CLI::App& app);
 
 }  // namespace clumpforge::cli
