@@ -1,18 +1,33 @@
 #!/usr/bin/env bash
-# README command 1: set up, build, and run the main job on the bundled default scan.
+# README command 1: set up, build, and run the main job on the bundled default scan:
+# repair -> mass properties -> fill (lattice 1, 2, 4 mm and adaptive) -> error report -> exports.
 # Results go to out/main/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
 cf=./build/tools/clumpforge
 scan=meshes/tuber-default.stl
-mkdir -p out/main
+out=out/main
+rm -rf "$out"
+mkdir -p "$out/exports"
 echo
 echo "== 1. repair the raw scan ($scan)"
-$cf repair "$scan" -o out/main/tuber-default.stl
+$cf repair "$scan" -o "$out/tuber-default.stl"
 echo
 echo "== 2. mass properties of the repaired body at the study's density (1085 kg/m^3)"
-$cf props out/main/tuber-default.stl --density 1085
-$cf props out/main/tuber-default.stl --density 1085 --json > out/main/tuber-default.props.json
+$cf props "$out/tuber-default.stl" --density 1085
+$cf props "$out/tuber-default.stl" --density 1085 --json > "$out/tuber-default.props.json"
 echo
-echo "main job done: out/main/tuber-default.stl, out/main/tuber-default.props.json"
+echo "== 3. fill: the study's lattice (1, 2, 4 mm spheres) and the adaptive method, with error reports"
+$cf fill "$out/tuber-default.stl" -o "$out/tuber-default.h5" --diameters 1,2,4mm
+$cf fill "$out/tuber-default.stl" -o "$out/tuber-default.h5" --append --method adaptive --max-spheres 427
+$cf fill "$out/tuber-default.stl" -o "$out/tuber-default.h5" --append --method adaptive --max-spheres 128
+echo
+echo "== 4. exports of the 2 mm lattice (the study's model) and the 128-sphere adaptive clump"
+source scripts/export-all.sh
+for clump in lattice-2mm adaptive-128; do
+  export_all "$out/tuber-default.h5" "$clump" "$out/exports"
+  echo "$out/exports/$clump/: $(ls "$out/exports/$clump" | tr '\n' ' ')"
+done
+echo
+echo "main job done: $out/ (repaired mesh, props JSON, clump library tuber-default.h5, exports/)"

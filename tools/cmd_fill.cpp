@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -32,6 +33,7 @@ struct FillArgs {
   std::string units = "mm";
   double density = 1085.0;
   bool json = false;
+  bool append = false;
 };
 
 // "1,2,4mm" or "1mm,2mm" -> metres; the unit of the last item applies to bare numbers.
@@ -126,6 +128,19 @@ int run_fill(const FillArgs& args) {
     report["clumps"].push_back(entry);
     clumps.push_back(std::move(filled->clump));
   }
+  if (args.append && std::filesystem::exists(args.output)) {
+    auto existing = read_clump_library(args.output);
+    if (!existing) return report_error(kCommand, existing.error());
+    for (const auto& c : clumps) {
+      for (const auto& e : *existing) {
+        if (e.name == c.name) {
+          return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("'{}' already holds a clump '{}'", args.output, c.name)});
+        }
+      }
+    }
+    existing->insert(existing->end(), clumps.begin(), clumps.end());
+    clumps = std::move(*existing);
+  }
   if (auto ok = write_clump_library(args.output, clumps); !ok) return report_error(kCommand, ok.error());
   if (report["clumps"].size() == 1) report.update(report["clumps"][0]);
   if (args.json) {
@@ -161,6 +176,7 @@ Command add_fill_command(CLI::App& app) {
   sub->add_option("--voxel", args->voxel, "Signed-distance voxel size, e.g. 0.1mm (default: smallest diameter / 8)");
   sub->add_option("--density", args->density, "Bulk density [kg/m^3] (default: the Corydalis tuber's)")->capture_default_str();
   sub->add_option("--units", args->units, "Length unit of the mesh file: mm, cm or m")->capture_default_str();
+  sub->add_flag("--append", args->append, "Add the clumps to an existing library file instead of replacing it");
   sub->add_flag("--json", args->json, "Print one JSON report on stdout");
   return {sub, [args] { return run_fill(*args); }};
 }

@@ -24,7 +24,10 @@ constexpr std::array<std::pair<std::string_view, ExportFormat>, 8> kFormats{{{"l
 
 using Files = std::vector<std::pair<fs::path, std::string>>;
 
+// Scalars (mass, inertia, volume) keep every bit; sphere coordinates keep 10 digits,
+// a tenth of a nanometre on a 10 mm particle, and half the file size.
 std::string number(double value) { return fmt::format("{:.17g}", value); }
+std::string coordinate(double value) { return fmt::format("{:.10g}", value); }
 
 // A name usable as a LIGGGHTS fix ID or a Python identifier.
 std::string identifier(const std::string& name) {
@@ -48,7 +51,7 @@ Files liggghts(const Clump& c, const fs::path& output) {
   // LIGGGHTS-PUBLIC fix particletemplate/multisphere: one "x y z r" line per sphere, '#'
   // comments allowed, as many lines as nspheres; `scale` is mandatory after `file`.
   std::string spheres = "# " + provenance(c) + "\n";
-  for (const auto& s : c.spheres) spheres += fmt::format("{} {} {} {}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  for (const auto& s : c.spheres) spheres += fmt::format("{} {} {} {}\n", coordinate(s.centre.x()), coordinate(s.centre.y()), coordinate(s.centre.z()), coordinate(s.radius));
   const std::string id = identifier(c.name);
   const Eigen::Matrix3d& I = c.inertia;
   std::string snippet = fmt::format(
@@ -67,7 +70,7 @@ Files yade(const Clump& c, const fs::path& output) {
   // YADE ymport.textClumps: whitespace-separated "x y z r clumpId", '#' lines skipped, no
   // blank lines (they crash the reader).
   std::string text = "#format x_y_z_r_clumpId\n# " + provenance(c) + "\n";
-  for (const auto& s : c.spheres) text += fmt::format("{} {} {} {} 0\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  for (const auto& s : c.spheres) text += fmt::format("{} {} {} {} 0\n", coordinate(s.centre.x()), coordinate(s.centre.y()), coordinate(s.centre.z()), coordinate(s.radius));
   const Eigen::Vector3d& m = c.principal_moments;
   std::string script = fmt::format(
       "# {}\n"
@@ -128,7 +131,7 @@ Files pfc(const Clump& c, const fs::path& output) {
   std::string text = "; " + provenance(c) + "\n";
   text += fmt::format("clump template create name '{}' ...\n    pebbles {} ...\n", identifier(c.name), c.spheres.size());
   for (const auto& s : c.spheres) {
-    text += fmt::format("        {} {} {} {} ...\n", number(s.radius), number(s.centre.x()), number(s.centre.y()), number(s.centre.z()));
+    text += fmt::format("        {} {} {} {} ...\n", coordinate(s.radius), coordinate(s.centre.x()), coordinate(s.centre.y()), coordinate(s.centre.z()));
   }
   const Eigen::Matrix3d unit = c.inertia / c.density;
   text += fmt::format("    volume {} ...\n    inertia {} {} {} {} {} {}\n", number(c.body_volume), number(unit(0, 0)),
@@ -142,7 +145,7 @@ Files mercurydpm(const Clump& c, const fs::path& output) {
   // pd.txt (principal directions, 3 rows).
   const fs::path root = output / identifier(c.name);
   std::string pebbles;
-  for (const auto& s : c.spheres) pebbles += fmt::format("{},{},{},{}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  for (const auto& s : c.spheres) pebbles += fmt::format("{},{},{},{}\n", coordinate(s.centre.x()), coordinate(s.centre.y()), coordinate(s.centre.z()), coordinate(s.radius));
   std::string toi;
   for (int r = 0; r < 3; ++r) toi += fmt::format("{},{},{}\n", number(c.inertia(r, 0)), number(c.inertia(r, 1)), number(c.inertia(r, 2)));
   return {{root / "clump" / "clump.txt", pebbles},
@@ -155,7 +158,7 @@ Files chrono(const Clump& c, const fs::path& output) {
   // Chrono DEM-Engine LoadClumpType(mass, moi, "clump.csv", material): a CSV with header
   // "x,y,z,r"; mass and principal moments go beside it.
   std::string csv = "x,y,z,r\n";
-  for (const auto& s : c.spheres) csv += fmt::format("{},{},{},{}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  for (const auto& s : c.spheres) csv += fmt::format("{},{},{},{}\n", coordinate(s.centre.x()), coordinate(s.centre.y()), coordinate(s.centre.z()), coordinate(s.radius));
   const Eigen::Vector3d& m = c.principal_moments;
   std::string props = fmt::format(
       "{{\n  \"comment\": \"{}\",\n  \"clump_file\": \"{}\",\n  \"mass_kg\": {},\n  \"moi_kg_m2\": [{}, {}, {}],\n"
@@ -170,8 +173,8 @@ Files vtk(const Clump& c, const fs::path& output) {
   std::string points, radii, offsets, connectivity;
   for (std::size_t i = 0; i < c.spheres.size(); ++i) {
     const auto& s = c.spheres[i];
-    points += fmt::format("{} {} {}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()));
-    radii += number(s.radius) + "\n";
+    points += fmt::format("{} {} {}\n", coordinate(s.centre.x()), coordinate(s.centre.y()), coordinate(s.centre.z()));
+    radii += coordinate(s.radius) + "\n";
     connectivity += fmt::format("{}\n", i);
     offsets += fmt::format("{}\n", i + 1);
   }
@@ -190,7 +193,7 @@ Files vtk(const Clump& c, const fs::path& output) {
 
 Files csv(const Clump& c, const fs::path& output) {
   std::string text = "x_m,y_m,z_m,r_m\n";
-  for (const auto& s : c.spheres) text += fmt::format("{},{},{},{}\n", number(s.centre.x()), number(s.centre.y()), number(s.centre.z()), number(s.radius));
+  for (const auto& s : c.spheres) text += fmt::format("{},{},{},{}\n", coordinate(s.centre.x()), coordinate(s.centre.y()), coordinate(s.centre.z()), coordinate(s.radius));
   return {{output, text}};
 }
 }  // namespace

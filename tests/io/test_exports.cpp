@@ -46,7 +46,7 @@ void expect_spheres(const std::vector<std::vector<double>>& rows, const Clump& c
     const auto& s = c.spheres[i];
     const std::array<double, 4> expected = radius_first ? std::array{s.radius, s.centre.x(), s.centre.y(), s.centre.z()}
                                                         : std::array{s.centre.x(), s.centre.y(), s.centre.z(), s.radius};
-    for (int k = 0; k < 4; ++k) EXPECT_NEAR(rows[i][k], expected[k] * scale, 1e-12 * scale) << "sphere " << i;
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(rows[i][k], expected[k] * scale, 1e-12 * scale) << "sphere " << i;  // 10 digits of mm-sized values
   }
 }
 

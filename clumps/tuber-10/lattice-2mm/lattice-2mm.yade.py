@@ -1,0 +1,27 @@
+# clumpforge 0.1.0 clump 'lattice-2mm' (lattice method, 272 spheres); source mesh sha256 a20d27d58a2eb6013870a4663af14ad35f6c0bd0eb6bac0fc18841c54b858d29; frame: principal axes, centre of mass at the origin; SI units
+# Builds the clump in YADE with the body's true mass and inertia. Use inside a YADE script:
+#   exec(open('lattice-2mm.yade.py').read()); clump_id = add_clump(material=my_material, position=Vector3(0, 0, 0.1))
+# ymport.textClumps sums the spheres' volumes (overlaps counted twice), so the mass and inertia it
+# computes are replaced here. YADE keeps a diagonal inertia in the clump's own frame, which it
+# chooses from the spheres; the body's tensor is expressed in that frame and its diagonal is used.
+import os
+from yade import ymport
+from yade.minieigenHP import Vector3, Matrix3, Quaternion
+CF_SPHERES_FILE = os.path.join(os.path.dirname(os.path.abspath(globals().get('__file__', 'lattice-2mm.yade.py'))), 'lattice-2mm.yade.txt')
+CF_MASS = 0.0023917457852023504  # kg
+CF_PRINCIPAL_MOMENTS = Vector3(5.7518659886934314e-08, 6.0667421924060947e-08, 8.1789546432220929e-08)  # kg m^2, about the principal axes x, y, z
+CF_DENSITY = 1085  # kg/m^3
+
+def add_clump(material=None, position=Vector3(0, 0, 0), spheres_file=None):
+    kw = {} if material is None else {'material': material}
+    path = spheres_file or CF_SPHERES_FILE
+    if not os.path.exists(path):
+        path = os.path.join(os.getcwd(), 'lattice-2mm.yade.txt')
+    clump_id = ymport.textClumps(path, shift=position, **kw)[0][0]
+    state = O.bodies[clump_id].state
+    rotation = state.ori.toRotationMatrix()
+    body = Matrix3(CF_PRINCIPAL_MOMENTS[0], 0, 0, 0, CF_PRINCIPAL_MOMENTS[1], 0, 0, 0, CF_PRINCIPAL_MOMENTS[2])
+    local = rotation.transpose() * body * rotation
+    state.mass = CF_MASS
+    state.inertia = Vector3(local[0, 0], local[1, 1], local[2, 2])
+    return clump_id

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Regenerates clumps/ from the bundled scans in meshes/ (run after scripts/build.sh):
+#  clumps/<scan>.h5       clump library: lattice 1, 2, 4 mm (the study's method) and adaptive
+#                         clumps with as many spheres as the 4 and 2 mm lattices and a tenth
+#                         of the 1 mm lattice's;
+#  clumps/<scan>/<clump>/ exports of each clump in every format (the 1 mm lattice, eight
+#                         times larger, only in the library: `clumpforge export` writes it).
+# For the batch scans (tuber-01..10) the exports are those of the 2 mm lattice and of the
+# adaptive clump of the same size.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cf=build/tools/clumpforge
+[ -x "$cf" ] || { echo "build first: bash scripts/build.sh" >&2; exit 1; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+names() { /usr/bin/python3 -c 'import json, sys; print(" ".join(c["name"] for c in json.load(sys.stdin)["clumps"]))'; }
+counts() { /usr/bin/python3 -c 'import json, sys; print(" ".join(str(c["sphere_count"]) for c in json.load(sys.stdin)["clumps"]))'; }
+source scripts/export-all.sh
+rm -rf clumps
+mkdir -p clumps
+for scan in meshes/*.stl; do
+  name=$(basename "$scan" .stl)
+  body="$work/$name.stl"
+  lib="clumps/$name.h5"
+  $cf repair "$scan" -o "$body" > /dev/null
+  read -r n1 n2 n4 <<< "$($cf fill "$body" -o "$lib" --diameters 1,2,4mm --json | counts)"
+  adaptive=()
+  for n in "$n4" "$n2" $((n1 / 10)); do
+    adaptive+=("$($cf fill "$body" -o "$lib" --append --method adaptive --max-spheres "$n" --json | names)")
+  done
+  if [ "$name" = tuber-default ]; then
+    for clump in lattice-2mm lattice-4mm "${adaptive[@]}"; do export_all "$lib" "$clump" "clumps/$name"; done
+  else
+    for clump in lattice-2mm "${adaptive[1]}"; do export_all "$lib" "$clump" "clumps/$name"; done
+  fi
+  echo "clumps/$name.h5: lattice $n1 / $n2 / $n4 spheres; ${adaptive[*]}"
+done
