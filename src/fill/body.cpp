@@ -17,7 +17,6 @@ Result<PreparedBody> prepare_body(const TriangleSoup& soup, double density, cons
   auto sdf = compute_signed_distance(body.soup, sdf_options, context);
   if (!sdf) return std::unexpected(sdf.error());
   body.sdf = std::move(*sdf);
-  body.surface = std::make_shared<SurfaceDistance>(body.soup);
   return body;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 /// A closed body made ready for filling: in its principal frame, with its signed distance.
 #include <memory>
+#include <mutex>
 
 #include "core/error.hpp"
 #include "core/run_context.hpp"
@@ -10,12 +11,28 @@
 
 namespace clumpforge {
 
+/// Exact distances to a body's surface, built on first use (only error reports need them).
+class LazySurfaceDistance {
+ public:
+  const SurfaceDistance& get(const TriangleSoup& soup) {
+    std::call_once(built_, [&] { value_ = std::make_unique<SurfaceDistance>(soup); });
+    return *value_;
+  }
+
+ private:
+  std::once_flag built_;
+  std::unique_ptr<SurfaceDistance> value_;
+};
+
 struct PreparedBody {
   TriangleSoup soup;             ///< principal frame: centroid at the origin, principal axes along x, y, z
   MassProperties properties;     ///< in the principal frame (diagonal inertia)
   MassProperties original;       ///< in the mesh file's frame
   SignedDistance sdf;            ///< of `soup`
-  std::shared_ptr<const SurfaceDistance> surface;  ///< exact distances to `soup`
+  std::shared_ptr<LazySurfaceDistance> surface_cache = std::make_shared<LazySurfaceDistance>();
+
+  /// Exact unsigned distances to `soup` (an AABB tree, built on the first call).
+  const SurfaceDistance& surface() const { return surface_cache->get(soup); }
 };
 
 /// Checks that `soup` is a closed outward body, moves it into its principal frame and

@@ -193,7 +193,7 @@ void surface_distances(const PreparedBody& body, std::span<const Sphere> spheres
     if (signed_depth[i] > 0.0) protruding.push_back(boundary[i]);
   }
   std::vector<double> from_union(protruding.size());
-  body.surface->distances(protruding, from_union);
+  body.surface().distances(protruding, from_union);
   double sum_squares = 0.0, largest = 0.0;
   for (const auto* distances : {&from_mesh, &from_union}) {
     for (double d : *distances) {

@@ -234,7 +234,7 @@ Result<RepairStep> remove_self_intersections(TriangleSoup& soup, const RepairOpt
                      {"holes_refilled", holes_refilled}}};
 }
 
-Result<void> check_result(const TriangleSoup& soup) {
+Result<MeshStats> check_result(const TriangleSoup& soup) {
   const MeshStats stats = analyze_topology(soup);
   if (stats.faces == 0) return fail(ErrorCode::RepairFailed, "repair removed every face: nothing is left of the body");
   if (!stats.closed) {
@@ -248,7 +248,7 @@ Result<void> check_result(const TriangleSoup& soup) {
                 fmt::format("the repaired surface encloses no volume ({:.3g} m^3): the input is a sheet, not a body",
                             stats.volume));
   }
-  return {};
+  return stats;
 }
 
 }  // namespace
@@ -287,9 +287,13 @@ Result<RepairResult> repair_mesh(TriangleSoup soup, const RepairOptions& options
   if (!intersections) return std::unexpected(intersections.error());
   result.steps.push_back(std::move(*intersections));
   remove_unused_points(soup);
-  if (auto ok = check_result(soup); !ok) return std::unexpected(ok.error());
-  // Outer shells outwards, cavities inwards, now that the surface is closed and clean.
-  if (auto ok = detail::orient_outward_closed(soup); !ok) return std::unexpected(ok.error());
+  const auto stats = check_result(soup);
+  if (!stats) return std::unexpected(stats.error());
+  // Outer shells outwards, cavities inwards, now that the surface is closed and clean. A
+  // single closed component with positive volume already is (check_result saw to that).
+  if (stats->components > 1) {
+    if (auto ok = detail::orient_outward_closed(soup); !ok) return std::unexpected(ok.error());
+  }
   context.report("done", 1.0);
   result.soup = std::move(soup);
   return result;
