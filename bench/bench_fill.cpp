@@ -12,7 +12,7 @@
 
 #include "fill/fill.hpp"
 #include "fill/study.hpp"
-#include "io/mesh_writer.hpp"
+#include "mesh/mesh_writer.hpp"
 #include "mesh/load.hpp"
 #include "mesh/repair.hpp"
 #include "synth/tuber.hpp"

@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "io/mesh_writer.hpp"
+#include "mesh/mesh_writer.hpp"
 #include "mesh/load.hpp"
 #include "mesh/mass_properties.hpp"
 #include "mesh/repair.hpp"

@@ -7,7 +7,7 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "core/atomic_file.hpp"
-#include "io/mesh_writer.hpp"
+#include "mesh/mesh_writer.hpp"
 #include "mesh/load.hpp"
 #include "mesh/repair.hpp"
 

@@ -8,7 +8,7 @@
 #include "cli_common.hpp"
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
-#include "io/mesh_writer.hpp"
+#include "mesh/mesh_writer.hpp"
 #include "mesh/mass_properties.hpp"
 #include "synth/tuber.hpp"
 

@@ -3,7 +3,7 @@
 
 #include <fmt/format.h>
 
-#include "io/mesh_writer.hpp"
+#include "mesh/mesh_writer.hpp"
 #include "mesh/load.hpp"
 #include "mesh/mass_properties.hpp"
 #include "mesh/topology.hpp"

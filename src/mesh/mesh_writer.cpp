@@ -1,4 +1,4 @@
-#include "io/mesh_writer.hpp"
+#include "mesh/mesh_writer.hpp"
 
 #include <algorithm>
 #include <cstring>

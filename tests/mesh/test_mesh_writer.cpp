@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "io/mesh_writer.hpp"
+#include "mesh/mesh_writer.hpp"
 #include "mesh/load.hpp"
 #include "mesh/topology.hpp"
 #include "support/test_support.hpp"

@@ -1,0 +1,102 @@
+#pragma once
+/// The DEM's plain data: rigid multi-sphere bodies, walls, contact history, settings.
+/// Free functions in step.hpp advance it.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "dem/materials.hpp"
+#include "dem/terms/terms.hpp"
+#include "fill/clump.hpp"
+
+namespace clumpforge {
+
+/// A rigid clump: spheres fixed in its body frame (principal axes, centre of mass at the
+/// origin), diagonal inertia in that frame.
+struct RigidBody {
+  std::vector<Sphere> spheres;                                  ///< body frame [m]
+  double mass = 0.0;                                            ///< [kg]
+  Eigen::Vector3d inertia = Eigen::Vector3d::Ones();            ///< principal moments [kg m^2]
+  int material = 0;                                             ///< index into World::materials
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();           ///< centre of mass, world [m]
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();           ///< [m/s]
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< body -> world
+  Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();   ///< world frame [kg m^2/s]
+  double bounding_radius = 0.0;                                 ///< max |centre| + radius [m]
+  std::vector<double> reach;                                    ///< per sphere: |centre| + radius [m]
+
+  Eigen::Vector3d angular_velocity() const;                     ///< world frame [rad/s]
+  Eigen::Vector3d sphere_position(std::size_t k) const { return position + orientation * spheres[k].centre; }
+  double kinetic_energy() const;
+};
+
+/// Makes a body from a clump (its spheres, the clump's corrected mass and principal moments).
+RigidBody make_body(const Clump& clump, int material);
+/// A one-sphere body (for analytic benchmarks): solid sphere of `radius` and `density`.
+RigidBody make_sphere_body(double radius, double density, int material);
+
+/// A wall: an infinite plane, or a rectangle on it (|u|, |v| within the half sizes), that
+/// may rotate at a constant rate about an axis through its `pivot`.
+struct Wall {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();    ///< on the surface [m]
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit, towards the particles
+  Eigen::Vector3d u_axis = Eigen::Vector3d::UnitX();  ///< in-plane axes of a finite plate
+  double half_u = 0.0, half_v = 0.0;                  ///< [m]; 0 = infinite in that direction
+  int material = 0;
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();    ///< tilting axis point [m]
+  Eigen::Vector3d spin = Eigen::Vector3d::Zero();     ///< angular velocity of the wall [rad/s]
+
+  Eigen::Vector3d v_axis() const { return normal.cross(u_axis); }
+  /// Velocity of the wall's material point at p.
+  Eigen::Vector3d velocity_at(const Eigen::Vector3d& p) const { return spin.cross(p - pivot); }
+};
+
+enum class RollingModel {
+  None,
+  ConstantTorque,  ///< EDEM standard / Ai et al. type A / LIGGGHTS `cdt`: mu_r Fn R opposing omega
+  Epsd,            ///< Ai et al. type C, LIGGGHTS `epsd`: elastic-plastic spring-dashpot
+};
+/// The lever arm of the rolling torque.
+enum class RollingArm {
+  SphereRadius,     ///< LIGGGHTS: the element sphere's radius
+  ContactToCentre,  ///< EDEM: distance from the contact point to the clump's centre of mass
+};
+
+struct ContactSettings {
+  bool limit_force = false;          ///< LIGGGHTS `limitForce`: clip attractive damped Fn (default off, as LIGGGHTS)
+  bool tangential_damping = true;    ///< LIGGGHTS default
+  RollingModel rolling = RollingModel::ConstantTorque;
+  RollingArm rolling_arm = RollingArm::SphereRadius;
+  double rolling_damping = 0.3;      ///< eta_r of EPSD (Ai et al. suggest 0.3)
+};
+
+/// Contact history (tangential spring, rolling spring) of one sphere pair or sphere-wall pair.
+struct ContactState {
+  Eigen::Vector3d shear = Eigen::Vector3d::Zero();          ///< accumulated tangential displacement [m]
+  Eigen::Vector3d rolling_torque = Eigen::Vector3d::Zero(); ///< EPSD spring torque [N m]
+  std::uint64_t last_step = 0;
+};
+
+struct World {
+  std::vector<RigidBody> bodies;
+  std::vector<Wall> walls;
+  std::vector<Material> materials;
+  /// interaction[i][j] for material indices i, j.
+  std::vector<std::vector<Interaction>> interactions;
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};
+  ContactSettings contact;
+  std::vector<PhysicsTerm> terms;   ///< extra physics (air drag, ...)
+  double time = 0.0;                ///< [s]
+  std::uint64_t steps = 0;
+  std::unordered_map<std::uint64_t, ContactState> history;  ///< key: contact id
+  /// Per (body, wall): spheres that may touch the wall before the next refresh.
+  std::vector<std::vector<std::vector<int>>> wall_candidates;
+  std::vector<double> candidate_travel;  ///< per body: motion since its candidates were refreshed [m]
+};
+
+/// Adds `material` (if new) and returns its index; interactions default to `fallback`.
+int add_material(World& world, const Material& material);
+void set_interaction(World& world, int a, int b, const Interaction& interaction);
+
+}  // namespace clumpforge
