@@ -1,7 +1,7 @@
 #pragma once
 #include <nlohmann/json.hpp>
 
-#include "fill/clump.hpp"
+#include "core/clump.hpp"
 
 namespace clumpforge::cli {
 /// The clump's error report under the documented --json keys.

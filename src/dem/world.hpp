@@ -8,7 +8,7 @@
 
 #include "dem/materials.hpp"
 #include "dem/terms/terms.hpp"
-#include "fill/clump.hpp"
+#include "core/clump.hpp"
 
 namespace clumpforge {
 
@@ -66,6 +66,10 @@ enum class RollingArm {
 struct ContactSettings {
   bool limit_force = false;          ///< LIGGGHTS `limitForce`: clip attractive damped Fn (default off, as LIGGGHTS)
   bool tangential_damping = true;    ///< LIGGGHTS default
+  /// Coulomb limit on the whole tangential force (spring + dashpot). LIGGGHTS checks the
+  /// spring alone and adds the dashpot after, which can exceed mu_s |Fn| when a fast-sliding
+  /// contact's normal force grows (false reproduces LIGGGHTS exactly).
+  bool coulomb_on_total = true;
   RollingModel rolling = RollingModel::ConstantTorque;
   RollingArm rolling_arm = RollingArm::SphereRadius;
   double rolling_damping = 0.3;      ///< eta_r of EPSD (Ai et al. suggest 0.3)
@@ -93,6 +97,8 @@ struct World {
   /// Per (body, wall): spheres that may touch the wall before the next refresh.
   std::vector<std::vector<std::vector<int>>> wall_candidates;
   std::vector<double> candidate_travel;  ///< per body: motion since its candidates were refreshed [m]
+  std::vector<Eigen::Vector3d> force, torque;  ///< per body, at the current state (world frame)
+  bool forces_current = false;
 };
 
 /// Adds `material` (if new) and returns its index; interactions default to `fallback`.

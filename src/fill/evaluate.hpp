@@ -4,7 +4,7 @@
 #include <span>
 
 #include "fill/body.hpp"
-#include "fill/clump.hpp"
+#include "core/clump.hpp"
 
 namespace clumpforge {
 

@@ -4,10 +4,6 @@
 
 namespace clumpforge {
 
-std::string_view to_string(FillMethod method) {
-  return method == FillMethod::Lattice ? "lattice" : "adaptive";
-}
-
 namespace {
 Result<void> check_options(const PreparedBody& body, const FillOptions& options) {
   const BoundingBox box = bounding_box(body.soup);

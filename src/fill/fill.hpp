@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "fill/body.hpp"
-#include "fill/clump.hpp"
+#include "core/clump.hpp"
 #include "fill/evaluate.hpp"
 
 namespace clumpforge {

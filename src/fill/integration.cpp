@@ -1,5 +1,7 @@
 #include "fill/integration.hpp"
 
+#include "mesh/mass_properties.hpp"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>

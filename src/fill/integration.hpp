@@ -5,7 +5,7 @@
 /// (midpoint rule with spacing h, with the h^2/12 correction for the second moments).
 #include <span>
 
-#include "fill/clump.hpp"
+#include "core/clump.hpp"
 #include "mesh/triangle_mesh.hpp"
 
 namespace clumpforge {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/error.hpp"
-#include "fill/clump.hpp"
+#include "core/clump.hpp"
 
 namespace clumpforge {
 

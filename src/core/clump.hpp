@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-#include "mesh/mass_properties.hpp"
+#include <string_view>
 
 namespace clumpforge {
 
@@ -63,6 +63,6 @@ struct Clump {
   ClumpError error;
 };
 
-std::string_view to_string(FillMethod method);
+inline std::string_view to_string(FillMethod method) { return method == FillMethod::Lattice ? "lattice" : "adaptive"; }
 
 }  // namespace clumpforge

@@ -1,0 +1,189 @@
+// DEM dynamics against analytic answers, each with its tolerance stated.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "dem/contact.hpp"
+#include "dem_support.hpp"
+
+namespace clumpforge {
+namespace {
+constexpr double kPi = std::numbers::pi;
+constexpr double kG = 9.81;
+const Material kSoft{"soft", 1e7, 0.3, 1000, "test material"};
+const Material kSteel{"steel", 2.06e11, 0.3, 7850, "test material"};
+
+World soft_sphere_world(const Interaction& interaction, double radius) {
+  World world = test::sphere_over_plane(kSoft, kSteel, interaction, radius);
+  world.gravity = {0, 0, -kG};
+  return world;
+}
+
+double contact_time(const World& world, double speed) {
+  const auto& b = world.bodies[0];
+  return test::hertz_theory(b.mass, b.spheres[0].radius, effective_youngs_modulus(kSoft, kSteel), speed).duration;
+}
+
+void tilt_floor(World& world, double degrees) {
+  const double a = degrees * kPi / 180.0;
+  world.walls[0].normal = {std::sin(a), 0, std::cos(a)};  // the surface z = -x tan(a): downhill is +x
+  world.walls[0].u_axis = {std::cos(a), 0, -std::sin(a)};  // the downhill direction
+}
+}  // namespace
+
+TEST(Dynamics, ReboundApexIsRestitutionSquaredTimesDropHeight) {
+  // Sphere dropped from H (lowest point) on a plane: apex of the rebound = e^2 H within 1 %
+  // (the contact's own overlap, micrometres, is the only departure).
+  const double r = 5e-3, h = 0.2;
+  for (double e : {0.3, 0.728}) {
+    SCOPED_TRACE(e);
+    World world = soft_sphere_world({e, 0.0, 0.0}, r);
+    world.bodies[0].position = {0, 0, r + h};
+    const double dt = contact_time(world, std::sqrt(2 * kG * h)) / 1000.0;
+    double apex = 0.0;
+    bool bounced = false;
+    for (int i = 0; i < 5'000'000; ++i) {
+      step(world, dt);
+      if (!bounced && world.bodies[0].velocity.z() > 0 && world.bodies[0].position.z() > r) bounced = true;
+      if (bounced) {
+        apex = std::max(apex, world.bodies[0].position.z() - r);
+        if (world.bodies[0].velocity.z() < 0) break;
+      }
+    }
+    EXPECT_NEAR(apex, e * e * h, 0.01 * e * e * h);
+  }
+}
+
+TEST(Dynamics, SphereRollsDownAnInclineAtFiveSeventhsGSinTheta) {
+  // No slip needs mu_s >= 2/7 tan(theta); a = 5/7 g sin(theta) within 1 %.
+  const double r = 5e-3, degrees = 15.0;
+  World world = soft_sphere_world({0.5, 0.8, 0.0}, r);
+  tilt_floor(world, degrees);
+  world.bodies[0].position = r * world.walls[0].normal;
+  const double dt = contact_time(world, 0.1) / 50.0;
+  for (int i = 0; i < 2000; ++i) step(world, dt);  // settle onto the slope
+  const Eigen::Vector3d downhill = world.walls[0].u_axis;
+  const double s0 = world.bodies[0].position.dot(downhill), v0 = world.bodies[0].velocity.dot(downhill), t0 = world.time;
+  while (world.time - t0 < 0.3) step(world, dt);
+  const double t = world.time - t0;
+  const double a = 2.0 * (world.bodies[0].position.dot(downhill) - s0 - v0 * t) / (t * t);
+  const double expected = 5.0 / 7.0 * kG * std::sin(degrees * kPi / 180.0);
+  EXPECT_NEAR(a, expected, 0.01 * expected);
+}
+
+TEST(Dynamics, ConstantTorqueRollingStopsAtSevenV0SquaredOverTenMuRG) {
+  // Type A (EDEM standard / LIGGGHTS cdt), arm = sphere radius: deceleration 5/7 mu_r g, so
+  // s = 7 v0^2 / (10 mu_r g) (within 2 %).
+  const double r = 5e-3, v0 = 0.5, mu_r = 0.05;
+  World world = soft_sphere_world({0.5, 0.8, mu_r}, r);
+  world.contact.rolling = RollingModel::ConstantTorque;
+  world.bodies[0].position = {0, 0, r};
+  const double dt = contact_time(world, 0.1) / 50.0;
+  for (int i = 0; i < 2000; ++i) step(world, dt);  // settle
+  world.bodies[0].velocity = {v0, 0, 0};
+  world.bodies[0].angular_momentum = world.bodies[0].inertia.y() * Eigen::Vector3d(0, v0 / r, 0);
+  const double x0 = world.bodies[0].position.x();
+  while (world.bodies[0].velocity.x() > 1e-4 && world.time < 10) step(world, dt);
+  const double expected = 7.0 * v0 * v0 / (10.0 * mu_r * kG);
+  EXPECT_NEAR(world.bodies[0].position.x() - x0, expected, 0.02 * expected);
+}
+
+TEST(Dynamics, FlatBlockSlipsAboveTheFrictionAngleOnly) {
+  // A flat 3 x 3 cluster on an incline holds below atan(mu_s) = 26.57 deg and slides above.
+  const double mu = 0.5, r = 1e-3;
+  for (double degrees : {25.5, 27.5}) {
+    SCOPED_TRACE(degrees);
+    World world = soft_sphere_world({0.5, mu, 0.0}, r);
+    world.contact.rolling = RollingModel::None;
+    RigidBody& block = world.bodies[0];
+    block.spheres.clear();
+    for (int i = -1; i <= 1; ++i) {
+      for (int j = -1; j <= 1; ++j) block.spheres.push_back({{2 * r * i, 2 * r * j, 0}, r});
+    }
+    block.reach.assign(9, 0.0);
+    block.bounding_radius = 2 * std::sqrt(2.0) * r + r;
+    block.mass *= 9;
+    block.inertia = Eigen::Vector3d(6 * block.mass * r * r * 4 / 9, 6 * block.mass * r * r * 4 / 9, 12 * block.mass * r * r * 4 / 9);
+    tilt_floor(world, degrees);
+    world.bodies[0].position = r * world.walls[0].normal;
+    world.bodies[0].orientation = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), world.walls[0].normal);
+    const double dt = contact_time(world, 0.1) / 50.0;
+    for (int i = 0; i < 3000; ++i) step(world, dt);
+    const double s0 = world.bodies[0].position.dot(world.walls[0].u_axis);
+    while (world.time < 0.3) step(world, dt);
+    const double moved = world.bodies[0].position.dot(world.walls[0].u_axis) - s0;
+    if (degrees < 26.57) {
+      EXPECT_LT(std::abs(moved), 1e-5);
+    } else {
+      EXPECT_GT(moved, 1e-3);
+    }
+  }
+}
+
+TEST(Dynamics, ElasticFrictionlessBouncesConserveEnergyToOnePartInAMillion) {
+  // e = 1, mu = 0: kinetic + gravitational + Hertz elastic energy (8/15 E* sqrt(R) d^2.5)
+  // stays within 1e-6 of its start over 10 bounces (measured in flight, between contacts,
+  // where the symplectic integrator's shadow energy and the true one coincide).
+  const double r = 5e-3, h = 0.05;
+  World world = soft_sphere_world({1.0, 0.0, 0.0}, r);
+  world.bodies[0].position = {0, 0, r + h};
+  const double e_star = effective_youngs_modulus(kSoft, kSteel);
+  auto energy = [&] {
+    const auto& b = world.bodies[0];
+    const double overlap = std::max(0.0, r - b.position.z());
+    return b.kinetic_energy() + b.mass * kG * b.position.z() + 8.0 / 15.0 * e_star * std::sqrt(r) * std::pow(overlap, 2.5);
+  };
+  const double start = energy();
+  const double dt = contact_time(world, std::sqrt(2 * kG * h)) / 1000.0;
+  int bounces = 0;
+  bool in_contact = false;
+  double worst = 0.0;
+  while (bounces < 10) {
+    step(world, dt);
+    const bool touching = world.bodies[0].position.z() < r;
+    if (in_contact && !touching) ++bounces;
+    in_contact = touching;
+    if (!touching) worst = std::max(worst, std::abs(energy() - start) / start);
+  }
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(Dynamics, TorqueFreeAsymmetricBodyConservesEnergyAndAngularMomentum) {
+  World world;
+  world.gravity.setZero();
+  add_material(world, kSoft);
+  RigidBody body = make_sphere_body(0.01, 1000, 0);
+  body.inertia = {1e-6, 2e-6, 3e-6};
+  body.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
+  // Mostly about the intermediate axis: the unstable, tumbling case.
+  body.angular_momentum = body.orientation * Eigen::Vector3d(0.05e-6, 2e-6 * 3.0, 0.05e-6);
+  world.bodies.push_back(body);
+  const Eigen::Vector3d momentum = world.bodies[0].angular_momentum;
+  const double energy = world.bodies[0].kinetic_energy();
+  double closest = 1.0;
+  for (int i = 0; i < 200000; ++i) {
+    step(world, 1e-4);
+    const Eigen::Vector3d axis = world.bodies[0].orientation * Eigen::Vector3d::UnitY();
+    closest = std::min(closest, std::abs(axis.dot(momentum.normalized())));
+  }
+  EXPECT_LT((world.bodies[0].angular_momentum - momentum).norm(), 1e-15 * momentum.norm() + 1e-20);
+  EXPECT_NEAR(world.bodies[0].kinetic_energy(), energy, 1e-9 * energy);
+  // It did tumble: the intermediate axis turned far from L on the way.
+  EXPECT_LT(closest, 0.5);
+}
+
+TEST(TimeStep, EstimatesAndRefusalOfTooLargeSteps) {
+  World world = soft_sphere_world({0.5, 0.5, 0.0}, 1e-3);
+  const auto estimate = estimate_time_step(world, 2.0);
+  const double t_r = kPi * 1e-3 * std::sqrt(1000.0 / kSoft.shear_modulus()) / (0.1631 * 0.3 + 0.8766);
+  EXPECT_NEAR(estimate.rayleigh, t_r, 1e-12);
+  EXPECT_LE(estimate.chosen, estimate.hertz / 50.0);
+  EXPECT_TRUE(check_time_step(estimate.chosen, estimate));
+  const auto refused = check_time_step(10 * estimate.largest_allowed, estimate);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("stable limit"), std::string::npos);
+  EXPECT_FALSE(check_time_step(-1.0, estimate));
+}
+
+}  // namespace clumpforge
