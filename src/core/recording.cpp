@@ -1,0 +1,31 @@
+#include "core/recording.hpp"
+
+namespace clumpforge {
+
+std::string_view to_string(LabTest test) {
+  switch (test) {
+    case LabTest::Drop: return "drop";
+    case LabTest::Roll: return "roll";
+    case LabTest::Tilt: return "tilt";
+  }
+  return "drop";
+}
+
+std::string_view summary_key(LabTest test) {
+  switch (test) {
+    case LabTest::Drop: return "rebound_height_m";
+    case LabTest::Roll: return "roll_distance_m";
+    case LabTest::Tilt: return "slip_angle_deg";
+  }
+  return "";
+}
+
+std::vector<double> Recording::summaries() const {
+  std::vector<double> values;
+  for (const auto& trial : trials) {
+    if (trial.summary) values.push_back(*trial.summary);
+  }
+  return values;
+}
+
+}  // namespace clumpforge

@@ -1,0 +1,54 @@
+#pragma once
+/// A laboratory (or simulated) recording of one calibration test on one surface, as
+/// ../shared/spec/recording-format.md defines it (format "recording/1").
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace clumpforge {
+
+enum class LabTest { Drop, Roll, Tilt };
+enum class Composite { Single, FourSquare };
+
+std::string_view to_string(LabTest test);
+std::string_view summary_key(LabTest test);  ///< rebound_height_m, roll_distance_m, slip_angle_deg
+
+/// One trial's track: a row per video frame; NaN where tracking was lost.
+struct Track {
+  std::vector<double> t;      ///< [s], arbitrary origin, increasing
+  std::vector<double> x, z;   ///< [m] tracked point (the visible centroid)
+  std::vector<double> angle;  ///< [rad] optional column (empty when absent)
+  std::vector<double> tilt;   ///< [deg] optional column, tilt tests (empty when absent)
+  std::size_t size() const { return t.size(); }
+};
+
+struct Trial {
+  std::string id;
+  std::optional<double> summary;    ///< the test's summary value (SI, degrees for tilt)
+  std::string track_file;           ///< relative to the recording's directory; empty = none
+  std::optional<Track> track;
+  std::string extra_json = "{}";    ///< other keys of the trial, kept when rewriting
+};
+
+struct Recording {
+  LabTest test = LabTest::Drop;
+  std::string surface;
+  double release_height = 0.2;              ///< drop [m]
+  double incline_deg = 30.0;                ///< roll
+  double start_distance = 0.035;            ///< roll [m], along the slope from the foot
+  std::optional<double> tilt_rate_deg_per_s;  ///< tilt; absent when not recorded
+  Composite composite = Composite::Single;  ///< tilt
+  std::optional<std::string> particle_mesh;      ///< relative to the manifest
+  std::optional<std::string> particle_mesh_units;
+  std::optional<double> particle_density;   ///< [kg/m^3]
+  std::optional<double> frame_rate_hz;
+  std::optional<double> position_noise_m;
+  std::vector<Trial> trials;
+  std::string extra_json = "{}";  ///< other top-level keys (notes, ...), kept when rewriting
+
+  /// Summaries of the trials that have one.
+  std::vector<double> summaries() const;
+};
+
+}  // namespace clumpforge

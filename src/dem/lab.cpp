@@ -1,0 +1,280 @@
+#include "dem/lab.hpp"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/rng.hpp"
+
+namespace clumpforge {
+namespace {
+constexpr double kPi = std::numbers::pi;
+
+Eigen::Quaterniond random_orientation(Rng& rng) {
+  Eigen::Quaterniond q(rng.normal(), rng.normal(), rng.normal(), rng.normal());
+  return q.normalized();
+}
+
+// Lowest point of the body along `normal` relative to its centre of mass.
+double lowest_offset(const RigidBody& body, const Eigen::Quaterniond& q, const Eigen::Vector3d& normal) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const auto& s : body.spheres) lowest = std::min(lowest, (q * s.centre).dot(normal) - s.radius);
+  return lowest;
+}
+
+double lowest_height(const RigidBody& body) { return lowest_offset(body, body.orientation, Eigen::Vector3d::UnitZ()) + body.position.z(); }
+
+struct TrialOutcome {
+  Trial trial;
+  Eigen::Quaterniond orientation;
+  std::uint64_t steps = 0;
+};
+
+class TrackSampler {
+ public:
+  explicit TrackSampler(double frame_rate) : interval_(1.0 / frame_rate) {}
+  void sample(const World& world, double tilt_deg = std::numeric_limits<double>::quiet_NaN()) {
+    if (world.time + 1e-12 < next_) return;
+    next_ += interval_;
+    const RigidBody& b = world.bodies[0];
+    track_.t.push_back(world.time);
+    track_.x.push_back(b.position.x());
+    track_.z.push_back(b.position.z());
+    const Eigen::Vector3d axis = b.orientation * Eigen::Vector3d::UnitX();
+    track_.angle.push_back(std::atan2(axis.z(), axis.x()));  // in-plane rotation of the body's x axis
+    if (!std::isnan(tilt_deg)) track_.tilt.push_back(tilt_deg);
+  }
+  Track take() { return std::move(track_); }
+
+ private:
+  double interval_;
+  double next_ = 0.0;
+  Track track_;
+};
+
+bool any_wall_contact(const World& world) { return !world.history.empty(); }
+
+// Drop: released from rest with its lowest point `H` above the plate; the summary is the
+// apex of the first rebound, measured as the rise of the lowest point above the plate.
+TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& options, double dt, Rng& rng) {
+  RigidBody& body = world.bodies[0];
+  body.orientation = random_orientation(rng);
+  body.position = {0, 0, setup.release_height - lowest_offset(body, body.orientation, Eigen::Vector3d::UnitZ())};
+  TrackSampler sampler(options.frame_rate_hz);
+  TrialOutcome out;
+  out.orientation = body.orientation;
+  bool impacted = false, airborne_after = false;
+  double apex = 0.0, impact_time = 0.0;  // apex of the lowest point, >= 0 once it touched
+  while (world.time < options.max_time) {
+    step(world, dt);
+    sampler.sample(world);
+    const bool touching = any_wall_contact(world);
+    if (!impacted && touching) {
+      impacted = true;
+      impact_time = world.time;
+    }
+    if (!impacted) continue;
+    if (!touching) airborne_after = true;
+    if (airborne_after && touching) break;  // the second impact ends the first rebound
+    apex = std::max(apex, lowest_height(world.bodies[0]));
+    if (world.time - impact_time > 0.6) break;  // never left the plate again
+  }
+  out.trial.summary = apex;
+  out.trial.track = sampler.take();
+  out.steps = world.steps;
+  return out;
+}
+
+// Roll: released from rest on the incline with its contact point `L` up the slope from the
+// foot; the summary is the horizontal distance on the flat from the foot where it stops.
+TrialOutcome roll_trial(World world, const Recording& setup, const LabOptions& options, double dt, Rng& rng) {
+  RigidBody& body = world.bodies[0];
+  const double beta = setup.incline_deg * kPi / 180.0;
+  const Eigen::Vector3d normal(std::sin(beta), 0, std::cos(beta));       // incline surface z = -x tan(beta), x < 0
+  const Eigen::Vector3d downhill(std::cos(beta), 0, -std::sin(beta));
+  body.orientation = random_orientation(rng);
+  // Lowest sphere along the incline normal touches the incline at the start point.
+  std::size_t touching = 0;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < body.spheres.size(); ++k) {
+    const double h = (body.orientation * body.spheres[k].centre).dot(normal) - body.spheres[k].radius;
+    if (h < lowest) {
+      lowest = h;
+      touching = k;
+    }
+  }
+  const Eigen::Vector3d contact_point = -setup.start_distance * downhill;
+  const Eigen::Vector3d sphere_offset = body.orientation * body.spheres[touching].centre;
+  const Eigen::Vector3d sphere_centre = contact_point + (body.spheres[touching].radius + 1e-7) * normal;
+  body.position = sphere_centre - sphere_offset;
+  TrackSampler sampler(options.frame_rate_hz);
+  TrialOutcome out;
+  out.orientation = body.orientation;
+  double still_since = -1.0;
+  while (world.time < options.max_time) {
+    step(world, dt);
+    sampler.sample(world);
+    const RigidBody& b = world.bodies[0];
+    const bool still = b.velocity.norm() < 2e-3 && b.angular_velocity().norm() * b.bounding_radius < 2e-3;
+    if (still && world.time > 0.05) {
+      if (still_since < 0) still_since = world.time;
+      if (world.time - still_since > 0.05) break;
+    } else {
+      still_since = -1.0;
+    }
+  }
+  out.trial.summary = std::max(0.0, world.bodies[0].position.x());
+  out.trial.track = sampler.take();
+  out.steps = world.steps;
+  return out;
+}
+
+// Tilt: resting flat on a plate tilted at a steady rate about y; the summary is the plate
+// angle at which sliding starts (1 mm of motion along the plate).
+TrialOutcome tilt_trial(World world, const Recording& setup, const LabOptions& options, double dt, Rng& rng) {
+  RigidBody& body = world.bodies[0];
+  const double yaw = rng.uniform(0.0, 2.0 * kPi);
+  body.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+  body.position = {0, 0, 1e-7 - lowest_offset(body, body.orientation, Eigen::Vector3d::UnitZ())};
+  TrialOutcome out;
+  out.orientation = body.orientation;
+  TrackSampler sampler(options.frame_rate_hz);
+  const double rate = (setup.tilt_rate_deg_per_s ? *setup.tilt_rate_deg_per_s : options.tilt_rate_deg_per_s) * kPi / 180.0;
+  Wall& plate = world.walls[0];
+  // Settle, then tilt.
+  while (world.time < 0.05) step(world, dt);
+  plate.spin = {0, -rate, 0};  // the +x side goes down: sliding towards +x
+  const double start_time = world.time;
+  auto plate_coordinate = [&] { return (world.bodies[0].position - plate.pivot).dot(plate.u_axis); };
+  const double start = plate_coordinate();
+  double slip_angle = std::numeric_limits<double>::quiet_NaN();
+  while (world.time - start_time < options.max_time) {
+    step(world, dt);
+    const double angle = rate * (world.time - start_time) * 180.0 / kPi;
+    sampler.sample(world, angle);
+    if (std::abs(plate_coordinate() - start) > 1e-3) {
+      slip_angle = angle;
+      break;
+    }
+    if (angle > 89.0) break;
+  }
+  out.trial.summary = std::isnan(slip_angle) ? 90.0 : slip_angle;
+  out.trial.track = sampler.take();
+  out.steps = world.steps;
+  return out;
+}
+}  // namespace
+
+RigidBody four_square_body(const Clump& clump, int material) {
+  Eigen::Vector3d low = clump.spheres[0].centre, high = low;
+  for (const auto& s : clump.spheres) {
+    low = low.cwiseMin(s.centre - Eigen::Vector3d::Constant(s.radius));
+    high = high.cwiseMax(s.centre + Eigen::Vector3d::Constant(s.radius));
+  }
+  const Eigen::Vector3d size = high - low;
+  RigidBody body;
+  body.material = material;
+  body.mass = 4.0 * clump.mass;
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+  for (int i : {-1, 1}) {
+    for (int j : {-1, 1}) {
+      // Each copy's centre of mass sits half its extent from the square's centre.
+      const Eigen::Vector3d offset(i * 0.5 * size.x(), j * 0.5 * size.y(), 0.0);
+      for (const auto& s : clump.spheres) body.spheres.push_back({s.centre + offset, s.radius});
+      inertia += clump.principal_moments.asDiagonal().toDenseMatrix() +
+                 clump.mass * (offset.squaredNorm() * Eigen::Matrix3d::Identity() - offset * offset.transpose());
+    }
+  }
+  body.inertia = inertia.diagonal();  // symmetric arrangement: still principal
+  for (const auto& s : body.spheres) {
+    body.reach.push_back(s.centre.norm() + s.radius);
+    body.bounding_radius = std::max(body.bounding_radius, body.reach.back());
+  }
+  return body;
+}
+
+Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, const Recording& setup,
+                               const LabOptions& options, const RunContext& context) {
+  if (options.trials < 1) return fail(ErrorCode::InvalidArgument, "the number of trials must be at least 1");
+  if (clump.spheres.empty() || !(clump.mass > 0.0)) return fail(ErrorCode::InvalidArgument, "the clump has no spheres or no mass");
+  auto particle = table.find(options.particle_material);
+  if (!particle) return std::unexpected(particle.error());
+  auto surface = table.find(setup.surface);
+  if (!surface) return std::unexpected(surface.error());
+  Interaction interaction;
+  if (options.interaction) {
+    interaction = *options.interaction;
+  } else {
+    auto pair = table.interaction(options.particle_material, setup.surface);
+    if (!pair) return std::unexpected(pair.error());
+    interaction = *pair;
+  }
+  if (auto ok = validate_interaction(interaction, fmt::format("{} on {}", options.particle_material, setup.surface)); !ok) {
+    return std::unexpected(ok.error());
+  }
+  World world;
+  const int p = add_material(world, **particle);
+  const int s = add_material(world, **surface);
+  set_interaction(world, p, s, interaction);
+  set_interaction(world, p, p, table.interaction(options.particle_material, options.particle_material).value_or(interaction));
+  set_interaction(world, s, s, interaction);
+  world.contact = options.contact;
+  world.terms = options.terms;
+  world.bodies.push_back(setup.test == LabTest::Tilt && setup.composite == Composite::FourSquare ? four_square_body(clump, p)
+                                                                                                  : make_body(clump, p));
+  Wall floor;
+  floor.material = s;
+  if (setup.test == LabTest::Roll) {
+    const double beta = setup.incline_deg * kPi / 180.0;
+    Wall incline;
+    incline.material = s;
+    incline.normal = {std::sin(beta), 0, std::cos(beta)};
+    incline.u_axis = {std::cos(beta), 0, -std::sin(beta)};
+    incline.half_u = 0.5;
+    incline.point = -0.5 * incline.u_axis;  // the incline ends at the foot, x = 0
+    floor.u_axis = Eigen::Vector3d::UnitX();
+    floor.half_u = 1.0;
+    floor.point = {1.0, 0, 0};  // the flat starts at the foot
+    world.walls = {incline, floor};
+  } else {
+    world.walls = {floor};
+  }
+  const double impact_speed = setup.test == LabTest::Drop ? std::sqrt(2 * 9.81 * setup.release_height)
+                              : setup.test == LabTest::Roll
+                                  ? std::sqrt(2 * 9.81 * setup.start_distance * std::sin(setup.incline_deg * kPi / 180.0)) + 0.2
+                                  : 0.1;
+  LabResult result;
+  result.estimate = estimate_time_step(world, impact_speed);
+  result.time_step = options.time_step.value_or(result.estimate.chosen);
+  if (auto ok = check_time_step(result.time_step, result.estimate); !ok) return std::unexpected(ok.error());
+  result.interaction = interaction;
+
+  std::vector<TrialOutcome> outcomes(static_cast<std::size_t>(options.trials));
+  std::atomic<int> done{0};
+  tbb::parallel_for(0, options.trials, [&](int i) {
+    Rng rng(options.seed, static_cast<std::uint64_t>(i));
+    switch (setup.test) {
+      case LabTest::Drop: outcomes[i] = drop_trial(world, setup, options, result.time_step, rng); break;
+      case LabTest::Roll: outcomes[i] = roll_trial(world, setup, options, result.time_step, rng); break;
+      case LabTest::Tilt: outcomes[i] = tilt_trial(world, setup, options, result.time_step, rng); break;
+    }
+    context.report(fmt::format("{} trials", to_string(setup.test)), static_cast<double>(++done) / options.trials);
+  });
+  result.recording = setup;
+  result.recording.trials.clear();
+  result.recording.frame_rate_hz = options.frame_rate_hz;
+  if (setup.test == LabTest::Tilt && !setup.tilt_rate_deg_per_s) result.recording.tilt_rate_deg_per_s = options.tilt_rate_deg_per_s;
+  for (int i = 0; i < options.trials; ++i) {
+    outcomes[i].trial.id = fmt::format("{:02d}", i + 1);
+    const Eigen::Quaterniond& q = outcomes[i].orientation;
+    outcomes[i].trial.extra_json = fmt::format("{{\"orientation_wxyz\": [{:.9f}, {:.9f}, {:.9f}, {:.9f}]}}", q.w(), q.x(), q.y(), q.z());
+    result.orientations.push_back(q);
+    result.steps += outcomes[i].steps;
+    result.recording.trials.push_back(std::move(outcomes[i].trial));
+  }
+  return result;
+}
+
+}  // namespace clumpforge

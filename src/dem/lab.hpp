@@ -1,0 +1,48 @@
+#pragma once
+/// The study's laboratory tests run in the DEM: drop, tilt and roll, set up exactly as
+/// ../shared/spec/recording-format.md defines them; each trial's result comes back as a
+/// recording trial (summary and a track sampled like a camera).
+#include <cstdint>
+#include <optional>
+
+#include "core/clump.hpp"
+#include "core/recording.hpp"
+#include "core/run_context.hpp"
+#include "dem/materials.hpp"
+#include "dem/step.hpp"
+
+namespace clumpforge {
+
+struct LabOptions {
+  int trials = 10;                  ///< >= 1
+  std::uint64_t seed = 1;           ///< trial i uses substream i: any thread count, the same bits
+  std::optional<Interaction> interaction;  ///< overrides the table's particle-surface pair
+  ContactSettings contact;          ///< contact law settings (rolling model, limitForce, ...)
+  std::optional<double> time_step;  ///< [s]; default: the estimate's choice
+  double frame_rate_hz = 1000.0;    ///< track sampling, like a high-speed camera
+  double tilt_rate_deg_per_s = 5.0; ///< used when the recording has none
+  double max_time = 6.0;            ///< [s] simulated time limit per trial
+  std::string particle_material = "tuber";
+  std::vector<PhysicsTerm> terms;   ///< extra physics
+};
+
+struct LabResult {
+  Recording recording;              ///< the set-up and one trial per run (summary + track)
+  std::vector<Eigen::Quaterniond> orientations;  ///< initial orientation of each trial
+  Interaction interaction;          ///< coefficients actually used
+  TimeStepEstimate estimate;
+  double time_step = 0.0;           ///< [s]
+  std::uint64_t steps = 0;          ///< over all trials
+};
+
+/// Runs `options.trials` trials of `setup`'s test (its test, surface and set-up fields)
+/// with `clump` as the particle. Fails for an unknown surface or particle material, bad
+/// coefficients, or a time step above the stable limit.
+Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, const Recording& setup,
+                               const LabOptions& options, const RunContext& context = {});
+
+/// The four-square composite: four copies of the clump lying flat (largest principal
+/// moment's axis vertical) glued edge to edge in a 2 x 2 square, as one rigid body.
+RigidBody four_square_body(const Clump& clump, int material);
+
+}  // namespace clumpforge

@@ -1,0 +1,303 @@
+#include "io/recording_io.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/atomic_file.hpp"
+#include "core/text.hpp"
+
+namespace clumpforge {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+struct ManifestError {
+  std::string message;
+};
+
+// The line of the first occurrence of `"key"` at or after `from` (1-based), for messages.
+std::size_t line_of(const std::string& text, const std::string& key, std::size_t from = 0) {
+  const auto at = text.find("\"" + key + "\"", from);
+  const auto end = at == std::string::npos ? text.size() : at;
+  return 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<long>(end), '\n'));
+}
+
+class ManifestReader {
+ public:
+  ManifestReader(std::string file, std::string text) : file_(std::move(file)), text_(std::move(text)) {}
+
+  [[noreturn]] void error(const std::string& key, const std::string& what, std::size_t from = 0) const {
+    throw ManifestError{fmt::format("{}:{}: {}", file_, line_of(text_, key, from), what)};
+  }
+  double positive(const json& object, const char* key, const std::string& where) const {
+    if (!object.contains(key)) error(where, fmt::format("'{}' is missing its '{}'", where, key));
+    const auto& value = object.at(key);
+    if (!value.is_number()) error(key, fmt::format("'{}' must be a number", key));
+    const double v = value.get<double>();
+    if (!(v > 0.0) || !std::isfinite(v)) error(key, fmt::format("'{}' must be positive, not {}", key, v));
+    return v;
+  }
+  std::string string(const json& object, const char* key) const {
+    if (!object.contains(key)) error(key, fmt::format("the manifest has no '{}'", key));
+    if (!object.at(key).is_string()) error(key, fmt::format("'{}' must be a string", key));
+    return object.at(key).get<std::string>();
+  }
+  const std::string& text() const { return text_; }
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  std::string text_;
+};
+
+std::string extras(const json& object, std::initializer_list<const char*> known) {
+  json rest = json::object();
+  for (const auto& [key, value] : object.items()) {
+    bool is_known = false;
+    for (const char* k : known) is_known = is_known || key == k;
+    if (!is_known) rest[key] = value;
+  }
+  return rest.dump();
+}
+
+Result<Track> read_track(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) return fail(ErrorCode::NotFound, fmt::format("{}: track file not found", path.string()));
+  std::string line;
+  if (!std::getline(in, line)) return fail(ErrorCode::ParseError, fmt::format("{}:1: empty track file", path.string()));
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  std::vector<std::string> columns;
+  {
+    std::stringstream header(line);
+    std::string cell;
+    while (std::getline(header, cell, ',')) columns.emplace_back(trim(cell));
+  }
+  Track track;
+  std::vector<std::vector<double>*> targets;
+  bool has_t = false, has_x = false, has_z = false;
+  for (const auto& c : columns) {
+    if (c == "t_s") targets.push_back(&track.t), has_t = true;
+    else if (c == "x_m") targets.push_back(&track.x), has_x = true;
+    else if (c == "z_m") targets.push_back(&track.z), has_z = true;
+    else if (c == "angle_rad") targets.push_back(&track.angle);
+    else if (c == "tilt_deg") targets.push_back(&track.tilt);
+    else {
+      return fail(ErrorCode::ParseError,
+                  fmt::format("{}:1: unknown column '{}'{} (t_s, x_m, z_m, angle_rad, tilt_deg)", path.string(), c,
+                              did_you_mean(c, {"t_s", "x_m", "z_m", "angle_rad", "tilt_deg"})));
+    }
+  }
+  if (!has_t || !has_x || !has_z) {
+    return fail(ErrorCode::ParseError, fmt::format("{}:1: the header needs t_s, x_m and z_m", path.string()));
+  }
+  std::size_t number = 1;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (trim(line).empty()) continue;
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    std::string cell;
+    while (std::getline(row, cell, ',')) cells.push_back(std::string(trim(cell)));
+    if (!line.empty() && line.back() == ',') cells.emplace_back();
+    if (cells.size() != columns.size()) {
+      return fail(ErrorCode::ParseError, fmt::format("{}:{}: {} cells where the header has {}", path.string(), number,
+                                                     cells.size(), columns.size()));
+    }
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      double value = std::numeric_limits<double>::quiet_NaN();
+      if (!cells[k].empty()) {
+        const char* begin = cells[k].data();
+        const char* end = begin + cells[k].size();
+        auto [ptr, ec] = std::from_chars(begin, end, value);
+        if (ec != std::errc{} || ptr != end || !std::isfinite(value)) {
+          return fail(ErrorCode::ParseError, fmt::format("{}:{}: '{}' in column {} is not a number", path.string(), number,
+                                                         cells[k], columns[k]));
+        }
+      } else if (columns[k] == "t_s") {
+        return fail(ErrorCode::ParseError, fmt::format("{}:{}: the time cell is empty", path.string(), number));
+      }
+      targets[k]->push_back(value);
+    }
+    const auto& t = track.t;
+    if (t.size() >= 2 && !(t.back() > t[t.size() - 2])) {
+      return fail(ErrorCode::ParseError, fmt::format("{}:{}: time {} does not increase (previous {})", path.string(), number,
+                                                     t.back(), t[t.size() - 2]));
+    }
+  }
+  if (track.t.empty()) return fail(ErrorCode::ParseError, fmt::format("{}: the track has no rows", path.string()));
+  return track;
+}
+
+Recording parse_manifest(const ManifestReader& reader, const json& manifest, const fs::path& dir) {
+  Recording r;
+  if (!manifest.is_object()) reader.error("format", "the manifest must be a JSON object");
+  if (reader.string(manifest, "format") != "recording/1") {
+    reader.error("format", fmt::format("format '{}' is not \"recording/1\"", manifest["format"].get<std::string>()));
+  }
+  const std::string test = reader.string(manifest, "test");
+  if (test == "drop") r.test = LabTest::Drop;
+  else if (test == "roll") r.test = LabTest::Roll;
+  else if (test == "tilt") r.test = LabTest::Tilt;
+  else reader.error("test", fmt::format("unknown test '{}'{} (drop, roll or tilt)", test, did_you_mean(test, {"drop", "roll", "tilt"})));
+  r.surface = reader.string(manifest, "surface");
+  if (!manifest.contains("setup") || !manifest["setup"].is_object()) reader.error("setup", "the manifest has no 'setup' object");
+  const json& setup = manifest["setup"];
+  if (r.test == LabTest::Drop) r.release_height = reader.positive(setup, "release_height_m", "setup");
+  if (r.test == LabTest::Roll) {
+    r.incline_deg = reader.positive(setup, "incline_deg", "setup");
+    if (r.incline_deg >= 90.0) reader.error("incline_deg", "'incline_deg' must be below 90");
+    r.start_distance = reader.positive(setup, "start_distance_m", "setup");
+  }
+  if (r.test == LabTest::Tilt) {
+    if (setup.contains("tilt_rate_deg_per_s")) r.tilt_rate_deg_per_s = reader.positive(setup, "tilt_rate_deg_per_s", "setup");
+    if (setup.contains("composite")) {
+      const std::string composite = setup["composite"].is_string() ? setup["composite"].get<std::string>() : "";
+      if (composite == "single") r.composite = Composite::Single;
+      else if (composite == "four-square") r.composite = Composite::FourSquare;
+      else reader.error("composite", fmt::format("composite '{}' is not \"single\" or \"four-square\"", composite));
+    }
+  }
+  if (manifest.contains("particle")) {
+    const json& p = manifest["particle"];
+    if (p.contains("mesh")) r.particle_mesh = reader.string(p, "mesh");
+    if (p.contains("mesh_units")) r.particle_mesh_units = reader.string(p, "mesh_units");
+    if (p.contains("density_kg_m3")) r.particle_density = reader.positive(p, "density_kg_m3", "particle");
+  }
+  if (manifest.contains("camera")) {
+    const json& c = manifest["camera"];
+    if (c.contains("frame_rate_hz")) r.frame_rate_hz = reader.positive(c, "frame_rate_hz", "camera");
+    if (c.contains("position_noise_m")) r.position_noise_m = reader.positive(c, "position_noise_m", "camera");
+  }
+  if (!manifest.contains("trials") || !manifest["trials"].is_array() || manifest["trials"].empty()) {
+    reader.error("trials", "the manifest needs a non-empty 'trials' list");
+  }
+  std::size_t search_from = reader.text().find("\"trials\"");
+  for (const auto& entry : manifest["trials"]) {
+    search_from = reader.text().find("\"id\"", search_from + 1);
+    if (!entry.is_object() || !entry.contains("id")) reader.error("trials", "every trial needs an 'id'", search_from);
+    Trial trial;
+    trial.id = entry["id"].is_string() ? entry["id"].get<std::string>() : entry["id"].dump();
+    const std::string key(summary_key(r.test));
+    if (entry.contains("summary")) {
+      const json& summary = entry["summary"];
+      if (!summary.is_object() || !summary.contains(key) || !summary[key].is_number()) {
+        reader.error("summary", fmt::format("trial '{}': the summary of a {} test is {{\"{}\": number}}", trial.id, test, key), search_from);
+      }
+      const double v = summary[key].get<double>();
+      if (!std::isfinite(v) || (r.test != LabTest::Tilt && v < 0.0)) {
+        reader.error("summary", fmt::format("trial '{}': {} {} is not a valid value", trial.id, key, v), search_from);
+      }
+      trial.summary = v;
+    }
+    if (entry.contains("track")) {
+      if (!entry["track"].is_string()) reader.error("track", fmt::format("trial '{}': 'track' must be a file name", trial.id), search_from);
+      trial.track_file = entry["track"].get<std::string>();
+      auto track = read_track(dir / trial.track_file);
+      if (!track) throw ManifestError{track.error().message};
+      trial.track = std::move(*track);
+    }
+    if (!trial.summary && !trial.track) reader.error("id", fmt::format("trial '{}' has neither a summary nor a track", trial.id), search_from);
+    trial.extra_json = extras(entry, {"id", "summary", "track"});
+    r.trials.push_back(std::move(trial));
+  }
+  r.extra_json = extras(manifest, {"format", "test", "surface", "setup", "particle", "camera", "trials"});
+  return r;
+}
+
+std::string track_csv(const Track& track) {
+  std::string header = "t_s,x_m,z_m";
+  if (!track.angle.empty()) header += ",angle_rad";
+  if (!track.tilt.empty()) header += ",tilt_deg";
+  std::string text = header + "\n";
+  auto cell = [](double v) { return std::isnan(v) ? std::string() : fmt::format("{:.7g}", v); };
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    text += fmt::format("{:.6f},{},{}", track.t[i], cell(track.x[i]), cell(track.z[i]));
+    if (!track.angle.empty()) text += "," + cell(track.angle[i]);
+    if (!track.tilt.empty()) text += "," + cell(track.tilt[i]);
+    text += "\n";
+  }
+  return text;
+}
+}  // namespace
+
+Result<Recording> read_recording(const fs::path& path) {
+  std::error_code ec;
+  const fs::path manifest_path = fs::is_directory(path, ec) ? path / "recording.json" : path;
+  std::ifstream in(manifest_path);
+  if (!in) return fail(ErrorCode::NotFound, fmt::format("{}: no recording manifest", manifest_path.string()));
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  json manifest;
+  try {
+    manifest = json::parse(text);
+  } catch (const json::parse_error& e) {
+    const std::size_t line = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<long>(std::min<std::size_t>(e.byte, text.size())), '\n'));
+    return fail(ErrorCode::ParseError, fmt::format("{}:{}: not valid JSON", manifest_path.string(), line));
+  }
+  try {
+    return parse_manifest(ManifestReader(manifest_path.string(), text), manifest, manifest_path.parent_path());
+  } catch (const ManifestError& e) {
+    return fail(ErrorCode::ParseError, e.message);
+  } catch (const json::exception& e) {
+    return fail(ErrorCode::ParseError, fmt::format("{}: {}", manifest_path.string(), e.what()));
+  }
+}
+
+Result<void> write_recording(const fs::path& dir, const Recording& r) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir, ec)) return fail(ErrorCode::IoError, fmt::format("cannot create '{}'", dir.string()));
+  json manifest = json::parse(r.extra_json);
+  manifest["format"] = "recording/1";
+  manifest["test"] = std::string(to_string(r.test));
+  manifest["surface"] = r.surface;
+  json setup = json::object();
+  if (r.test == LabTest::Drop) setup["release_height_m"] = r.release_height;
+  if (r.test == LabTest::Roll) {
+    setup["incline_deg"] = r.incline_deg;
+    setup["start_distance_m"] = r.start_distance;
+  }
+  if (r.test == LabTest::Tilt) {
+    if (r.tilt_rate_deg_per_s) setup["tilt_rate_deg_per_s"] = *r.tilt_rate_deg_per_s;
+    setup["composite"] = r.composite == Composite::FourSquare ? "four-square" : "single";
+  }
+  manifest["setup"] = setup;
+  if (r.particle_mesh || r.particle_density) {
+    json particle = json::object();
+    if (r.particle_mesh) particle["mesh"] = *r.particle_mesh;
+    if (r.particle_mesh_units) particle["mesh_units"] = *r.particle_mesh_units;
+    if (r.particle_density) particle["density_kg_m3"] = *r.particle_density;
+    manifest["particle"] = particle;
+  }
+  if (r.frame_rate_hz || r.position_noise_m) {
+    json camera = json::object();
+    if (r.frame_rate_hz) camera["frame_rate_hz"] = *r.frame_rate_hz;
+    if (r.position_noise_m) camera["position_noise_m"] = *r.position_noise_m;
+    manifest["camera"] = camera;
+  }
+  std::vector<std::pair<fs::path, std::string>> files;
+  manifest["trials"] = json::array();
+  for (const auto& trial : r.trials) {
+    json entry = json::parse(trial.extra_json);
+    entry["id"] = trial.id;
+    if (trial.summary) entry["summary"] = {{std::string(summary_key(r.test)), *trial.summary}};
+    if (trial.track) {
+      const std::string name = trial.track_file.empty() ? fmt::format("trial-{}.csv", trial.id) : trial.track_file;
+      entry["track"] = name;
+      files.emplace_back(dir / name, track_csv(*trial.track));
+    }
+    manifest["trials"].push_back(entry);
+  }
+  files.emplace_back(dir / "recording.json", manifest.dump(2) + "\n");
+  return write_files_atomically(files);
+}
+
+}  // namespace clumpforge

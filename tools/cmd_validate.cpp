@@ -1,0 +1,151 @@
+// clumpforge validate CLUMP.h5 --test drop|tilt|roll --surface Q235|soil [--trials N] [--seed S]
+//                    [--out DIR] [--json] [--restitution e] [--static-friction m] [--rolling-friction m] ...
+#include <fmt/format.h>
+
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <numeric>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "core/text.hpp"
+#include "dem/lab.hpp"
+#include "io/clump_library.hpp"
+#include "io/recording_io.hpp"
+
+namespace clumpforge::cli {
+namespace {
+
+struct ValidateArgs {
+  std::string input, clump, test, surface, out, rolling_model = "cdt", composite = "four-square";
+  int trials = 10;
+  std::uint64_t seed = 1;
+  std::optional<double> restitution, static_friction, rolling_friction, time_step, tilt_rate;
+  double release_height = 0.2, incline_deg = 30.0, start_distance = 0.035;
+  bool json = false, limit_force = false;
+};
+
+Result<LabTest> parse_test(const std::string& name) {
+  if (name == "drop") return LabTest::Drop;
+  if (name == "tilt") return LabTest::Tilt;
+  if (name == "roll") return LabTest::Roll;
+  return fail(ErrorCode::InvalidArgument, fmt::format("unknown test '{}'{} (drop, tilt or roll)", name, did_you_mean(name, {"drop", "tilt", "roll"})));
+}
+
+struct Spread {
+  double mean = 0.0, std = 0.0, min = 0.0, max = 0.0;
+};
+Spread spread(const std::vector<double>& v) {
+  Spread s;
+  if (v.empty()) return s;
+  s.mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  double squares = 0.0;
+  for (double x : v) squares += (x - s.mean) * (x - s.mean);
+  s.std = v.size() > 1 ? std::sqrt(squares / static_cast<double>(v.size() - 1)) : 0.0;
+  s.min = *std::min_element(v.begin(), v.end());
+  s.max = *std::max_element(v.begin(), v.end());
+  return s;
+}
+
+int run_validate(const ValidateArgs& args) {
+  constexpr std::string_view kCommand = "validate";
+  auto test = parse_test(args.test);
+  if (!test) return report_error(kCommand, test.error());
+  if (args.trials < 1 || args.trials > 100000) return report_error(kCommand, {ErrorCode::InvalidArgument, "--trials must be between 1 and 100000"});
+  const MaterialTable table = default_material_table();
+  if (auto surface = table.find(args.surface); !surface) return report_error(kCommand, surface.error());
+  LabOptions options;
+  options.trials = args.trials;
+  options.seed = args.seed;
+  options.time_step = args.time_step;
+  if (args.rolling_model == "cdt") options.contact.rolling = RollingModel::ConstantTorque;
+  else if (args.rolling_model == "epsd") options.contact.rolling = RollingModel::Epsd;
+  else if (args.rolling_model == "none") options.contact.rolling = RollingModel::None;
+  else return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("unknown rolling model '{}' (cdt, epsd or none)", args.rolling_model)});
+  options.contact.limit_force = args.limit_force;
+  Interaction interaction = table.interaction("tuber", args.surface).value_or(Interaction{});
+  if (args.restitution) interaction.restitution = *args.restitution;
+  if (args.static_friction) interaction.static_friction = *args.static_friction;
+  if (args.rolling_friction) interaction.rolling_friction = *args.rolling_friction;
+  if (auto ok = validate_interaction(interaction, "the overrides"); !ok) return report_error(kCommand, ok.error());
+  options.interaction = interaction;
+
+  Recording setup;
+  setup.test = *test;
+  setup.surface = args.surface;
+  setup.release_height = args.release_height;
+  setup.incline_deg = args.incline_deg;
+  setup.start_distance = args.start_distance;
+  setup.tilt_rate_deg_per_s = args.tilt_rate;
+  if (args.composite == "four-square") setup.composite = Composite::FourSquare;
+  else if (args.composite == "single") setup.composite = Composite::Single;
+  else return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("unknown composite '{}' (single or four-square)", args.composite)});
+  if (!(setup.release_height > 0.0 && setup.release_height < 10.0) || !(setup.incline_deg > 0.0 && setup.incline_deg < 90.0) ||
+      !(setup.start_distance > 0.0 && setup.start_distance < 0.45) || (setup.tilt_rate_deg_per_s && !(*setup.tilt_rate_deg_per_s > 0.0))) {
+    return report_error(kCommand, {ErrorCode::InvalidArgument, "the set-up is out of range (height in (0, 10) m, incline in (0, 90) deg, start in (0, 0.45) m, tilt rate > 0)"});
+  }
+  auto clumps = read_clump_library(args.input);
+  if (!clumps) return report_error(kCommand, clumps.error());
+  auto clump = select_clump(std::move(*clumps), args.clump, args.input);
+  if (!clump) return report_error(kCommand, clump.error());
+  setup.particle_density = clump->density;
+  const RunContext context = progress_context(args.json);
+  auto result = run_lab_test(*clump, table, setup, options, context);
+  if (!result) return report_error(kCommand, result.error());
+  if (!args.out.empty()) {
+    if (auto ok = write_recording(args.out, result->recording); !ok) return report_error(kCommand, ok.error());
+  }
+  const std::string key(summary_key(*test));
+  const auto values = result->recording.summaries();
+  const Spread s = spread(values);
+  const std::string model = args.rolling_model;
+  if (args.json) {
+    nlohmann::json report{{"clump", clump->name}, {"test", args.test}, {"surface", args.surface}, {"summary_key", key},
+                          {"trials", nlohmann::json::array()}, {"mean", s.mean}, {"std", s.std}, {"min", s.min}, {"max", s.max},
+                          {"restitution", result->interaction.restitution}, {"static_friction", result->interaction.static_friction},
+                          {"rolling_friction", result->interaction.rolling_friction}, {"rolling_model", model},
+                          {"limit_force", args.limit_force}, {"time_step_s", result->time_step},
+                          {"rayleigh_time_s", result->estimate.rayleigh}, {"hertz_time_s", result->estimate.hertz},
+                          {"steps", result->steps}, {"seed", args.seed}};
+    for (const auto& trial : result->recording.trials) report["trials"].push_back({{"id", trial.id}, {key, *trial.summary}});
+    if (!args.out.empty()) report["recording"] = args.out;
+    std::cout << report.dump(2) << "\n";
+  } else {
+    fmt::print("{} test of clump '{}' on {} ({} trials, seed {}): e {} mu_s {} mu_r {} ({}), time step {:.3g} s\n", args.test,
+               clump->name, args.surface, args.trials, args.seed, result->interaction.restitution, result->interaction.static_friction,
+               result->interaction.rolling_friction, model, result->time_step);
+    for (const auto& trial : result->recording.trials) fmt::print("  trial {}: {} = {:.5g}\n", trial.id, key, *trial.summary);
+    fmt::print("  mean {:.5g}, standard deviation {:.3g}, range {:.5g} .. {:.5g}\n", s.mean, s.std, s.min, s.max);
+    if (!args.out.empty()) fmt::print("  recording written to {}/\n", args.out);
+  }
+  return kExitOk;
+}
+}  // namespace
+
+Command add_validate_command(CLI::App& app) {
+  auto args = std::make_shared<ValidateArgs>();
+  CLI::App* sub = app.add_subcommand("validate", "Run the study's drop, tilt or roll test on a clump in the built-in DEM");
+  sub->add_option("clump_file", args->input, "Clump library (.h5)")->required();
+  sub->add_option("--clump", args->clump, "Which clump of the file (needed when it holds several)");
+  sub->add_option("--test", args->test, "drop, tilt or roll")->required();
+  sub->add_option("--surface", args->surface, "Plate material: Q235 or soil")->required();
+  sub->add_option("--trials", args->trials, "Trials (random orientations)")->capture_default_str();
+  sub->add_option("--seed", args->seed, "Seed of the orientations")->capture_default_str();
+  sub->add_option("--out", args->out, "Write the run as a recording (recording.json + tracks) in this directory");
+  sub->add_option("--restitution", args->restitution, "Override e (0, 1]");
+  sub->add_option("--static-friction", args->static_friction, "Override mu_s");
+  sub->add_option("--rolling-friction", args->rolling_friction, "Override mu_r");
+  sub->add_option("--rolling-model", args->rolling_model, "cdt (EDEM standard, type A), epsd (type C) or none")->capture_default_str();
+  sub->add_flag("--limit-force", args->limit_force, "No attractive normal force at the end of a contact (LIGGGHTS limitForce on)");
+  sub->add_option("--time-step", args->time_step, "Time step [s] (default: from the Rayleigh and Hertz estimates)");
+  sub->add_option("--release-height", args->release_height, "Drop: lowest point above the plate [m]")->capture_default_str();
+  sub->add_option("--incline", args->incline_deg, "Roll: incline angle [deg]")->capture_default_str();
+  sub->add_option("--start-distance", args->start_distance, "Roll: start along the slope from the foot [m]")->capture_default_str();
+  sub->add_option("--tilt-rate", args->tilt_rate, "Tilt: plate rate [deg/s] (default 5)");
+  sub->add_option("--composite", args->composite, "Tilt: four-square (the study's) or single")->capture_default_str();
+  sub->add_flag("--json", args->json, "Print per-trial summaries, their spread and the parameters used as JSON");
+  return {sub, [args] { return run_validate(*args); }};
+}
+
+}  // namespace clumpforge::cli
