@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # README command 1: set up, build, and run the main job on the bundled default scan:
-# repair -> mass properties -> fill (lattice 1, 2, 4 mm and adaptive) -> error report -> exports.
+# repair -> mass properties -> fill (lattice 1, 2, 4 mm and adaptive) -> error report -> exports
+# -> the study's drop, tilt and roll tests in the built-in DEM.
 # Results go to out/main/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,4 +31,11 @@ for clump in lattice-2mm adaptive-128; do
   echo "$out/exports/$clump/: $(ls "$out/exports/$clump" | tr '\n' ' ')"
 done
 echo
-echo "main job done: $out/ (repaired mesh, props JSON, clump library tuber-default.h5, exports/)"
+echo "== 5. the study's drop, tilt and roll tests on the 2 mm lattice clump in the built-in DEM (study's coefficients)"
+for surface in Q235 soil; do
+  $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test drop --surface "$surface" --trials 10 --out "$out/dem/drop-$surface"
+  $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test tilt --surface "$surface" --trials 1 --out "$out/dem/tilt-$surface"
+  $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test roll --surface "$surface" --trials 10 --out "$out/dem/roll-$surface"
+done
+echo
+echo "main job done: $out/ (repaired mesh, props JSON, clump library tuber-default.h5, exports/, dem/ recordings)"

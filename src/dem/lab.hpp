@@ -21,7 +21,7 @@ struct LabOptions {
   std::optional<double> time_step;  ///< [s]; default: the estimate's choice
   double frame_rate_hz = 1000.0;    ///< track sampling, like a high-speed camera
   double tilt_rate_deg_per_s = 5.0; ///< used when the recording has none
-  double max_time = 6.0;            ///< [s] simulated time limit per trial
+  double max_time = 6.0;            ///< [s] simulated time limit of a drop or roll trial (a tilt runs to 89 deg)
   std::string particle_material = "tuber";
   std::vector<PhysicsTerm> terms;   ///< extra physics
 };

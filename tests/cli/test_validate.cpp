@@ -1,0 +1,60 @@
+// End-to-end: validate runs the lab tests, writes recordings, reports the parameters.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "io/recording_io.hpp"
+#include "support/test_support.hpp"
+
+namespace clumpforge {
+namespace {
+std::string library() { return (test::source_dir() / "clumps" / "tuber-default.h5").string(); }
+}  // namespace
+
+TEST(ValidateCli, DropJsonAndRecording) {
+  test::ScratchDir dir("validate");
+  const auto run = test::run_clumpforge(fmt::format(
+      "validate '{}' --clump lattice-4mm --test drop --surface Q235 --trials 3 --seed 5 --out '{}' --restitution 0.6 --json",
+      library(), (dir / "rec").string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  for (const char* key : {"restitution", "static_friction", "rolling_friction", "rolling_model", "time_step_s", "trials", "mean", "std"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["restitution"], 0.6);
+  EXPECT_EQ(j["static_friction"], 0.41);  // the table's tuber-Q235 value
+  EXPECT_EQ(j["rolling_model"], "cdt");
+  ASSERT_EQ(j["trials"].size(), 3u);
+  const auto recording = read_recording(dir / "rec");
+  ASSERT_TRUE(recording) << recording.error().message;
+  EXPECT_EQ(recording->trials.size(), 3u);
+  EXPECT_DOUBLE_EQ(*recording->trials[0].summary, j["trials"][0]["rebound_height_m"].get<double>());
+  EXPECT_TRUE(recording->trials[0].track.has_value());
+  // The same seed gives the same trials.
+  const auto again = test::run_clumpforge(fmt::format(
+      "validate '{}' --clump lattice-4mm --test drop --surface Q235 --trials 3 --seed 5 --restitution 0.6 --json", library()));
+  EXPECT_EQ(nlohmann::json::parse(again.out)["trials"], j["trials"]);
+}
+
+TEST(ValidateCli, BadInputIsAClearError) {
+  test::ScratchDir dir("validate");
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {fmt::format("validate '{}' --clump lattice-4mm --test bounce --surface Q235", library()), "unknown test 'bounce'"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface glass", library()), "unknown material 'glass'"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --restitution 1.5", library()), "outside (0, 1]"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --static-friction -0.1", library()), "must be in [0, 10]"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --time-step 0.01", library()), "stable limit"},
+      {fmt::format("validate '{}' --test drop --surface Q235", library()), "choose one with --clump"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235", (test::source_dir() / "meshes" / "tuber-default.stl").string()), "not an HDF5 file"},
+  };
+  for (const auto& [arguments, expected] : cases) {
+    SCOPED_TRACE(arguments);
+    const auto run = test::run_clumpforge(arguments + fmt::format(" --out '{}'", (dir / "out").string()));
+    EXPECT_EQ(run.exit_code, 1);
+    EXPECT_NE(run.err.find(expected), std::string::npos) << run.err;
+  }
+  EXPECT_EQ(test::count_files(dir.path()), 0);
+}
+
+}  // namespace clumpforge
