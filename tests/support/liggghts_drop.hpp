@@ -1,0 +1,27 @@
+#pragma once
+/// The drop test of one clump run the same way in clumpforge's DEM and in LIGGGHTS (Debian
+/// `liggghts`): same spheres, mass, inertia, materials, coefficients, time step and
+/// orientation; used by the cross-check test and bench/bench_liggghts.
+#include <Eigen/Geometry>
+#include <filesystem>
+
+#include "core/clump.hpp"
+#include "core/error.hpp"
+#include "dem/materials.hpp"
+
+namespace clumpforge::test {
+
+struct DropComparison {
+  double rebound_clumpforge = 0.0;  ///< apex of the lowest point after the first impact [m]
+  double rebound_liggghts = 0.0;    ///< [m]
+  double seconds_clumpforge = 0.0;  ///< wall time of the run
+  double seconds_liggghts = 0.0;
+  double time_step = 0.0;           ///< [s], the same in both
+};
+
+/// Drops `clump` (all spheres of one radius) from `height` with orientation `q` onto Q235 in
+/// both engines; LIGGGHTS works in `dir`.
+Result<DropComparison> compare_drop(const Clump& clump, const Eigen::Quaterniond& q, double height,
+                                    const Interaction& interaction, const std::filesystem::path& dir);
+
+}  // namespace clumpforge::test
