@@ -18,7 +18,7 @@ namespace clumpforge::cli {
 namespace {
 
 struct ValidateArgs {
-  std::string input, clump, test, surface, out, rolling_model = "cdt", composite = "four-square";
+  std::string input, clump, test, surface, out, rolling_model = "cdt", composite = "four-square", rolling_arm = "centre";
   int trials = 10;
   std::uint64_t seed = 1;
   std::optional<double> restitution, static_friction, rolling_friction, time_step, tilt_rate;
@@ -64,6 +64,9 @@ int run_validate(const ValidateArgs& args) {
   else if (args.rolling_model == "none") options.contact.rolling = RollingModel::None;
   else return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("unknown rolling model '{}' (cdt, epsd or none)", args.rolling_model)});
   options.contact.limit_force = args.limit_force;
+  if (args.rolling_arm == "centre") options.contact.rolling_arm = RollingArm::ContactToCentre;
+  else if (args.rolling_arm == "sphere") options.contact.rolling_arm = RollingArm::SphereRadius;
+  else return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("unknown rolling arm '{}' (centre or sphere)", args.rolling_arm)});
   Interaction interaction = table.interaction("tuber", args.surface).value_or(Interaction{});
   if (args.restitution) interaction.restitution = *args.restitution;
   if (args.static_friction) interaction.static_friction = *args.static_friction;
@@ -104,7 +107,7 @@ int run_validate(const ValidateArgs& args) {
     nlohmann::json report{{"clump", clump->name}, {"test", args.test}, {"surface", args.surface}, {"summary_key", key},
                           {"trials", nlohmann::json::array()}, {"mean", s.mean}, {"std", s.std}, {"min", s.min}, {"max", s.max},
                           {"restitution", result->interaction.restitution}, {"static_friction", result->interaction.static_friction},
-                          {"rolling_friction", result->interaction.rolling_friction}, {"rolling_model", model},
+                          {"rolling_friction", result->interaction.rolling_friction}, {"rolling_model", model}, {"rolling_arm", args.rolling_arm},
                           {"limit_force", args.limit_force}, {"time_step_s", result->time_step},
                           {"rayleigh_time_s", result->estimate.rayleigh}, {"hertz_time_s", result->estimate.hertz},
                           {"steps", result->steps}, {"seed", args.seed}};
@@ -137,6 +140,8 @@ Command add_validate_command(CLI::App& app) {
   sub->add_option("--static-friction", args->static_friction, "Override mu_s");
   sub->add_option("--rolling-friction", args->rolling_friction, "Override mu_r");
   sub->add_option("--rolling-model", args->rolling_model, "cdt (EDEM standard, type A), epsd (type C) or none")->capture_default_str();
+  sub->add_option("--rolling-arm", args->rolling_arm, "Lever of the cdt torque: centre (EDEM: contact to the clump's centre of mass) or sphere (LIGGGHTS)")
+      ->capture_default_str();
   sub->add_flag("--limit-force", args->limit_force, "No attractive normal force at the end of a contact (LIGGGHTS limitForce on)");
   sub->add_option("--time-step", args->time_step, "Time step [s] (default: from the Rayleigh and Hertz estimates)");
   sub->add_option("--release-height", args->release_height, "Drop: lowest point above the plate [m]")->capture_default_str();

@@ -71,7 +71,8 @@ struct ContactSettings {
   /// contact's normal force grows (false reproduces LIGGGHTS exactly).
   bool coulomb_on_total = true;
   RollingModel rolling = RollingModel::ConstantTorque;
-  RollingArm rolling_arm = RollingArm::SphereRadius;
+  /// EDEM's standard model (the convention of the study's mu_r values); LIGGGHTS uses the sphere radius.
+  RollingArm rolling_arm = RollingArm::ContactToCentre;
   double rolling_damping = 0.3;      ///< eta_r of EPSD (Ai et al. suggest 0.3)
 };
 

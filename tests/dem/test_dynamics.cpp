@@ -78,6 +78,7 @@ TEST(Dynamics, ConstantTorqueRollingStopsAtSevenV0SquaredOverTenMuRG) {
   const double r = 5e-3, v0 = 0.5, mu_r = 0.05;
   World world = soft_sphere_world({0.5, 0.8, mu_r}, r);
   world.contact.rolling = RollingModel::ConstantTorque;
+  world.contact.rolling_arm = RollingArm::SphereRadius;
   world.bodies[0].position = {0, 0, r};
   const double dt = contact_time(world, 0.1) / 50.0;
   for (int i = 0; i < 2000; ++i) step(world, dt);  // settle

@@ -121,6 +121,7 @@ Result<DropComparison> compare_drop(const Clump& clump, const Eigen::Quaterniond
   set_interaction(world, p, s, interaction);
   world.contact.rolling = RollingModel::ConstantTorque;
   world.contact.coulomb_on_total = false;  // LIGGGHTS checks the spring alone
+  world.contact.rolling_arm = RollingArm::SphereRadius;  // LIGGGHTS cdt's lever
   world.bodies.push_back(make_body(clump, p));
   Wall floor;
   floor.material = s;

@@ -1,0 +1,104 @@
+#include "calibrate/stats.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace clumpforge {
+
+QuadraticFit fit_quadratic(const std::vector<double>& x, const std::vector<double>& y) {
+  const auto n = static_cast<Eigen::Index>(x.size());
+  Eigen::MatrixXd design(n, 3);
+  Eigen::VectorXd values(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    design(i, 0) = x[i] * x[i];
+    design(i, 1) = x[i];
+    design(i, 2) = 1.0;
+    values(i) = y[i];
+  }
+  const Eigen::Vector3d coefficients = design.colPivHouseholderQr().solve(values);
+  QuadraticFit fit{coefficients(0), coefficients(1), coefficients(2)};
+  const double mean = values.mean();
+  double sse = 0.0, sst = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    sse += std::pow(values(i) - fit(x[i]), 2);
+    sst += std::pow(values(i) - mean, 2);
+  }
+  fit.r_squared = sst > 0.0 ? 1.0 - sse / sst : 1.0;
+  if (n > 3 && sse > 0.0) {
+    fit.f_statistic = ((sst - sse) / 2.0) / (sse / static_cast<double>(n - 3));
+    fit.p_value = f_distribution_upper_tail(fit.f_statistic, 2.0, static_cast<double>(n - 3));
+  } else if (n > 3) {
+    fit.f_statistic = INFINITY;
+    fit.p_value = 0.0;
+  }
+  return fit;
+}
+
+std::vector<double> solve_in_range(const QuadraticFit& fit, double target, double low, double high) {
+  std::vector<double> roots;
+  const double a = fit.a, b = fit.b, c = fit.c - target;
+  if (std::abs(a) < 1e-14 * (std::abs(b) + std::abs(c) + 1e-300)) {
+    if (b != 0.0) roots.push_back(-c / b);
+  } else {
+    const double discriminant = b * b - 4 * a * c;
+    if (discriminant >= 0.0) {
+      // Numerically stable pair of roots.
+      const double q = -0.5 * (b + std::copysign(std::sqrt(discriminant), b));
+      roots.push_back(q / a);
+      if (q != 0.0) roots.push_back(c / q);
+    }
+  }
+  std::vector<double> inside;
+  for (double r : roots) {
+    if (r >= low && r <= high) inside.push_back(r);
+  }
+  std::sort(inside.begin(), inside.end());
+  return inside;
+}
+
+namespace {
+// Continued fraction for I_x(a, b) (modified Lentz).
+double beta_fraction(double a, double b, double x) {
+  constexpr double kTiny = 1e-300;
+  double c = 1.0, d = 1.0 - (a + b) * x / (a + 1.0);
+  if (std::abs(d) < kTiny) d = kTiny;
+  d = 1.0 / d;
+  double h = d;
+  for (int m = 1; m <= 300; ++m) {
+    const double m2 = 2.0 * m;
+    double aa = m * (b - m) * x / ((a - 1.0 + m2) * (a + m2));
+    d = 1.0 + aa * d;
+    if (std::abs(d) < kTiny) d = kTiny;
+    c = 1.0 + aa / c;
+    if (std::abs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    h *= d * c;
+    aa = -(a + m) * (a + b + m) * x / ((a + m2) * (a + 1.0 + m2));
+    d = 1.0 + aa * d;
+    if (std::abs(d) < kTiny) d = kTiny;
+    c = 1.0 + aa / c;
+    if (std::abs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::abs(delta - 1.0) < 1e-15) break;
+  }
+  return h;
+}
+}  // namespace
+
+double incomplete_beta(double a, double b, double x) {
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x));
+  if (x < (a + 1.0) / (a + b + 2.0)) return front * beta_fraction(a, b, x) / a;
+  return 1.0 - front * beta_fraction(b, a, 1.0 - x) / b;
+}
+
+double f_distribution_upper_tail(double f, double d1, double d2) {
+  if (!(f > 0.0)) return 1.0;
+  // P(F > f) = I_{d2 / (d2 + d1 f)}(d2 / 2, d1 / 2).
+  return incomplete_beta(d2 / 2.0, d1 / 2.0, d2 / (d2 + d1 * f));
+}
+
+}  // namespace clumpforge

@@ -1,0 +1,155 @@
+// clumpforge calibrate --recordings DIR... --clump CLUMP.h5 [--clump-name NAME] [--method paper]
+//                      [--trials-per-level N] [--seed S] [--out DIR] [--json]
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "calibrate/paper.hpp"
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "core/atomic_file.hpp"
+#include "core/text.hpp"
+#include "io/clump_library.hpp"
+#include "io/recording_io.hpp"
+#include "io/svg_plot.hpp"
+
+namespace clumpforge::cli {
+namespace {
+namespace fs = std::filesystem;
+
+struct CalibrateArgs {
+  std::vector<std::string> recordings;
+  std::string clump_file, clump_name, method = "paper", out;
+  int trials_per_level = 10;
+  std::uint64_t seed = 1;
+  bool json = false;
+};
+
+std::string unit_of(LabTest test) { return test == LabTest::Tilt ? "deg" : "mm"; }
+
+nlohmann::json step_json(const ParameterCalibration& p) {
+  nlohmann::json levels = nlohmann::json::array();
+  for (const auto& l : p.levels) levels.push_back({{"value", l.value}, {"mean", l.mean}, {"responses", l.responses}});
+  nlohmann::json j{{"parameter", p.parameter}, {"surface", p.surface}, {"test", std::string(to_string(p.test))}, {"units", unit_of(p.test)},
+                   {"held", {{"restitution", p.held.restitution}, {"static_friction", p.held.static_friction}, {"rolling_friction", p.held.rolling_friction}}},
+                   {"levels", levels}, {"fit", {{"a", p.fit.a}, {"b", p.fit.b}, {"c", p.fit.c}, {"r_squared", p.fit.r_squared},
+                                                 {"f_statistic", p.fit.f_statistic}, {"p_value", p.fit.p_value}}},
+                   {"measured_mean", p.measured_mean}, {"roots", p.roots}, {"calibrated", p.calibrated}, {"flag", p.flag},
+                   {"verification_mean", p.verification_mean}, {"verification_relative_error", p.verification_error}};
+  j["study_value"] = p.study_value ? nlohmann::json(*p.study_value) : nlohmann::json(nullptr);
+  return j;
+}
+
+std::string markdown(const PaperCalibration& c) {
+  std::string text = "| parameter | surface | fit (y = a x^2 + b x + c) | R^2 | p | measured | calibrated | study | check | rel. error | note |\n"
+                     "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n";
+  for (const auto& p : c.steps) {
+    text += fmt::format("| {} | {} | {:.4g}, {:.4g}, {:.4g} | {:.4f} | {:.2g} | {:.4g} {u} | {:.4g} | {} | {:.4g} {u} | {:+.2f} % | {} |\n",
+                        p.parameter, p.surface, p.fit.a, p.fit.b, p.fit.c, p.fit.r_squared, p.fit.p_value, p.measured_mean,
+                        p.calibrated, p.study_value ? fmt::format("{:g}", *p.study_value) : "-", p.verification_mean,
+                        100 * p.verification_error, p.flag, fmt::arg("u", unit_of(p.test)));
+  }
+  return text;
+}
+
+std::string response_plot(const ParameterCalibration& p) {
+  Plot plot{fmt::format("{} on {}: {} test", p.parameter, p.surface, to_string(p.test)), p.parameter,
+            fmt::format("mean response [{}]", unit_of(p.test)), false, false, {}, {{p.measured_mean, "measured"}}};
+  PlotSeries levels{"level means (10 trials)", {}, {}, "#1f77b4", false, true};
+  for (const auto& l : p.levels) {
+    levels.x.push_back(l.value);
+    levels.y.push_back(l.mean);
+  }
+  PlotSeries fit{"quadratic fit", {}, {}, "#d62728", true, false};
+  const double low = p.levels.front().value, high = p.levels.back().value;
+  for (int i = 0; i <= 60; ++i) {
+    const double x = low + (high - low) * i / 60.0;
+    fit.x.push_back(x);
+    fit.y.push_back(p.fit(x));
+  }
+  PlotSeries chosen{"calibrated", {p.calibrated}, {p.measured_mean}, "#2ca02c", false, true};
+  plot.series = {levels, fit, chosen};
+  return render_svg(plot);
+}
+
+int run_calibrate(const CalibrateArgs& args) {
+  constexpr std::string_view kCommand = "calibrate";
+  if (args.method != "paper") {
+    return report_error(kCommand, {ErrorCode::InvalidArgument,
+                                   fmt::format("unknown method '{}'{} (this version offers 'paper', the study's procedure)", args.method,
+                                               did_you_mean(args.method, {"paper"}))});
+  }
+  if (args.trials_per_level < 1 || args.trials_per_level > 1000) {
+    return report_error(kCommand, {ErrorCode::InvalidArgument, "--trials-per-level must be between 1 and 1000"});
+  }
+  std::vector<Recording> recordings;
+  for (const auto& path : args.recordings) {
+    auto r = read_recording(path);
+    if (!r) return report_error(kCommand, r.error());
+    recordings.push_back(std::move(*r));
+  }
+  auto clumps = read_clump_library(args.clump_file);
+  if (!clumps) return report_error(kCommand, clumps.error());
+  auto clump = select_clump(std::move(*clumps), args.clump_name, args.clump_file);
+  if (!clump) return report_error(kCommand, clump.error());
+  PaperOptions options;
+  options.trials_per_level = args.trials_per_level;
+  options.lab.seed = args.seed;
+  const RunContext context = progress_context(args.json);
+  auto calibration = calibrate_paper(*clump, default_material_table(), recordings, options, context);
+  if (!calibration) return report_error(kCommand, calibration.error());
+
+  nlohmann::json report{{"method", "paper"}, {"clump", clump->name}, {"trials_per_level", args.trials_per_level}, {"seed", args.seed},
+                        {"steps", nlohmann::json::array()}, {"results", nlohmann::json::object()}, {"notes", calibration->notes}};
+  for (const auto& p : calibration->steps) report["steps"].push_back(step_json(p));
+  for (const auto& [surface, i] : calibration->results) {
+    report["results"][surface] = {{"restitution", i.restitution}, {"static_friction", i.static_friction}, {"rolling_friction", i.rolling_friction}};
+  }
+  if (!args.out.empty()) {
+    std::error_code ec;
+    fs::create_directories(args.out, ec);
+    std::vector<std::pair<fs::path, std::string>> files{{fs::path(args.out) / "calibration.json", report.dump(2) + "\n"},
+                                                        {fs::path(args.out) / "calibration.md",
+                                                         fmt::format("# Calibration by the study's method ({})\n\n{}\n", clump->name, markdown(*calibration))}};
+    Plot overview{"Measured against calibrated (verification runs)", "measured mean", "simulated mean at the calibrated values", false, false, {}, {}};
+    PlotSeries points{"tests (mm, or deg for tilt)", {}, {}, "#1f77b4", false, true};
+    double top = 0.0;
+    for (const auto& p : calibration->steps) {
+      files.emplace_back(fs::path(args.out) / fmt::format("sweep-{}-{}.svg", p.parameter, p.surface), response_plot(p));
+      points.x.push_back(p.measured_mean);
+      points.y.push_back(p.verification_mean);
+      top = std::max({top, p.measured_mean, p.verification_mean});
+    }
+    overview.series = {points, {"equal", {0.0, 1.1 * top}, {0.0, 1.1 * top}, "#999999", true, false}};
+    files.emplace_back(fs::path(args.out) / "measured-vs-calibrated.svg", render_svg(overview));
+    if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
+  }
+  if (args.json) {
+    std::cout << report.dump(2) << "\n";
+  } else {
+    fmt::print("calibration of clump '{}' by the study's method ({} trials per level)\n\n{}\n", clump->name, args.trials_per_level,
+               markdown(*calibration));
+    for (const auto& note : calibration->notes) fmt::print("note: {}\n", note);
+    if (!args.out.empty()) fmt::print("report, sweeps and plots written to {}/\n", args.out);
+  }
+  return kExitOk;
+}
+}  // namespace
+
+Command add_calibrate_command(CLI::App& app) {
+  auto args = std::make_shared<CalibrateArgs>();
+  CLI::App* sub = app.add_subcommand("calibrate", "Calibrate e, mu_s and mu_r against recordings by the study's method");
+  sub->add_option("--recordings", args->recordings, "Recording directories (drop, tilt, roll on each surface)")->required();
+  sub->add_option("--clump", args->clump_file, "Clump library (.h5)")->required();
+  sub->add_option("--clump-name", args->clump_name, "Which clump of the file (needed when it holds several)");
+  sub->add_option("--method", args->method, "paper: the study's one-at-a-time sweep, fit and inversion")->capture_default_str();
+  sub->add_option("--trials-per-level", args->trials_per_level, "Trials per swept level")->capture_default_str();
+  sub->add_option("--seed", args->seed, "Seed of the trial orientations")->capture_default_str();
+  sub->add_option("--out", args->out, "Directory for calibration.json, calibration.md and the plots");
+  sub->add_flag("--json", args->json, "Print the report as JSON");
+  return {sub, [args] { return run_calibrate(*args); }};
+}
+
+}  // namespace clumpforge::cli
