@@ -31,7 +31,7 @@ ContactOutput hertz_mindlin(const ContactInput& in, const ContactSettings& setti
   const double sn = 2.0 * in.youngs * root;        // normal tangent stiffness
   const double kn = 4.0 / 3.0 * in.youngs * root;  // secant: Fn_el = kn dn
   const double st = 8.0 * in.shear * root;
-  const double beta = damping_beta(in.coefficients.restitution);
+  const double beta = in.beta;
   const double gamma_n = -kTwoSqrtFiveSixths * beta * std::sqrt(sn * in.effective_mass);
   const double vn = in.relative_velocity.dot(n);
   const double elastic_normal = kn * in.overlap;

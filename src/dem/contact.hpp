@@ -35,6 +35,7 @@ struct ContactInput {
   double rolling_inertia = 0.0;  ///< I_r for the EPSD dashpot [kg m^2]
   double youngs = 0.0;           ///< E* [Pa]
   double shear = 0.0;            ///< G* [Pa]
+  double beta = 0.0;             ///< damping_beta(coefficients.restitution), precomputed per material pair
   Interaction coefficients;
   double dt = 0.0;               ///< [s]
 };

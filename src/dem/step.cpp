@@ -42,11 +42,35 @@ double candidate_skin(const RigidBody& body) {
   return 0.5 * smallest;
 }
 
-void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, double dt) {
+// E*, G* and beta of every material pair, once per force evaluation.
+struct PairConstants {
+  double youngs = 0.0, shear = 0.0, beta = 0.0;
+};
+std::vector<std::vector<PairConstants>> pair_constants(const World& world) {
+  const std::size_t n = world.materials.size();
+  std::vector<std::vector<PairConstants>> table(n, std::vector<PairConstants>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < n; ++j) {
+      table[i][j] = {effective_youngs_modulus(world.materials[i], world.materials[j]),
+                     effective_shear_modulus(world.materials[i], world.materials[j]),
+                     damping_beta(world.interactions[i][j].restitution)};
+    }
+  }
+  return table;
+}
+
+// The body's rotation and spin, computed once per force evaluation.
+struct BodyFrame {
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d omega;
+};
+
+void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, double dt, const BodyFrame& frame,
+                  const std::vector<std::vector<PairConstants>>& constants) {
   RigidBody& body = world.bodies[b];
   const Wall& wall = world.walls[w];
   const Sphere& sphere = body.spheres[k];
-  const Eigen::Vector3d centre = body.sphere_position(k);
+  const Eigen::Vector3d centre = body.position + frame.rotation * sphere.centre;
   const double height = (centre - wall.point).dot(wall.normal);
   const double overlap = sphere.radius - height;
   if (overlap <= 0.0) return;
@@ -55,9 +79,8 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
   if (wall.half_v > 0.0 && std::abs((foot - wall.point).dot(wall.v_axis())) > wall.half_v) return;
   const Eigen::Vector3d point = centre - (sphere.radius - 0.5 * overlap) * wall.normal;
   const Eigen::Vector3d arm = point - body.position;
-  const Eigen::Vector3d omega = body.angular_velocity();
-  const Material& mi = world.materials[body.material];
-  const Material& mj = world.materials[wall.material];
+  const Eigen::Vector3d& omega = frame.omega;
+  const PairConstants& pair = constants[body.material][wall.material];
   ContactInput in;
   in.normal = wall.normal;
   in.overlap = overlap;
@@ -67,8 +90,9 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
   in.effective_mass = body.mass;        // every sphere of a clump carries the clump's mass (LIGGGHTS)
   in.rolling_arm = world.contact.rolling_arm == RollingArm::SphereRadius ? sphere.radius : arm.norm();
   in.rolling_inertia = 1.4 * body.mass * sphere.radius * sphere.radius;
-  in.youngs = effective_youngs_modulus(mi, mj);
-  in.shear = effective_shear_modulus(mi, mj);
+  in.youngs = pair.youngs;
+  in.shear = pair.shear;
+  in.beta = pair.beta;
   in.coefficients = world.interactions[body.material][wall.material];
   in.dt = dt;
   ContactState& state = world.history[wall_key(b, k, w)];
@@ -78,13 +102,12 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
   world.torque[b] += arm.cross(out.force) + out.rolling_torque;
 }
 
-void sphere_contacts(World& world, std::size_t bi, std::size_t bj, double dt) {
+void sphere_contacts(World& world, std::size_t bi, std::size_t bj, double dt, const std::vector<std::vector<PairConstants>>& constants) {
   RigidBody& a = world.bodies[bi];
   RigidBody& c = world.bodies[bj];
   if ((a.position - c.position).norm() > a.bounding_radius + c.bounding_radius) return;
   const Eigen::Vector3d wa = a.angular_velocity(), wc = c.angular_velocity();
-  const Material& ma = world.materials[a.material];
-  const Material& mc = world.materials[c.material];
+  const PairConstants& pair = constants[a.material][c.material];
   for (std::size_t si = 0; si < a.spheres.size(); ++si) {
     const Eigen::Vector3d pi = a.sphere_position(si);
     if ((pi - c.position).norm() > c.bounding_radius + a.spheres[si].radius) continue;
@@ -108,8 +131,9 @@ void sphere_contacts(World& world, std::size_t bi, std::size_t bj, double dt) {
       in.rolling_arm = in.effective_radius;
       const double ia = a.mass * ri * ri, ic = c.mass * rj * rj;
       in.rolling_inertia = 1.4 * ia * ic / (ia + ic);
-      in.youngs = effective_youngs_modulus(ma, mc);
-      in.shear = effective_shear_modulus(ma, mc);
+      in.youngs = pair.youngs;
+      in.shear = pair.shear;
+      in.beta = pair.beta;
       in.coefficients = world.interactions[a.material][c.material];
       in.dt = dt;
       ContactState& state = world.history[pair_key(bi, si, bj, sj)];
@@ -157,9 +181,12 @@ void compute_forces(World& world, double dt) {
     world.wall_candidates.assign(n, {});
     world.candidate_travel.assign(n, std::numeric_limits<double>::infinity());
   }
+  const auto constants = pair_constants(world);
   for (std::size_t b = 0; b < n; ++b) {
     RigidBody& body = world.bodies[b];
     world.force[b] += body.mass * world.gravity;
+    const Eigen::Matrix3d rotation = body.orientation.toRotationMatrix();
+    const BodyFrame frame{rotation, rotation * (rotation.transpose() * body.angular_momentum).cwiseQuotient(body.inertia)};
     for (const auto& term : world.terms) {
       const TermLoad load = std::visit([&](const auto& t) { return apply(t, body.velocity, body.mass, world.materials[body.material].density); }, term);
       world.force[b] += load.force;
@@ -168,11 +195,11 @@ void compute_forces(World& world, double dt) {
     const double skin = candidate_skin(body);
     if (world.candidate_travel[b] > 0.5 * skin) refresh_candidates(world, b, skin);
     for (std::size_t w = 0; w < world.walls.size(); ++w) {
-      for (int k : world.wall_candidates[b][w]) wall_contact(world, b, static_cast<std::size_t>(k), w, dt);
+      for (int k : world.wall_candidates[b][w]) wall_contact(world, b, static_cast<std::size_t>(k), w, dt, frame, constants);
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = i + 1; j < n; ++j) sphere_contacts(world, i, j, dt);
+    for (std::size_t j = i + 1; j < n; ++j) sphere_contacts(world, i, j, dt, constants);
   }
   // Contacts that ended this step lose their history.
   std::erase_if(world.history, [&](const auto& entry) { return entry.second.last_step != world.steps; });
