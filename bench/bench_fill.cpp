@@ -15,21 +15,14 @@
 #include "mesh/mesh_writer.hpp"
 #include "mesh/load.hpp"
 #include "mesh/repair.hpp"
+#include "large_scan.hpp"
 #include "synth/tuber.hpp"
 
 namespace {
 using namespace clumpforge;
 namespace fs = std::filesystem;
 
-const fs::path& large_scan() {
-  static const fs::path path = [] {
-    const fs::path file = fs::temp_directory_path() / "clumpforge-bench-tuber-200k.stl";
-    const DamagedScan scan = damage_scan(make_tuber({.seed = 2026, .frequency = 100}), {.seed = 2027});
-    if (!write_mesh(file, scan.soup, LengthUnit::Millimetre)) std::abort();
-    return file;
-  }();
-  return path;
-}
+using bench::large_scan;
 
 TriangleSoup repaired(const fs::path& path) {
   auto loaded = load_mesh(path, {.unit = LengthUnit::Millimetre});

@@ -9,24 +9,14 @@
 #include "mesh/load.hpp"
 #include "mesh/mass_properties.hpp"
 #include "mesh/repair.hpp"
+#include "large_scan.hpp"
 #include "synth/tuber.hpp"
 
 namespace {
 using namespace clumpforge;
 namespace fs = std::filesystem;
 
-// The 200k-triangle scan: the default tuber at geodesic frequency 100, damaged like
-// the bundled ones, written once as binary STL in mm.
-const fs::path& large_scan() {
-  static const fs::path path = [] {
-    const fs::path file = fs::temp_directory_path() / "clumpforge-bench-tuber-200k.stl";
-    const TriangleSoup body = make_tuber({.seed = 2026, .frequency = 100});
-    const DamagedScan scan = damage_scan(body, {.seed = 2027});
-    if (!write_mesh(file, scan.soup, LengthUnit::Millimetre)) std::abort();
-    return file;
-  }();
-  return path;
-}
+using bench::large_scan;
 
 void repair_and_props(benchmark::State& state, const fs::path& path) {
   std::size_t faces = 0;

@@ -13,6 +13,18 @@
 namespace clumpforge {
 namespace {
 
+// Integer cell of a point on a uniform grid of edge `cell`, and its hash (Teschner et al. 2003).
+using CellKey = std::array<std::int64_t, 3>;
+struct CellHash {
+  std::size_t operator()(const CellKey& c) const {
+    return static_cast<std::size_t>((c[0] * 73856093) ^ (c[1] * 19349663) ^ (c[2] * 83492791));
+  }
+};
+CellKey cell_of(const Eigen::Vector3d& p, double cell) {
+  return {static_cast<std::int64_t>(std::floor(p.x() / cell)), static_cast<std::int64_t>(std::floor(p.y() / cell)),
+          static_cast<std::int64_t>(std::floor(p.z() / cell))};
+}
+
 // Area-weighted random points on the mesh surface.
 std::vector<Eigen::Vector3d> sample_mesh_surface(const TriangleSoup& soup, int count, std::uint64_t seed) {
   std::vector<double> cumulative(soup.faces.size());
@@ -68,18 +80,10 @@ class SphereIndex {
   }
 
  private:
-  struct Hash {
-    std::size_t operator()(const std::array<std::int64_t, 3>& c) const {
-      return static_cast<std::size_t>((c[0] * 73856093) ^ (c[1] * 19349663) ^ (c[2] * 83492791));
-    }
-  };
-  std::array<std::int64_t, 3> key(const Eigen::Vector3d& p) const {
-    return {static_cast<std::int64_t>(std::floor(p.x() / cell_)), static_cast<std::int64_t>(std::floor(p.y() / cell_)),
-            static_cast<std::int64_t>(std::floor(p.z() / cell_))};
-  }
+  CellKey key(const Eigen::Vector3d& p) const { return cell_of(p, cell_); }
   std::span<const Sphere> spheres_;
   double cell_ = 1.0;
-  std::unordered_map<std::array<std::int64_t, 3>, std::vector<int>, Hash> grid_;
+  std::unordered_map<CellKey, std::vector<int>, CellHash> grid_;
 };
 
 Eigen::Vector3d fibonacci_direction(int q, int n) {
@@ -142,18 +146,10 @@ class NearestPoint {
   }
 
  private:
-  struct Hash {
-    std::size_t operator()(const std::array<std::int64_t, 3>& c) const {
-      return static_cast<std::size_t>((c[0] * 73856093) ^ (c[1] * 19349663) ^ (c[2] * 83492791));
-    }
-  };
-  std::array<std::int64_t, 3> key(const Eigen::Vector3d& p) const {
-    return {static_cast<std::int64_t>(std::floor(p.x() / cell_)), static_cast<std::int64_t>(std::floor(p.y() / cell_)),
-            static_cast<std::int64_t>(std::floor(p.z() / cell_))};
-  }
+  CellKey key(const Eigen::Vector3d& p) const { return cell_of(p, cell_); }
   const std::vector<Eigen::Vector3d>& points_;
   double cell_;
-  std::unordered_map<std::array<std::int64_t, 3>, std::vector<int>, Hash> grid_;
+  std::unordered_map<CellKey, std::vector<int>, CellHash> grid_;
 };
 
 // Surface deviation, both ways: every point sampled on the mesh surface to the clump's

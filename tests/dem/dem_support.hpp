@@ -29,6 +29,21 @@ inline World sphere_over_plane(const Material& sphere, const Material& plane, co
   return world;
 }
 
+/// Two identical spheres of `material` approaching head-on along z at `speed` each.
+inline World two_spheres(const Material& material, const Interaction& interaction, double radius, double speed) {
+  World world;
+  const int m = add_material(world, material);
+  set_interaction(world, m, m, interaction);
+  world.gravity.setZero();
+  world.contact.rolling = RollingModel::None;
+  world.bodies = {make_sphere_body(radius, material.density, m), make_sphere_body(radius, material.density, m)};
+  world.bodies[0].position = {0, 0, radius + 1e-7};
+  world.bodies[1].position = {0, 0, -radius - 1e-7};
+  world.bodies[0].velocity = {0, 0, -speed};
+  world.bodies[1].velocity = {0, 0, speed};
+  return world;
+}
+
 /// Hertz impact of a sphere on a rigid plane: max overlap, max force, contact time.
 struct HertzImpact {
   double max_overlap, max_force, duration;

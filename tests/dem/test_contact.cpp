@@ -65,16 +65,7 @@ TEST(ChungOoi, Test2ElasticSphereOnRigidPlaneMatchesHertzWithinOnePercent) {
 
 TEST(ChungOoi, Test1TwoIdenticalSpheresMatchHertzWithinOnePercent) {
   const double r = 0.01, v = 10.0;
-  World world;
-  const int glass = add_material(world, kGlass);
-  set_interaction(world, glass, glass, {1.0, 0.0, 0.0});
-  world.gravity.setZero();
-  world.contact.rolling = RollingModel::None;
-  world.bodies = {make_sphere_body(r, kGlass.density, glass), make_sphere_body(r, kGlass.density, glass)};
-  world.bodies[0].position = {0, 0, r + 1e-7};
-  world.bodies[1].position = {0, 0, -r - 1e-7};
-  world.bodies[0].velocity = {0, 0, -v};
-  world.bodies[1].velocity = {0, 0, v};
+  World world = test::two_spheres(kGlass, {1.0, 0.0, 0.0}, r, v);
   const double m = world.bodies[0].mass;
   const auto theory = test::hertz_theory(m / 2, r / 2, effective_youngs_modulus(kGlass, kGlass), 2 * v);
   EXPECT_NEAR(theory.max_overlap, 274.1e-6, 1e-6);  // Chung & Ooi test 1, glass
@@ -144,16 +135,7 @@ TEST(ChungOoi, Test7OppositeSpinsMakeNoTangentialForce) {
   // Two identical spheres, equal and opposite spins about the same axis: their contact
   // points move together, so the spins and the tangential velocities stay as they were.
   const double r = 0.1, v = 0.2, omega = 10.0;
-  World world;
-  const int al = add_material(world, kAluminium);
-  set_interaction(world, al, al, {0.5, 0.4, 0.0});
-  world.gravity.setZero();
-  world.contact.rolling = RollingModel::None;
-  world.bodies = {make_sphere_body(r, kAluminium.density, al), make_sphere_body(r, kAluminium.density, al)};
-  world.bodies[0].position = {0, 0, r + 1e-7};
-  world.bodies[1].position = {0, 0, -r - 1e-7};
-  world.bodies[0].velocity = {0, 0, -v};
-  world.bodies[1].velocity = {0, 0, v};
+  World world = test::two_spheres(kAluminium, {0.5, 0.4, 0.0}, r, v);
   world.bodies[0].angular_momentum = world.bodies[0].inertia.x() * Eigen::Vector3d(0, omega, 0);
   world.bodies[1].angular_momentum = world.bodies[1].inertia.x() * Eigen::Vector3d(0, -omega, 0);
   const auto theory = test::hertz_theory(world.bodies[0].mass / 2, r / 2, effective_youngs_modulus(kAluminium, kAluminium), 2 * v);
