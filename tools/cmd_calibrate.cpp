@@ -39,6 +39,11 @@ nlohmann::json step_json(const ParameterCalibration& p) {
                    {"measured_mean", p.measured_mean}, {"roots", p.roots}, {"calibrated", p.calibrated}, {"flag", p.flag},
                    {"verification_mean", p.verification_mean}, {"verification_relative_error", p.verification_error}};
   j["study_value"] = p.study_value ? nlohmann::json(*p.study_value) : nlohmann::json(nullptr);
+  if (p.parameter == "restitution") {
+    j["verification_apparent_restitution"] = p.verification_apparent_restitution;
+    j["verification_impact_energy_to_rotation"] = p.verification_rotation_of_impact;
+    j["verification_contacts_at_impact"] = p.verification_contacts_at_impact;
+  }
   return j;
 }
 
@@ -50,6 +55,17 @@ std::string markdown(const PaperCalibration& c) {
                         p.parameter, p.surface, p.fit.a, p.fit.b, p.fit.c, p.fit.r_squared, p.fit.p_value, p.measured_mean,
                         p.calibrated, p.study_value ? fmt::format("{:g}", *p.study_value) : "-", p.verification_mean,
                         100 * p.verification_error, p.flag, fmt::arg("u", unit_of(p.test)));
+  }
+  for (const auto& p : c.steps) {
+    if (p.parameter != "restitution") continue;
+    text += fmt::format(
+        "\nWhy the calibrated restitution on {} ({:.3g}) is far above what the drop suggests: at e = {:.3g} the simulated clump's "
+        "sqrt(h/H) is {:.3f} on average: {:.0f} % of the impact energy leaves as rotation, and the clump lands on {:.1f} spheres "
+        "at once on average, each contact damped with the whole clump's mass (the EDEM/LIGGGHTS convention), so the body's "
+        "rebound is far below the contact's restitution. The lab's e = sqrt(h/H) (mean rebound {:.4g} mm) measures the body's "
+        "rebound, not the contact parameter.\n",
+        p.surface, p.calibrated, p.calibrated, p.verification_apparent_restitution, 100 * p.verification_rotation_of_impact,
+        p.verification_contacts_at_impact, p.measured_mean);
   }
   return text;
 }

@@ -111,14 +111,32 @@ int run_validate(const ValidateArgs& args) {
                           {"limit_force", args.limit_force}, {"time_step_s", result->time_step},
                           {"rayleigh_time_s", result->estimate.rayleigh}, {"hertz_time_s", result->estimate.hertz},
                           {"steps", result->steps}, {"seed", args.seed}};
-    for (const auto& trial : result->recording.trials) report["trials"].push_back({{"id", trial.id}, {key, *trial.summary}});
+    for (std::size_t i = 0; i < result->recording.trials.size(); ++i) {
+      const auto& trial = result->recording.trials[i];
+      nlohmann::json entry{{"id", trial.id}, {key, *trial.summary}};
+      if (*test == LabTest::Drop) {
+        entry["apparent_restitution"] = result->impacts[i].apparent_restitution;
+        entry["impact_energy_to_rotation"] = result->impacts[i].rotation_of_impact;
+        entry["contacts_at_impact"] = result->impacts[i].first_contacts;
+      }
+      report["trials"].push_back(entry);
+    }
     if (!args.out.empty()) report["recording"] = args.out;
     std::cout << report.dump(2) << "\n";
   } else {
     fmt::print("{} test of clump '{}' on {} ({} trials, seed {}): e {} mu_s {} mu_r {} ({}), time step {:.3g} s\n", args.test,
                clump->name, args.surface, args.trials, args.seed, result->interaction.restitution, result->interaction.static_friction,
                result->interaction.rolling_friction, model, result->time_step);
-    for (const auto& trial : result->recording.trials) fmt::print("  trial {}: {} = {:.5g}\n", trial.id, key, *trial.summary);
+    for (std::size_t i = 0; i < result->recording.trials.size(); ++i) {
+      const auto& trial = result->recording.trials[i];
+      if (*test == LabTest::Drop) {
+        const auto& d = result->impacts[i];
+        fmt::print("  trial {}: {} = {:.5g}  (sqrt(h/H) {:.3f}; {:.0f} % of the impact energy into rotation; {} spheres touching)\n",
+                   trial.id, key, *trial.summary, d.apparent_restitution, 100 * d.rotation_of_impact, d.first_contacts);
+      } else {
+        fmt::print("  trial {}: {} = {:.5g}\n", trial.id, key, *trial.summary);
+      }
+    }
     fmt::print("  mean {:.5g}, standard deviation {:.3g}, range {:.5g} .. {:.5g}\n", s.mean, s.std, s.min, s.max);
     if (!args.out.empty()) fmt::print("  recording written to {}/\n", args.out);
   }

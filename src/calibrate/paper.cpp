@@ -36,16 +36,28 @@ const Recording* find_recording(const std::vector<Recording>& recordings, const 
   return nullptr;
 }
 
-Result<std::vector<double>> run_responses(const Clump& clump, const MaterialTable& table, const Recording& setup,
-                                          const Interaction& interaction, const PaperOptions& options, int trials) {
+struct Responses {
+  std::vector<double> values;       // study units
+  double apparent_restitution = 0;  // drop: mean sqrt(h/H)
+  double rotation_of_impact = 0;    // drop: mean share of the impact energy turned into rotation
+  double contacts = 0;              // drop: mean spheres touching at the first impact
+};
+
+Result<Responses> run_responses(const Clump& clump, const MaterialTable& table, const Recording& setup, const Interaction& interaction,
+                                const PaperOptions& options, int trials) {
   LabOptions lab = options.lab;
   lab.trials = trials;
   lab.interaction = interaction;
   auto result = run_lab_test(clump, table, setup, lab);
   if (!result) return std::unexpected(result.error());
-  std::vector<double> values;
-  for (double v : result->recording.summaries()) values.push_back(study_units(setup.test, v));
-  return values;
+  Responses out;
+  for (double v : result->recording.summaries()) out.values.push_back(study_units(setup.test, v));
+  for (const auto& d : result->impacts) {
+    out.apparent_restitution += d.apparent_restitution / static_cast<double>(result->impacts.size());
+    out.rotation_of_impact += d.rotation_of_impact / static_cast<double>(result->impacts.size());
+    out.contacts += d.first_contacts / static_cast<double>(result->impacts.size());
+  }
+  return out;
 }
 
 // Picks the calibrated value among the roots in range, saying what it did when there is not
@@ -126,7 +138,7 @@ Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable
         coefficient(run, parameter) = level;
         auto responses = run_responses(clump, table, *recording, run, options, options.trials_per_level);
         if (!responses) return std::unexpected(responses.error());
-        p.levels.push_back({level, *responses, mean(*responses)});
+        p.levels.push_back({level, responses->values, mean(responses->values)});
         xs.push_back(level);
         ys.push_back(p.levels.back().mean);
       }
@@ -141,7 +153,10 @@ Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable
       if (parameter == "restitution") verify.static_friction = verify.rolling_friction = 0.0;
       auto check = run_responses(clump, table, *recording, verify, options, options.trials_per_level);
       if (!check) return std::unexpected(check.error());
-      p.verification_mean = mean(*check);
+      p.verification_mean = mean(check->values);
+      p.verification_apparent_restitution = check->apparent_restitution;
+      p.verification_rotation_of_impact = check->rotation_of_impact;
+      p.verification_contacts_at_impact = check->contacts;
       p.verification_error = (p.verification_mean - p.measured_mean) / p.measured_mean;
       calibration.steps.push_back(std::move(p));
     }

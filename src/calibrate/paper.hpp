@@ -35,6 +35,11 @@ struct ParameterCalibration {
   double verification_mean = 0.0;  ///< at the calibrated values (mm or deg)
   double verification_error = 0.0; ///< relative to the measured mean
   std::optional<double> study_value;  ///< what the study found for this pair
+  /// Restitution steps: at the calibrated e, the mean apparent restitution sqrt(h/H) the lab
+  /// would compute, and the share of the impact energy that leaves as rotation.
+  double verification_apparent_restitution = 0.0;
+  double verification_rotation_of_impact = 0.0;
+  double verification_contacts_at_impact = 0.0;  ///< mean spheres touching at once at the first impact
 };
 
 struct PaperOptions {

@@ -30,7 +30,10 @@ struct TrialOutcome {
   Trial trial;
   Eigen::Quaterniond orientation;
   std::uint64_t steps = 0;
+  ImpactDiagnostics impact;
 };
+
+double rotational_energy(const RigidBody& b) { return 0.5 * b.angular_momentum.dot(b.angular_velocity()); }
 
 class TrackSampler {
  public:
@@ -67,21 +70,34 @@ TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& o
   out.orientation = body.orientation;
   bool impacted = false, airborne_after = false;
   double apex = 0.0, impact_time = 0.0;  // apex of the lowest point, >= 0 once it touched
+  double energy_before = 0.0;
   while (world.time < options.max_time) {
+    const double kinetic_before = world.bodies[0].kinetic_energy();
     step(world, dt);
     sampler.sample(world);
     const bool touching = any_wall_contact(world);
     if (!impacted && touching) {
       impacted = true;
       impact_time = world.time;
+      energy_before = kinetic_before;
     }
     if (!impacted) continue;
+    if (touching && !airborne_after) {
+      out.impact.first_contacts = std::max(out.impact.first_contacts, static_cast<int>(world.history.size()));
+    }
+    if (!touching && !airborne_after) {
+      const RigidBody& b = world.bodies[0];
+      const double rotation = rotational_energy(b);
+      out.impact.rotation_share = rotation / std::max(b.kinetic_energy(), 1e-300);
+      out.impact.rotation_of_impact = rotation / std::max(energy_before, 1e-300);
+    }
     if (!touching) airborne_after = true;
     if (airborne_after && touching) break;  // the second impact ends the first rebound
     apex = std::max(apex, lowest_height(world.bodies[0]));
     if (world.time - impact_time > 0.6) break;  // never left the plate again
   }
   out.trial.summary = apex;
+  out.impact.apparent_restitution = std::sqrt(apex / setup.release_height);
   out.trial.track = sampler.take();
   out.steps = world.steps;
   return out;
@@ -270,7 +286,14 @@ Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, c
   for (int i = 0; i < options.trials; ++i) {
     outcomes[i].trial.id = fmt::format("{:02d}", i + 1);
     const Eigen::Quaterniond& q = outcomes[i].orientation;
-    outcomes[i].trial.extra_json = fmt::format("{{\"orientation_wxyz\": [{:.9f}, {:.9f}, {:.9f}, {:.9f}]}}", q.w(), q.x(), q.y(), q.z());
+    const ImpactDiagnostics& d = outcomes[i].impact;
+    outcomes[i].trial.extra_json =
+        setup.test == LabTest::Drop
+            ? fmt::format("{{\"orientation_wxyz\": [{:.9f}, {:.9f}, {:.9f}, {:.9f}], \"apparent_restitution\": {:.6f}, "
+                          "\"rotation_share_after_impact\": {:.6f}, \"impact_energy_to_rotation\": {:.6f}, \"contacts_at_impact\": {}}}",
+                          q.w(), q.x(), q.y(), q.z(), d.apparent_restitution, d.rotation_share, d.rotation_of_impact, d.first_contacts)
+            : fmt::format("{{\"orientation_wxyz\": [{:.9f}, {:.9f}, {:.9f}, {:.9f}]}}", q.w(), q.x(), q.y(), q.z());
+    result.impacts.push_back(d);
     result.orientations.push_back(q);
     result.steps += outcomes[i].steps;
     result.recording.trials.push_back(std::move(outcomes[i].trial));

@@ -26,9 +26,18 @@ struct LabOptions {
   std::vector<PhysicsTerm> terms;   ///< extra physics
 };
 
+/// What a drop trial's impact did, to explain a rebound (drop tests only).
+struct ImpactDiagnostics {
+  double apparent_restitution = 0.0;  ///< sqrt(rebound / release height): the lab's e estimate
+  double rotation_share = 0.0;        ///< of the kinetic energy just after the first impact, the part in rotation
+  double rotation_of_impact = 0.0;    ///< rotational energy after the impact over the kinetic energy before it
+  int first_contacts = 0;             ///< spheres touching at once at the first impact (most during it)
+};
+
 struct LabResult {
   Recording recording;              ///< the set-up and one trial per run (summary + track)
   std::vector<Eigen::Quaterniond> orientations;  ///< initial orientation of each trial
+  std::vector<ImpactDiagnostics> impacts;        ///< per trial (drop tests)
   Interaction interaction;          ///< coefficients actually used
   TimeStepEstimate estimate;
   double time_step = 0.0;           ///< [s]
