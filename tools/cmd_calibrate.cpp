@@ -39,6 +39,8 @@ nlohmann::json step_json(const ParameterCalibration& p) {
                    {"measured_mean", p.measured_mean}, {"roots", p.roots}, {"calibrated", p.calibrated}, {"flag", p.flag},
                    {"verification_mean", p.verification_mean}, {"verification_relative_error", p.verification_error}};
   j["study_value"] = p.study_value ? nlohmann::json(*p.study_value) : nlohmann::json(nullptr);
+  j["verification_responses"] = p.verification_responses;
+  j["measured"] = p.measured;
   if (p.parameter == "restitution") {
     j["verification_apparent_restitution"] = p.verification_apparent_restitution;
     j["verification_impact_energy_to_rotation"] = p.verification_rotation_of_impact;
@@ -90,6 +92,32 @@ std::string response_plot(const ParameterCalibration& p) {
   return render_svg(plot);
 }
 
+// Histogram (as joined bin counts) of the simulated responses at the calibrated values and
+// of the lab's trials: the spread that orientation makes.
+std::string distribution_plot(const ParameterCalibration& p) {
+  std::vector<double> all = p.verification_responses;
+  all.insert(all.end(), p.measured.begin(), p.measured.end());
+  const double low = *std::min_element(all.begin(), all.end()), high = *std::max_element(all.begin(), all.end());
+  const int bins = 8;
+  const double width = std::max((high - low) / bins, 1e-9);
+  auto histogram = [&](const std::vector<double>& values, const std::string& name, const std::string& colour) {
+    PlotSeries series{name, {}, {}, colour, true, true};
+    for (int b = 0; b < bins; ++b) {
+      const double from = low + b * width;
+      series.x.push_back(from + 0.5 * width);
+      series.y.push_back(static_cast<double>(std::count_if(values.begin(), values.end(), [&](double v) {
+        return v >= from && (v < from + width || (b == bins - 1 && v <= high));
+      })));
+    }
+    return series;
+  };
+  Plot plot{fmt::format("{} test on {}: trials by outcome", to_string(p.test), p.surface), fmt::format("outcome [{}]", unit_of(p.test)),
+            "trials", false, false, {}, {}};
+  plot.series = {histogram(p.verification_responses, fmt::format("simulated at {} = {:.3g}", p.parameter, p.calibrated), "#1f77b4"),
+                 histogram(p.measured, "measured", "#d62728")};
+  return render_svg(plot);
+}
+
 int run_calibrate(const CalibrateArgs& args) {
   constexpr std::string_view kCommand = "calibrate";
   if (args.method != "paper") {
@@ -134,6 +162,7 @@ int run_calibrate(const CalibrateArgs& args) {
     double top = 0.0;
     for (const auto& p : calibration->steps) {
       files.emplace_back(fs::path(args.out) / fmt::format("sweep-{}-{}.svg", p.parameter, p.surface), response_plot(p));
+      files.emplace_back(fs::path(args.out) / fmt::format("distribution-{}-{}.svg", to_string(p.test), p.surface), distribution_plot(p));
       points.x.push_back(p.measured_mean);
       points.y.push_back(p.verification_mean);
       top = std::max({top, p.measured_mean, p.verification_mean});

@@ -154,6 +154,8 @@ Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable
       auto check = run_responses(clump, table, *recording, verify, options, options.trials_per_level);
       if (!check) return std::unexpected(check.error());
       p.verification_mean = mean(check->values);
+      p.verification_responses = check->values;
+      p.measured = measured;
       p.verification_apparent_restitution = check->apparent_restitution;
       p.verification_rotation_of_impact = check->rotation_of_impact;
       p.verification_contacts_at_impact = check->contacts;

@@ -33,6 +33,8 @@ struct ParameterCalibration {
   double calibrated = 0.0;
   std::string flag;                ///< "" when exactly one root, else what happened
   double verification_mean = 0.0;  ///< at the calibrated values (mm or deg)
+  std::vector<double> verification_responses;  ///< per trial (mm or deg)
+  std::vector<double> measured;                ///< the recording's trials (mm or deg)
   double verification_error = 0.0; ///< relative to the measured mean
   std::optional<double> study_value;  ///< what the study found for this pair
   /// Restitution steps: at the calibrated e, the mean apparent restitution sqrt(h/H) the lab

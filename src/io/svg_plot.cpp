@@ -8,7 +8,7 @@
 
 namespace clumpforge {
 namespace {
-constexpr double kWidth = 640, kHeight = 420, kLeft = 80, kRight = 160, kTop = 40, kBottom = 60;
+constexpr double kWidth = 720, kHeight = 420, kLeft = 80, kRight = 220, kTop = 40, kBottom = 60;
 
 struct Axis {
   bool log = false;
@@ -51,7 +51,7 @@ std::vector<double> ticks(const Axis& axis) {
   const double raw = span / 5.0;
   const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
   const double step = raw / magnitude < 2 ? 2 * magnitude : raw / magnitude < 5 ? 5 * magnitude : 10 * magnitude;
-  for (double v = std::ceil(axis.low / step) * step; v <= axis.high; v += step) t.push_back(v);
+  for (double v = std::ceil(axis.low / step) * step; v <= axis.high; v += step) t.push_back(std::abs(v) < 1e-9 * step ? 0.0 : v);
   return t;
 }
 
@@ -100,7 +100,7 @@ std::string render_svg(const Plot& plot) {
   for (const auto& [value, label] : plot.reference_lines) {
     svg += fmt::format("<line x1=\"{}\" y1=\"{:.1f}\" x2=\"{}\" y2=\"{:.1f}\" stroke=\"#888\" stroke-dasharray=\"5,4\"/>"
                        "<text x=\"{}\" y=\"{:.1f}\" fill=\"#555\">{}</text>\n",
-                       kLeft, py(value), kLeft + pw, py(value), kLeft + pw + 6, py(value) + 4, escape(label));
+                       kLeft, py(value), kLeft + pw, py(value), kLeft + 6, py(value) - 4, escape(label));
   }
   double legend_y = kTop + 10;
   for (const auto& s : plot.series) {
