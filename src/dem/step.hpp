@@ -10,7 +10,8 @@ namespace clumpforge {
 struct TimeStepEstimate {
   double rayleigh = 0.0;   ///< T_R = pi R sqrt(rho/G) / (0.1631 nu + 0.8766), smallest sphere [s]
   double hertz = 0.0;      ///< Hertz contact duration 2.87 (m*^2 / (R* E*^2 v))^(1/5) [s]
-  double chosen = 0.0;     ///< min(0.2 T_R, t_H / 50): at least 50 steps per contact [s]
+  double rayleigh_fraction = 0.2;  ///< 0.4 for a single body on walls (low coordination), else 0.2 (EDEM)
+  double chosen = 0.0;     ///< min(fraction T_R, t_H / 50): at least 50 steps per contact [s]
   double largest_allowed = 0.0;  ///< min(0.4 T_R, t_H / 20): an override above this is refused [s]
 };
 
