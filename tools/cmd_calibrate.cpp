@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 
+#include "calibrate/joint.hpp"
 #include "calibrate/paper.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
@@ -118,12 +119,66 @@ std::string distribution_plot(const ParameterCalibration& p) {
   return render_svg(plot);
 }
 
+std::string joint_markdown(const std::vector<JointSurfaceResult>& results) {
+  std::string text = "| surface | e [95 %] | mu_s [95 %] | mu_r [95 %] | chi^2 | DEM runs |\n| --- | --- | --- | --- | ---: | ---: |\n";
+  auto cell = [](const Estimate& e) { return fmt::format("{:.3f} [{:.3f}, {:.3f}]", e.value, e.low, e.high); };
+  for (const auto& r : results) {
+    text += fmt::format("| {} | {} | {} | {} | {:.3g} | {} |\n", r.surface, cell(r.restitution), cell(r.static_friction),
+                        cell(r.rolling_friction), r.chi_squared, r.evaluations);
+  }
+  text += "\n| surface | test | measured mean | simulated mean | residual | in standard errors |\n| --- | --- | ---: | ---: | ---: | ---: |\n";
+  for (const auto& r : results) {
+    for (const auto& t : r.residuals) {
+      text += fmt::format("| {} | {} | {:.4g} {u} | {:.4g} {u} | {:+.3g} {u} | {:+.2f} |\n", r.surface, to_string(t.test), t.measured_mean,
+                          t.simulated_mean, t.residual(), t.z(), fmt::arg("u", unit_of(t.test)));
+    }
+  }
+  for (const auto& r : results) {
+    for (const auto& note : r.notes) text += "\nnote: " + note;
+  }
+  return text + "\n";
+}
+
+int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<Recording>& recordings) {
+  constexpr std::string_view kCommand = "calibrate";
+  JointOptions options;
+  options.trials = args.trials_per_level;
+  options.seed = args.seed;
+  const RunContext context = progress_context(args.json);
+  auto results = calibrate_joint(clump, default_material_table(), recordings, options, context);
+  if (!results) return report_error(kCommand, results.error());
+  nlohmann::json report{{"method", "joint"}, {"clump", clump.name}, {"trials", options.trials}, {"seed", args.seed}, {"surfaces", nlohmann::json::array()}};
+  for (const auto& r : *results) {
+    auto estimate = [](const Estimate& e) { return nlohmann::json{{"value", e.value}, {"low95", e.low}, {"high95", e.high}}; };
+    nlohmann::json residuals = nlohmann::json::array();
+    for (const auto& t : r.residuals) {
+      residuals.push_back({{"test", std::string(to_string(t.test))}, {"units", unit_of(t.test)}, {"measured_mean", t.measured_mean},
+                           {"simulated_mean", t.simulated_mean}, {"residual", t.residual()}, {"standard_error", t.standard_error}, {"z", t.z()}});
+    }
+    report["surfaces"].push_back({{"surface", r.surface}, {"restitution", estimate(r.restitution)}, {"static_friction", estimate(r.static_friction)},
+                                  {"rolling_friction", estimate(r.rolling_friction)}, {"residuals", residuals}, {"chi_squared", r.chi_squared},
+                                  {"dem_evaluations", r.evaluations}, {"notes", r.notes}});
+  }
+  const std::string text = joint_markdown(*results);
+  if (!args.out.empty()) {
+    std::error_code ec;
+    fs::create_directories(args.out, ec);
+    if (auto ok = write_files_atomically({{fs::path(args.out) / "calibration.json", report.dump(2) + "\n"},
+                                          {fs::path(args.out) / "calibration.md", "# Joint calibration (" + clump.name + ")\n\n" + text}});
+        !ok) {
+      return report_error(kCommand, ok.error());
+    }
+  }
+  if (args.json) std::cout << report.dump(2) << "\n";
+  else fmt::print("joint calibration of clump '{}' ({} orientations per drop and roll evaluation)\n\n{}", clump.name, options.trials, text);
+  return kExitOk;
+}
+
 int run_calibrate(const CalibrateArgs& args) {
   constexpr std::string_view kCommand = "calibrate";
-  if (args.method != "paper") {
-    return report_error(kCommand, {ErrorCode::InvalidArgument,
-                                   fmt::format("unknown method '{}'{} (this version offers 'paper', the study's procedure)", args.method,
-                                               did_you_mean(args.method, {"paper"}))});
+  if (args.method != "paper" && args.method != "joint") {
+    return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("unknown method '{}'{} (paper or joint)", args.method,
+                                                                            did_you_mean(args.method, {"paper", "joint"}))});
   }
   if (args.trials_per_level < 1 || args.trials_per_level > 1000) {
     return report_error(kCommand, {ErrorCode::InvalidArgument, "--trials-per-level must be between 1 and 1000"});
@@ -138,6 +193,7 @@ int run_calibrate(const CalibrateArgs& args) {
   if (!clumps) return report_error(kCommand, clumps.error());
   auto clump = select_clump(std::move(*clumps), args.clump_name, args.clump_file);
   if (!clump) return report_error(kCommand, clump.error());
+  if (args.method == "joint") return run_joint(args, *clump, recordings);
   PaperOptions options;
   options.trials_per_level = args.trials_per_level;
   options.lab.seed = args.seed;
@@ -189,8 +245,11 @@ Command add_calibrate_command(CLI::App& app) {
   sub->add_option("--recordings", args->recordings, "Recording directories (drop, tilt, roll on each surface)")->required();
   sub->add_option("--clump", args->clump_file, "Clump library (.h5)")->required();
   sub->add_option("--clump-name", args->clump_name, "Which clump of the file (needed when it holds several)");
-  sub->add_option("--method", args->method, "paper: the study's one-at-a-time sweep, fit and inversion")->capture_default_str();
-  sub->add_option("--trials-per-level", args->trials_per_level, "Trials per swept level")->capture_default_str();
+  sub->add_option("--method", args->method,
+                  "paper: the study's one-at-a-time sweep, fit and inversion; joint: all three together with bootstrap intervals")
+      ->capture_default_str();
+  sub->add_option("--trials-per-level", args->trials_per_level, "Trials per swept level (joint: orientations per evaluation)")
+      ->capture_default_str();
   sub->add_option("--seed", args->seed, "Seed of the trial orientations")->capture_default_str();
   sub->add_option("--out", args->out, "Directory for calibration.json, calibration.md and the plots");
   sub->add_flag("--json", args->json, "Print the report as JSON");

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "calibrate/joint.hpp"
 #include "calibrate/paper.hpp"
 #include "io/clump_library.hpp"
 #include "support/test_support.hpp"
@@ -69,6 +70,41 @@ TEST(PaperCalibration, RecoversTheRestitutionThatMadeTheRecording) {
   EXPECT_NEAR(step.calibrated, 0.55, 0.05) << step.flag;
   EXPECT_LT(std::abs(step.verification_error), 0.1);
   EXPECT_EQ(calibration->notes.size(), 2u);  // no tilt or roll recording: kept, and said so
+}
+
+}  // namespace clumpforge
+
+namespace clumpforge {
+
+TEST(JointCalibration, RecoversCoefficientsThatMadeTheRecordings) {
+  // Drop, tilt and roll recordings made by the DEM with known coefficients on steel; the
+  // joint fit (same orientation ensemble) finds them, inside its intervals, with a small chi^2.
+  auto clumps = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
+  const Clump clump = *select_clump(std::move(*clumps), "lattice-4mm", "tuber-default.h5");
+  const Interaction truth{0.6, 0.5, 0.04};
+  std::vector<Recording> recordings;
+  for (LabTest test : {LabTest::Drop, LabTest::Tilt, LabTest::Roll}) {
+    Recording setup;
+    setup.test = test;
+    setup.surface = "Q235";
+    setup.composite = Composite::FourSquare;
+    LabOptions lab;
+    lab.trials = test == LabTest::Tilt ? 2 : 10;
+    lab.interaction = truth;
+    recordings.push_back(run_lab_test(clump, default_material_table(), setup, lab)->recording);
+  }
+  JointOptions options;
+  const auto results = calibrate_joint(clump, default_material_table(), recordings, options);
+  ASSERT_TRUE(results) << results.error().message;
+  ASSERT_EQ(results->size(), 1u);
+  const auto& r = results->front();
+  EXPECT_NEAR(r.restitution.value, truth.restitution, 0.05);
+  EXPECT_NEAR(r.static_friction.value, truth.static_friction, 0.03);
+  EXPECT_NEAR(r.rolling_friction.value, truth.rolling_friction, 0.03);
+  EXPECT_LE(r.static_friction.low, r.static_friction.value);
+  EXPECT_GE(r.static_friction.high, r.static_friction.value);
+  EXPECT_LT(r.chi_squared, 1.0);
+  for (const auto& t : r.residuals) EXPECT_LT(std::abs(t.z()), 1.0);
 }
 
 }  // namespace clumpforge
