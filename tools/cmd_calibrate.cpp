@@ -13,6 +13,7 @@
 #include "core/atomic_file.hpp"
 #include "core/text.hpp"
 #include "io/clump_library.hpp"
+#include "io/materials_io.hpp"
 #include "io/recording_io.hpp"
 #include "io/svg_plot.hpp"
 
@@ -22,7 +23,7 @@ namespace fs = std::filesystem;
 
 struct CalibrateArgs {
   std::vector<std::string> recordings;
-  std::string clump_file, clump_name, method = "paper", out;
+  std::string clump_file, clump_name, method = "paper", out, materials;
   int trials_per_level = 10;
   std::uint64_t seed = 1;
   bool json = false;
@@ -139,13 +140,13 @@ std::string joint_markdown(const std::vector<JointSurfaceResult>& results) {
   return text + "\n";
 }
 
-int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<Recording>& recordings) {
+int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<Recording>& recordings, const MaterialTable& table) {
   constexpr std::string_view kCommand = "calibrate";
   JointOptions options;
   options.trials = args.trials_per_level;
   options.seed = args.seed;
   const RunContext context = progress_context(args.json);
-  auto results = calibrate_joint(clump, default_material_table(), recordings, options, context);
+  auto results = calibrate_joint(clump, table, recordings, options, context);
   if (!results) return report_error(kCommand, results.error());
   nlohmann::json report{{"method", "joint"}, {"clump", clump.name}, {"trials", options.trials}, {"seed", args.seed}, {"surfaces", nlohmann::json::array()}};
   for (const auto& r : *results) {
@@ -193,12 +194,14 @@ int run_calibrate(const CalibrateArgs& args) {
   if (!clumps) return report_error(kCommand, clumps.error());
   auto clump = select_clump(std::move(*clumps), args.clump_name, args.clump_file);
   if (!clump) return report_error(kCommand, clump.error());
-  if (args.method == "joint") return run_joint(args, *clump, recordings);
+  auto table = args.materials.empty() ? Result<MaterialTable>(default_material_table()) : read_materials(args.materials);
+  if (!table) return report_error(kCommand, table.error());
+  if (args.method == "joint") return run_joint(args, *clump, recordings, *table);
   PaperOptions options;
   options.trials_per_level = args.trials_per_level;
   options.lab.seed = args.seed;
   const RunContext context = progress_context(args.json);
-  auto calibration = calibrate_paper(*clump, default_material_table(), recordings, options, context);
+  auto calibration = calibrate_paper(*clump, *table, recordings, options, context);
   if (!calibration) return report_error(kCommand, calibration.error());
 
   nlohmann::json report{{"method", "paper"}, {"clump", clump->name}, {"trials_per_level", args.trials_per_level}, {"seed", args.seed},
@@ -252,6 +255,7 @@ Command add_calibrate_command(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--seed", args->seed, "Seed of the trial orientations")->capture_default_str();
   sub->add_option("--out", args->out, "Directory for calibration.json, calibration.md and the plots");
+  sub->add_option("--materials", args->materials, "Materials file (JSON, see docs/materials.json) overriding the built-in table");
   sub->add_flag("--json", args->json, "Print the report as JSON");
   return {sub, [args] { return run_calibrate(*args); }};
 }

@@ -12,13 +12,14 @@
 #include "core/text.hpp"
 #include "dem/lab.hpp"
 #include "io/clump_library.hpp"
+#include "io/materials_io.hpp"
 #include "io/recording_io.hpp"
 
 namespace clumpforge::cli {
 namespace {
 
 struct ValidateArgs {
-  std::string input, clump, test, surface, out, rolling_model = "cdt", composite = "four-square", rolling_arm = "centre";
+  std::string input, clump, test, surface, out, rolling_model = "cdt", composite = "four-square", rolling_arm = "centre", materials;
   int trials = 10;
   std::uint64_t seed = 1;
   std::optional<double> restitution, static_friction, rolling_friction, time_step, tilt_rate;
@@ -53,7 +54,9 @@ int run_validate(const ValidateArgs& args) {
   auto test = parse_test(args.test);
   if (!test) return report_error(kCommand, test.error());
   if (args.trials < 1 || args.trials > 100000) return report_error(kCommand, {ErrorCode::InvalidArgument, "--trials must be between 1 and 100000"});
-  const MaterialTable table = default_material_table();
+  auto loaded_table = args.materials.empty() ? Result<MaterialTable>(default_material_table()) : read_materials(args.materials);
+  if (!loaded_table) return report_error(kCommand, loaded_table.error());
+  const MaterialTable& table = *loaded_table;
   if (auto surface = table.find(args.surface); !surface) return report_error(kCommand, surface.error());
   LabOptions options;
   options.trials = args.trials;
@@ -154,6 +157,7 @@ Command add_validate_command(CLI::App& app) {
   sub->add_option("--trials", args->trials, "Trials (random orientations)")->capture_default_str();
   sub->add_option("--seed", args->seed, "Seed of the orientations")->capture_default_str();
   sub->add_option("--out", args->out, "Write the run as a recording (recording.json + tracks) in this directory");
+  sub->add_option("--materials", args->materials, "Materials file (JSON, see docs/materials.json) overriding the built-in table");
   sub->add_option("--restitution", args->restitution, "Override e (0, 1]");
   sub->add_option("--static-friction", args->static_friction, "Override mu_s");
   sub->add_option("--rolling-friction", args->rolling_friction, "Override mu_r");

@@ -48,8 +48,8 @@ MaterialTable default_material_table() {
   table.materials = {
       {"tuber", 5.0e6, 0.40, 1085.0,
        "density: the study (water displacement); E and nu: fresh potato-tuber tissue, Mohsenin (1986) "
-       "'Physical properties of plant and animal materials' (E 3-6 MPa, nu 0.45-0.49); nu 0.40 keeps E* finite as "
-       "DEM tuber calibrations do"},
+       "'Physical properties of plant and animal materials' (E 3-6 MPa); nu 0.40, the value DEM potato-tuber "
+       "models commonly take (tissue measurements give 0.45-0.49)"},
       {"Q235", 2.06e11, 0.30, 7850.0, "GB/T 700-2006 carbon structural steel Q235: E 206 GPa, nu 0.3, 7850 kg/m^3"},
       {"soil", 1.0e7, 0.38, 1350.0,
        "loose cultivated loam as used in agricultural DEM soil-bin calibrations: E 1-10 MPa, nu 0.3-0.4, bulk density "

@@ -77,3 +77,23 @@ TEST(CalibrateCli, BadInputIsAClearError) {
   }
 }
 }  // namespace clumpforge
+
+namespace clumpforge {
+TEST(MaterialsCli, ShippedFileIsTheBuiltInTableAndOverridesWork) {
+  const auto printed = test::run_clumpforge("materials");
+  ASSERT_EQ(printed.exit_code, 0) << printed.err;
+  EXPECT_EQ(printed.out, test::read_text(test::source_dir() / "docs" / "materials.json"));  // regenerate: clumpforge materials > docs/materials.json
+  test::ScratchDir dir("materials");
+  test::write_text(dir / "m.json", R"({"materials": [{"name": "rubber", "youngs_modulus_pa": 5e6, "poisson_ratio": 0.45, "density_kg_m3": 1100}],
+    "interactions": [{"a": "tuber", "b": "rubber", "restitution": 0.3, "static_friction": 0.9, "rolling_friction": 0.05}]})");
+  const std::string lib = (test::source_dir() / "clumps" / "tuber-default.h5").string();
+  const auto run = test::run_clumpforge(fmt::format("validate '{}' --clump lattice-4mm --test drop --surface rubber --trials 2 --materials '{}' --json",
+                                                    lib, (dir / "m.json").string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out)["restitution"], 0.3);
+  test::write_text(dir / "bad.json", R"({"materials": [{"name": "x", "youngs_modulus_pa": -1, "poisson_ratio": 0.3, "density_kg_m3": 1}]})");
+  const auto bad = test::run_clumpforge(fmt::format("materials --materials '{}'", (dir / "bad.json").string()));
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("bad.json"), std::string::npos);
+}
+}  // namespace clumpforge
