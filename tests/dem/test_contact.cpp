@@ -131,6 +131,65 @@ TEST(ChungOoi, Test6ImpactWithSpinGrossSlipChangesSpinByTheFrictionImpulse) {
   EXPECT_NEAR(got.velocity_after.x(), mu * (1 + rebound) * vn, 0.01 * mu * (1 + rebound) * vn);
 }
 
+TEST(ChungOoi, Test5ObliqueImpactGrossSlipRecoilAndSpin) {
+  // Steel, R 1e-5 m, V_n 5 m/s, mu 0.3, e 1; constant normal velocity, tangential velocity
+  // Psi1 = V_t / (mu V_n) above 3.5 (1 + e) = 7 (gross slip): the contact point recoils with
+  // V_t' / (mu V_n') = Psi1 - 3.5 (1 + e) and R omega' / (mu V_n) = -2.5 (1 + e) (within 2 %).
+  const Material steel{"steel", 208e9, 0.30, 7850, "Chung & Ooi 2011"};
+  const double r = 1e-5, vn = 5.0, mu = 0.3, e = 1.0;
+  for (double psi : {9.0, 12.0}) {
+    SCOPED_TRACE(psi);
+    World world = test::sphere_over_plane(steel, test::rigid_like(steel), {e, mu, 0.0}, r);
+    world.contact.limit_force = true;
+    world.bodies[0].position = {0, 0, r + 1e-12};
+    world.bodies[0].velocity = {psi * mu * vn, 0, -vn};
+    const auto theory = test::hertz_theory(world.bodies[0].mass, r, effective_youngs_modulus(steel, test::rigid_like(steel)), vn);
+    const auto got = run_impact(world, theory.duration / 1000.0, r);
+    // Friction towards -x spins the sphere about +y; its bottom point moves at v_x - R omega_y.
+    const double contact_point = got.velocity_after.x() - r * got.spin_after.y();
+    const double rebound = got.velocity_after.z();
+    EXPECT_NEAR(contact_point / (mu * rebound), psi - 3.5 * (1 + e), 0.02 * (psi - 3.5 * (1 + e)));
+    EXPECT_NEAR(r * got.spin_after.y() / (mu * vn), 2.5 * (1 + e), 0.02 * 2.5 * (1 + e));
+  }
+}
+
+TEST(ChungOoi, Test8SpinningSphereOnAMuchLargerSphere) {
+  // Al alloy, R 0.1 m at V_n 0.2 m/s with spin (R omega0 = V_n tan 80 deg) hitting a sphere
+  // five times larger and a thousand times denser (effectively fixed), mu 0.4, e 0.5: gross
+  // slip, so omega' = omega0 - 2.5 mu (1 + e') V_n / R as on a plane, e' measured (1 %).
+  const double r = 0.1, vn = 0.2, e = 0.5, mu = 0.4;
+  Material heavy = kAluminium;
+  heavy.name = "heavy Al";
+  heavy.density *= 1000;
+  World world;
+  const int al = add_material(world, kAluminium), big = add_material(world, heavy);
+  set_interaction(world, al, big, {e, mu, 0.0});
+  set_interaction(world, al, al, {e, mu, 0.0});
+  set_interaction(world, big, big, {e, mu, 0.0});
+  world.gravity.setZero();
+  world.contact.rolling = RollingModel::None;
+  world.contact.limit_force = true;
+  world.bodies = {make_sphere_body(r, kAluminium.density, al), make_sphere_body(5 * r, heavy.density, big)};
+  world.bodies[0].position = {0, 0, r + 1e-7};
+  world.bodies[1].position = {0, 0, -5 * r};
+  world.bodies[0].velocity = {0, 0, -vn};
+  const double omega0 = vn * std::tan(80.0 * kPi / 180.0) / r;
+  world.bodies[0].angular_momentum = world.bodies[0].inertia.x() * Eigen::Vector3d(0, omega0, 0);
+  const double m_star = world.bodies[0].mass * world.bodies[1].mass / (world.bodies[0].mass + world.bodies[1].mass);
+  const auto theory = test::hertz_theory(m_star, r * 5 * r / (6 * r), effective_youngs_modulus(kAluminium, heavy), vn);
+  ImpactRecord got;
+  bool touching = false;
+  for (int i = 0; i < 1'000'000; ++i) {
+    step(world, theory.duration / 1000.0);
+    const double overlap = 6 * r - (world.bodies[0].position - world.bodies[1].position).norm();
+    if (overlap > 0) touching = true;
+    if (touching && overlap <= 0) break;
+  }
+  const double rebound = (world.bodies[0].velocity.z() - world.bodies[1].velocity.z()) / vn;
+  const double expected = omega0 - 2.5 * mu * (1 + rebound) * vn / r;
+  EXPECT_NEAR(world.bodies[0].angular_velocity().y(), expected, 0.01 * expected);
+}
+
 TEST(ChungOoi, Test7OppositeSpinsMakeNoTangentialForce) {
   // Two identical spheres, equal and opposite spins about the same axis: their contact
   // points move together, so the spins and the tangential velocities stay as they were.
