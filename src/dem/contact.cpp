@@ -18,12 +18,6 @@ double effective_shear_modulus(const Material& a, const Material& b) {
                 2.0 * (2.0 - b.poisson_ratio) * (1.0 + b.poisson_ratio) / b.youngs_modulus);
 }
 
-double damping_beta(double restitution) {
-  if (restitution >= 1.0) return 0.0;
-  const double log_e = std::log(restitution);
-  return log_e / std::sqrt(log_e * log_e + std::numbers::pi * std::numbers::pi);
-}
-
 ContactOutput hertz_mindlin(const ContactInput& in, const ContactSettings& settings, ContactState& history) {
   ContactOutput out;
   const Eigen::Vector3d& n = in.normal;

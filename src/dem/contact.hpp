@@ -20,26 +20,6 @@ namespace clumpforge {
 double effective_youngs_modulus(const Material& a, const Material& b);
 /// 1/G* = 2(2 - nu_i)(1 + nu_i)/E_i + 2(2 - nu_j)(1 + nu_j)/E_j.
 double effective_shear_modulus(const Material& a, const Material& b);
-/// beta(e) = ln e / sqrt(ln^2 e + pi^2); 0 for e = 1.
-double damping_beta(double restitution);
-
-/// Everything one contact needs, already resolved.
-struct ContactInput {
-  Eigen::Vector3d normal;        ///< unit, from j towards i
-  double overlap = 0.0;          ///< dn > 0 [m]
-  Eigen::Vector3d relative_velocity;   ///< of i's contact point relative to j's [m/s]
-  Eigen::Vector3d relative_spin;       ///< omega_i - omega_j [rad/s]
-  double effective_radius = 0.0; ///< R* [m]
-  double effective_mass = 0.0;   ///< m* [kg]
-  double rolling_arm = 0.0;      ///< lever of the rolling torque [m]
-  double rolling_inertia = 0.0;  ///< I_r for the EPSD dashpot [kg m^2]
-  double youngs = 0.0;           ///< E* [Pa]
-  double shear = 0.0;            ///< G* [Pa]
-  double beta = 0.0;             ///< damping_beta(coefficients.restitution), precomputed per material pair
-  Interaction coefficients;
-  double dt = 0.0;               ///< [s]
-};
-
 struct ContactOutput {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();          ///< on i (j gets the opposite)
   Eigen::Vector3d rolling_torque = Eigen::Vector3d::Zero(); ///< on i (j gets the opposite)

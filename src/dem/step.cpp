@@ -42,6 +42,17 @@ double candidate_skin(const RigidBody& body) {
   return 0.5 * smallest;
 }
 
+// Records the contact's impact speed on its first step, then lets every contact-level
+// physics term adjust the contact's inputs.
+void adjust_by_terms(const World& world, ContactInput& in, ContactState& state) {
+  if (state.impact_speed < 0.0) state.impact_speed = std::max(0.0, -in.relative_velocity.dot(in.normal));
+  for (const auto& term : world.terms) {
+    std::visit([&](const auto& t) {
+      if constexpr (ContactTerm<std::decay_t<decltype(t)>>) adjust_contact(t, in, state);
+    }, term);
+  }
+}
+
 // E*, G* and beta of every material pair, once per force evaluation.
 struct PairConstants {
   double youngs = 0.0, shear = 0.0, beta = 0.0;
@@ -97,6 +108,7 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
   in.dt = dt;
   ContactState& state = world.history[wall_key(b, k, w)];
   state.last_step = world.steps;
+  adjust_by_terms(world, in, state);
   const ContactOutput out = hertz_mindlin(in, world.contact, state);
   world.force[b] += out.force;
   world.torque[b] += arm.cross(out.force) + out.rolling_torque;
@@ -138,6 +150,7 @@ void sphere_contacts(World& world, std::size_t bi, std::size_t bj, double dt, co
       in.dt = dt;
       ContactState& state = world.history[pair_key(bi, si, bj, sj)];
       state.last_step = world.steps;
+      adjust_by_terms(world, in, state);
       const ContactOutput out = hertz_mindlin(in, world.contact, state);
       world.force[bi] += out.force;
       world.torque[bi] += arm_i.cross(out.force) + out.rolling_torque;
@@ -188,9 +201,13 @@ void compute_forces(World& world, double dt) {
     const Eigen::Matrix3d rotation = body.orientation.toRotationMatrix();
     const BodyFrame frame{rotation, rotation * (rotation.transpose() * body.angular_momentum).cwiseQuotient(body.inertia)};
     for (const auto& term : world.terms) {
-      const TermLoad load = std::visit([&](const auto& t) { return apply(t, body.velocity, body.mass, world.materials[body.material].density); }, term);
-      world.force[b] += load.force;
-      world.torque[b] += load.torque;
+      std::visit([&](const auto& t) {
+        if constexpr (BodyTerm<std::decay_t<decltype(t)>>) {
+          const TermLoad load = apply(t, body.velocity, body.mass, world.materials[body.material].density);
+          world.force[b] += load.force;
+          world.torque[b] += load.torque;
+        }
+      }, term);
     }
     const double skin = candidate_skin(body);
     if (world.candidate_travel[b] > 0.5 * skin) refresh_candidates(world, b, skin);

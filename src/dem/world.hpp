@@ -6,6 +6,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "dem/contact_state.hpp"
 #include "dem/materials.hpp"
 #include "dem/terms/terms.hpp"
 #include "core/clump.hpp"
@@ -74,13 +75,6 @@ struct ContactSettings {
   /// EDEM's standard model (the convention of the study's mu_r values); LIGGGHTS uses the sphere radius.
   RollingArm rolling_arm = RollingArm::ContactToCentre;
   double rolling_damping = 0.3;      ///< eta_r of EPSD (Ai et al. suggest 0.3)
-};
-
-/// Contact history (tangential spring, rolling spring) of one sphere pair or sphere-wall pair.
-struct ContactState {
-  Eigen::Vector3d shear = Eigen::Vector3d::Zero();          ///< accumulated tangential displacement [m]
-  Eigen::Vector3d rolling_torque = Eigen::Vector3d::Zero(); ///< EPSD spring torque [N m]
-  std::uint64_t last_step = 0;
 };
 
 struct World {

@@ -188,3 +188,43 @@ TEST(TimeStep, EstimatesAndRefusalOfTooLargeSteps) {
 }
 
 }  // namespace clumpforge
+
+namespace clumpforge {
+
+TEST(PhysicsTerms, ViscoelasticRestitutionFollowsTheImpactSpeed) {
+  // e(v) = 1 - (1 - e_ref) (v / v_ref)^(1/5): e_ref at v_ref, higher for slower impacts (1 %).
+  const double r = 5e-3, e_ref = 0.6, v_ref = 2.0;
+  for (double speed : {2.0, 0.5}) {
+    SCOPED_TRACE(speed);
+    World world = test::sphere_over_plane(kSoft, kSteel, {e_ref, 0.0, 0.0}, r);
+    world.terms.push_back(ViscoelasticRestitution{v_ref});
+    world.bodies[0].position = {0, 0, r + 1e-7};
+    world.bodies[0].velocity = {0, 0, -speed};
+    const double dt = contact_time(world, speed) / 1000.0;
+    bool touched = false;
+    for (int i = 0; i < 10'000'000; ++i) {
+      step(world, dt);
+      const bool touching = world.bodies[0].position.z() < r;
+      if (touching) touched = true;
+      if (touched && !touching) break;
+    }
+    const double expected = 1.0 - (1.0 - e_ref) * std::pow(speed / v_ref, 0.2);
+    EXPECT_NEAR(world.bodies[0].velocity.z() / speed, expected, 0.01 * expected);
+  }
+}
+
+TEST(PhysicsTerms, QuadraticDragGivesTheTerminalSpeed) {
+  // m g = 1/2 rho C_d A v_t^2 at terminal speed (within 0.5 %).
+  World world;
+  world.gravity = {0, 0, -kG};
+  add_material(world, kSoft);
+  world.bodies.push_back(make_sphere_body(5e-3, 1000, 0));
+  const QuadraticAirDrag drag;
+  world.terms.push_back(drag);
+  for (int i = 0; i < 200000; ++i) step(world, 1e-4);  // 20 s: long past the transient
+  const double area = kPi * 25e-6;
+  const double terminal = std::sqrt(2 * world.bodies[0].mass * kG / (drag.air_density * drag.drag_coefficient * area));
+  EXPECT_NEAR(-world.bodies[0].velocity.z(), terminal, 0.005 * terminal);
+}
+
+}  // namespace clumpforge

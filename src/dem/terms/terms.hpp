@@ -1,12 +1,22 @@
 #pragma once
-/// Extra physics as small pluggable terms. A new term is one new header in this folder
-/// (a struct with its parameters and an `apply` overload) and one line in `PhysicsTerm`.
+/// Extra physics as small pluggable terms. A new term is one new header in this folder (a
+/// struct with its parameters and one or both hooks below) and one line in `PhysicsTerm`:
+///   TermLoad apply(const T&, const Eigen::Vector3d& velocity, double mass, double density);
+///       a force and torque on each body (e.g. air drag);
+///   void adjust_contact(const T&, ContactInput&, const ContactState&);
+///       changes a contact's inputs before the contact law (e.g. speed-dependent restitution).
 #include <variant>
 
 #include "dem/terms/air_drag.hpp"
+#include "dem/terms/viscoelastic_restitution.hpp"
 
 namespace clumpforge {
 
-using PhysicsTerm = std::variant<QuadraticAirDrag>;
+using PhysicsTerm = std::variant<QuadraticAirDrag, ViscoelasticRestitution>;
+
+template <class T>
+concept BodyTerm = requires(const T& t, const Eigen::Vector3d& v) { apply(t, v, 1.0, 1.0); };
+template <class T>
+concept ContactTerm = requires(const T& t, ContactInput& in, const ContactState& s) { adjust_contact(t, in, s); };
 
 }  // namespace clumpforge
