@@ -61,7 +61,7 @@ int run_repair(const RepairArgs& args) {
   if (!repaired) {
     return report_error(kCommand, Error{repaired.error().code, fmt::format("'{}': {}", args.input, repaired.error().message)});
   }
-  const MeshStats after = analyze_mesh(repaired->soup);
+  const MeshStats& after = repaired->after;
   if (auto ok = write_mesh(args.output, repaired->soup, *unit); !ok) return report_error(kCommand, ok.error());
 
   if (args.json) {

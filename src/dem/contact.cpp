@@ -31,7 +31,6 @@ ContactOutput hertz_mindlin(const ContactInput& in, const ContactSettings& setti
   const double elastic_normal = kn * in.overlap;
   double fn = elastic_normal - gamma_n * vn;
   if (settings.limit_force) fn = std::max(fn, 0.0);
-  out.normal_force = fn;
 
   // Tangential spring with history, kept in the tangent plane (LIGGGHTS "history").
   const Eigen::Vector3d vt = in.relative_velocity - vn * n;

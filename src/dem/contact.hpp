@@ -23,7 +23,6 @@ double effective_shear_modulus(const Material& a, const Material& b);
 struct ContactOutput {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();          ///< on i (j gets the opposite)
   Eigen::Vector3d rolling_torque = Eigen::Vector3d::Zero(); ///< on i (j gets the opposite)
-  double normal_force = 0.0;                                 ///< signed Fn [N]
 };
 
 /// One contact's forces; updates its history (tangential spring, rolling spring).

@@ -205,10 +205,7 @@ RigidBody four_square_body(const Clump& clump, int material) {
     }
   }
   body.inertia = inertia.diagonal();  // symmetric arrangement: still principal
-  for (const auto& s : body.spheres) {
-    body.reach.push_back(s.centre.norm() + s.radius);
-    body.bounding_radius = std::max(body.bounding_radius, body.reach.back());
-  }
+  update_bounding_radius(body);
   return body;
 }
 

@@ -13,16 +13,10 @@ double RigidBody::kinetic_energy() const {
   return 0.5 * mass * velocity.squaredNorm() + 0.5 * angular_momentum.dot(angular_velocity());
 }
 
-namespace {
-void finish(RigidBody& body) {
-  body.reach.clear();
+void update_bounding_radius(RigidBody& body) {
   body.bounding_radius = 0.0;
-  for (const auto& s : body.spheres) {
-    body.reach.push_back(s.centre.norm() + s.radius);
-    body.bounding_radius = std::max(body.bounding_radius, body.reach.back());
-  }
+  for (const auto& s : body.spheres) body.bounding_radius = std::max(body.bounding_radius, s.centre.norm() + s.radius);
 }
-}  // namespace
 
 RigidBody make_body(const Clump& clump, int material) {
   RigidBody body;
@@ -30,7 +24,7 @@ RigidBody make_body(const Clump& clump, int material) {
   body.mass = clump.mass;
   body.inertia = clump.principal_moments;
   body.material = material;
-  finish(body);
+  update_bounding_radius(body);
   return body;
 }
 
@@ -40,7 +34,7 @@ RigidBody make_sphere_body(double radius, double density, int material) {
   body.mass = density * 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
   body.inertia = Eigen::Vector3d::Constant(0.4 * body.mass * radius * radius);
   body.material = material;
-  finish(body);
+  update_bounding_radius(body);
   return body;
 }
 

@@ -25,7 +25,6 @@ struct RigidBody {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< body -> world
   Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();   ///< world frame [kg m^2/s]
   double bounding_radius = 0.0;                                 ///< max |centre| + radius [m]
-  std::vector<double> reach;                                    ///< per sphere: |centre| + radius [m]
 
   Eigen::Vector3d angular_velocity() const;                     ///< world frame [rad/s]
   Eigen::Vector3d sphere_position(std::size_t k) const { return position + orientation * spheres[k].centre; }
@@ -34,6 +33,8 @@ struct RigidBody {
 
 /// Makes a body from a clump (its spheres, the clump's corrected mass and principal moments).
 RigidBody make_body(const Clump& clump, int material);
+/// Sets `bounding_radius` from the spheres (after changing them).
+void update_bounding_radius(RigidBody& body);
 /// A one-sphere body (for analytic benchmarks): solid sphere of `radius` and `density`.
 RigidBody make_sphere_body(double radius, double density, int material);
 

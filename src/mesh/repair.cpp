@@ -291,9 +291,12 @@ Result<RepairResult> repair_mesh(TriangleSoup soup, const RepairOptions& options
   if (!stats) return std::unexpected(stats.error());
   // Outer shells outwards, cavities inwards, now that the surface is closed and clean. A
   // single closed component with positive volume already is (check_result saw to that).
+  result.after = *stats;
   if (stats->components > 1) {
     if (auto ok = detail::orient_outward_closed(soup); !ok) return std::unexpected(ok.error());
+    result.after = analyze_topology(soup);  // cavities turned inwards change the signed volume
   }
+  result.after.self_intersecting_pairs = 0;  // the self-intersection step ends only at none
   context.report("done", 1.0);
   result.soup = std::move(soup);
   return result;

@@ -32,6 +32,7 @@ struct RepairStep {
 
 struct RepairResult {
   TriangleSoup soup;               ///< the repaired body [m]
+  MeshStats after;                 ///< its statistics (self-intersections counted: 0)
   std::vector<RepairStep> steps;   ///< in the order they ran
   std::vector<Diagnostic> notes;
 };

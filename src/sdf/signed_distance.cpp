@@ -38,28 +38,6 @@ void SignedDistance::distances(std::span<const Eigen::Vector3d> points, std::spa
   }
 }
 
-std::vector<InteriorSample> SignedDistance::interior_samples() const {
-  std::vector<InteriorSample> samples;
-  const auto& transform = impl_->grid->transform();
-  for (auto it = impl_->grid->cbeginValueOn(); it; ++it) {
-    const float value = *it;
-    if (value >= 0.0f) continue;
-    if (it.isVoxelValue()) {
-      const openvdb::Vec3d p = transform.indexToWorld(it.getCoord());
-      samples.push_back({{p.x(), p.y(), p.z()}, -static_cast<double>(value)});
-    } else {
-      // A constant interior tile: every voxel in it has the tile's value.
-      openvdb::CoordBBox box;
-      it.getBoundingBox(box);
-      for (auto c = box.begin(); c; ++c) {
-        const openvdb::Vec3d p = transform.indexToWorld(*c);
-        samples.push_back({{p.x(), p.y(), p.z()}, -static_cast<double>(value)});
-      }
-    }
-  }
-  return samples;
-}
-
 double resolve_voxel_size(const SdfOptions& options) {
   return options.voxel_size > 0.0 ? options.voxel_size : options.feature_size / options.voxels_per_feature;
 }

@@ -22,12 +22,6 @@ struct SdfOptions {
   double exterior_band_voxels = 3.0;
 };
 
-/// An interior voxel centre and its distance to the surface.
-struct InteriorSample {
-  Eigen::Vector3d position;  ///< [m]
-  double depth = 0.0;        ///< [m], > 0: radius of the largest sphere centred here inside the body
-};
-
 /// Signed distance field: negative inside, positive outside [m]. Cheap to copy (shared grid).
 class SignedDistance {
  public:
@@ -42,8 +36,6 @@ class SignedDistance {
   double distance(const Eigen::Vector3d& p) const;
   /// Samples many points at once (each `out[i]` for `points[i]`).
   void distances(std::span<const Eigen::Vector3d> points, std::span<double> out) const;
-  /// Every interior voxel centre with its depth.
-  std::vector<InteriorSample> interior_samples() const;
 
   struct Impl;
   explicit SignedDistance(std::shared_ptr<const Impl> impl);

@@ -102,8 +102,7 @@ TEST(Dynamics, FlatBlockSlipsAboveTheFrictionAngleOnly) {
     for (int i = -1; i <= 1; ++i) {
       for (int j = -1; j <= 1; ++j) block.spheres.push_back({{2 * r * i, 2 * r * j, 0}, r});
     }
-    block.reach.assign(9, 0.0);
-    block.bounding_radius = 2 * std::sqrt(2.0) * r + r;
+    update_bounding_radius(block);
     block.mass *= 9;
     block.inertia = Eigen::Vector3d(6 * block.mass * r * r * 4 / 9, 6 * block.mass * r * r * 4 / 9, 12 * block.mass * r * r * 4 / 9);
     tilt_floor(world, degrees);

@@ -54,6 +54,10 @@ TEST(BundledScans, EachIsDamagedAndRepairsToItsReference) {
     const auto repaired = repair_mesh(loaded->soup);
     ASSERT_TRUE(repaired) << repaired.error().message;
     const MeshStats after = analyze_mesh(repaired->soup);
+    // What repair reports about its result is what a fresh analysis finds.
+    EXPECT_EQ(repaired->after.faces, after.faces);
+    EXPECT_EQ(repaired->after.self_intersecting_pairs, after.self_intersecting_pairs);
+    EXPECT_DOUBLE_EQ(repaired->after.volume, after.volume);
     EXPECT_TRUE(after.closed);
     EXPECT_EQ(after.components, 1);
     EXPECT_EQ(after.self_intersecting_pairs, 0);
