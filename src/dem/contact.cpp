@@ -31,15 +31,18 @@ ContactOutput hertz_mindlin(const ContactInput& in, const ContactSettings& setti
   const double elastic_normal = kn * in.overlap;
   double fn = elastic_normal - gamma_n * vn;
   if (settings.limit_force) fn = std::max(fn, 0.0);
+  const double fn_total = fn - in.adhesion;  // adhesion pulls; friction and rolling still bear on the contact load fn
 
   // Tangential spring with history, kept in the tangent plane (LIGGGHTS "history").
   const Eigen::Vector3d vt = in.relative_velocity - vn * n;
   history.shear += vt * in.dt;
   history.shear -= history.shear.dot(n) * n;
   Eigen::Vector3d ft = -st * history.shear;
-  const double ft_limit = in.coefficients.static_friction * std::abs(fn);
+  const double friction = history.sliding && in.kinetic_friction >= 0.0 ? in.kinetic_friction : in.coefficients.static_friction;
+  const double ft_limit = friction * std::abs(fn);
   const double ft_magnitude = ft.norm();
-  if (ft_magnitude > ft_limit) {
+  history.sliding = ft_magnitude > ft_limit;
+  if (history.sliding) {
     // Sliding: Coulomb limit, spring reset to match, no tangential dashpot.
     ft *= ft_limit / ft_magnitude;
     history.shear = st > 0.0 ? Eigen::Vector3d(-ft / st) : Eigen::Vector3d::Zero();
@@ -49,21 +52,21 @@ ContactOutput hertz_mindlin(const ContactInput& in, const ContactSettings& setti
     const double total = ft.norm();
     if (settings.coulomb_on_total && total > ft_limit) ft *= ft_limit / total;
   }
-  out.force = fn * n + ft;
+  out.force = fn_total * n + ft;
 
   // Rolling resistance on the relative rolling velocity (torsion removed).
   const double mu_r = in.coefficients.rolling_friction;
-  if (settings.rolling == RollingModel::None || mu_r <= 0.0) return out;
+  if (in.rolling == RollingModel::None || mu_r <= 0.0) return out;
   Eigen::Vector3d w_r = in.relative_spin - in.relative_spin.dot(n) * n;
   const double w_magnitude = w_r.norm();
-  if (settings.rolling == RollingModel::ConstantTorque) {
+  if (in.rolling == RollingModel::ConstantTorque) {
     if (w_magnitude > 1e-12) out.rolling_torque = -mu_r * elastic_normal * in.rolling_arm * w_r / w_magnitude;
     return out;
   }
   // EPSD (Ai et al. type C; LIGGGHTS epsd): k_r = 2.25 kn mu_r^2 R^2, limit mu_r R |Fn|,
   // dashpot C_r = eta_r 2 sqrt(I_r k_r) while below the limit.
   const double arm = in.rolling_arm;
-  const double k_r = 2.25 * kn * mu_r * mu_r * arm * arm;
+  const double k_r = 2.25 * kn * mu_r * mu_r * arm * arm * in.rolling_stiffness_scale;
   history.rolling_torque += k_r * w_r * in.dt;
   history.rolling_torque -= history.rolling_torque.dot(n) * n;
   const double limit = mu_r * arm * std::abs(fn);

@@ -9,11 +9,19 @@
 
 namespace clumpforge {
 
+enum class RollingModel {
+  None,
+  ConstantTorque,  ///< EDEM standard / Ai et al. type A / LIGGGHTS `cdt`: mu_r Fn R opposing omega
+  Epsd,            ///< Ai et al. type C, LIGGGHTS `epsd`: elastic-plastic spring-dashpot
+};
+
 /// Contact history (tangential spring, rolling spring) of one sphere pair or sphere-wall pair.
 struct ContactState {
   Eigen::Vector3d shear = Eigen::Vector3d::Zero();          ///< accumulated tangential displacement [m]
   Eigen::Vector3d rolling_torque = Eigen::Vector3d::Zero(); ///< EPSD spring torque [N m]
   double impact_speed = -1.0;                               ///< normal approach speed when the contact began [m/s]
+  double max_overlap = 0.0;                                 ///< largest overlap so far [m] (plastic terms)
+  bool sliding = false;                                     ///< gross slip at the last step (kinetic friction)
   std::uint64_t last_step = 0;
 };
 
@@ -31,6 +39,10 @@ struct ContactInput {
   double shear = 0.0;            ///< G* [Pa]
   double beta = 0.0;             ///< damping_beta(coefficients.restitution), precomputed per material pair
   Interaction coefficients;
+  double kinetic_friction = -1.0;  ///< friction limit while sliding; < 0 = the static coefficient
+  double adhesion = 0.0;           ///< attractive normal force while touching [N], >= 0
+  RollingModel rolling = RollingModel::ConstantTorque;  ///< the settings' model unless a term changes it
+  double rolling_stiffness_scale = 1.0;  ///< EPSD: multiplies k_r
   double dt = 0.0;               ///< [s]
 };
 

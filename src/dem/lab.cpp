@@ -37,14 +37,15 @@ double rotational_energy(const RigidBody& b) { return 0.5 * b.angular_momentum.d
 
 class TrackSampler {
  public:
-  explicit TrackSampler(double frame_rate) : interval_(1.0 / frame_rate) {}
+  TrackSampler(double frame_rate, const Eigen::Vector3d& tracked_point) : interval_(1.0 / frame_rate), point_(tracked_point) {}
   void sample(const World& world, double tilt_deg = std::numeric_limits<double>::quiet_NaN()) {
     if (world.time + 1e-12 < next_) return;
     next_ += interval_;
     const RigidBody& b = world.bodies[0];
+    const Eigen::Vector3d p = b.position + b.orientation * point_;
     track_.t.push_back(world.time);
-    track_.x.push_back(b.position.x());
-    track_.z.push_back(b.position.z());
+    track_.x.push_back(p.x());
+    track_.z.push_back(p.z());
     const Eigen::Vector3d axis = b.orientation * Eigen::Vector3d::UnitX();
     track_.angle.push_back(std::atan2(axis.z(), axis.x()));  // in-plane rotation of the body's x axis
     if (!std::isnan(tilt_deg)) track_.tilt.push_back(tilt_deg);
@@ -53,19 +54,52 @@ class TrackSampler {
 
  private:
   double interval_;
+  Eigen::Vector3d point_;
   double next_ = 0.0;
   Track track_;
 };
 
 bool any_wall_contact(const World& world) { return !world.history.empty(); }
 
+// Drop: lowest point `H` above the plate, at rest.
+void place_drop(RigidBody& body, const Recording& setup, const Eigen::Quaterniond& q) {
+  body.orientation = q;
+  body.position = {0, 0, setup.release_height - lowest_offset(body, q, Eigen::Vector3d::UnitZ())};
+}
+
+// Roll: the lowest sphere along the incline normal touches the incline `L` up the slope.
+void place_roll(RigidBody& body, const Recording& setup, const Eigen::Quaterniond& q) {
+  const double beta = setup.incline_deg * kPi / 180.0;
+  const Eigen::Vector3d normal(std::sin(beta), 0, std::cos(beta));  // incline surface z = -x tan(beta), x < 0
+  const Eigen::Vector3d downhill(std::cos(beta), 0, -std::sin(beta));
+  body.orientation = q;
+  std::size_t touching = 0;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < body.spheres.size(); ++k) {
+    const double h = (q * body.spheres[k].centre).dot(normal) - body.spheres[k].radius;
+    if (h < lowest) {
+      lowest = h;
+      touching = k;
+    }
+  }
+  const Eigen::Vector3d contact_point = -setup.start_distance * downhill;
+  const Eigen::Vector3d sphere_centre = contact_point + (body.spheres[touching].radius + 1e-7) * normal;
+  body.position = sphere_centre - q * body.spheres[touching].centre;
+}
+
+// Tilt: resting on the level plate.
+void place_tilt(RigidBody& body, const Eigen::Quaterniond& q) {
+  body.orientation = q;
+  body.position = {0, 0, 1e-7 - lowest_offset(body, q, Eigen::Vector3d::UnitZ())};
+}
+
 // Drop: released from rest with its lowest point `H` above the plate; the summary is the
 // apex of the first rebound, measured as the rise of the lowest point above the plate.
-TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& options, double dt, Rng& rng) {
+TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked, double dt,
+                        Rng& rng) {
   RigidBody& body = world.bodies[0];
-  body.orientation = random_orientation(rng);
-  body.position = {0, 0, setup.release_height - lowest_offset(body, body.orientation, Eigen::Vector3d::UnitZ())};
-  TrackSampler sampler(options.frame_rate_hz);
+  place_drop(body, setup, random_orientation(rng));
+  TrackSampler sampler(options.frame_rate_hz, tracked);
   TrialOutcome out;
   out.orientation = body.orientation;
   bool impacted = false, airborne_after = false;
@@ -105,27 +139,11 @@ TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& o
 
 // Roll: released from rest on the incline with its contact point `L` up the slope from the
 // foot; the summary is the horizontal distance on the flat from the foot where it stops.
-TrialOutcome roll_trial(World world, const Recording& setup, const LabOptions& options, double dt, Rng& rng) {
+TrialOutcome roll_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked, double dt,
+                        Rng& rng) {
   RigidBody& body = world.bodies[0];
-  const double beta = setup.incline_deg * kPi / 180.0;
-  const Eigen::Vector3d normal(std::sin(beta), 0, std::cos(beta));       // incline surface z = -x tan(beta), x < 0
-  const Eigen::Vector3d downhill(std::cos(beta), 0, -std::sin(beta));
-  body.orientation = random_orientation(rng);
-  // Lowest sphere along the incline normal touches the incline at the start point.
-  std::size_t touching = 0;
-  double lowest = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < body.spheres.size(); ++k) {
-    const double h = (body.orientation * body.spheres[k].centre).dot(normal) - body.spheres[k].radius;
-    if (h < lowest) {
-      lowest = h;
-      touching = k;
-    }
-  }
-  const Eigen::Vector3d contact_point = -setup.start_distance * downhill;
-  const Eigen::Vector3d sphere_offset = body.orientation * body.spheres[touching].centre;
-  const Eigen::Vector3d sphere_centre = contact_point + (body.spheres[touching].radius + 1e-7) * normal;
-  body.position = sphere_centre - sphere_offset;
-  TrackSampler sampler(options.frame_rate_hz);
+  place_roll(body, setup, random_orientation(rng));
+  TrackSampler sampler(options.frame_rate_hz, tracked);
   TrialOutcome out;
   out.orientation = body.orientation;
   double still_since = -1.0;
@@ -149,14 +167,14 @@ TrialOutcome roll_trial(World world, const Recording& setup, const LabOptions& o
 
 // Tilt: resting flat on a plate tilted at a steady rate about y; the summary is the plate
 // angle at which sliding starts (1 mm of motion along the plate); 90 when it never slid by 89.
-TrialOutcome tilt_trial(World world, const Recording& setup, const LabOptions& options, double dt, Rng& rng) {
+TrialOutcome tilt_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked, double dt,
+                        Rng& rng) {
   RigidBody& body = world.bodies[0];
   const double yaw = rng.uniform(0.0, 2.0 * kPi);
-  body.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
-  body.position = {0, 0, 1e-7 - lowest_offset(body, body.orientation, Eigen::Vector3d::UnitZ())};
+  place_tilt(body, Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
   TrialOutcome out;
   out.orientation = body.orientation;
-  TrackSampler sampler(options.frame_rate_hz);
+  TrackSampler sampler(options.frame_rate_hz, tracked);
   const double rate = (setup.tilt_rate_deg_per_s ? *setup.tilt_rate_deg_per_s : options.tilt_rate_deg_per_s) * kPi / 180.0;
   Wall& plate = world.walls[0];
   // Settle, then tilt.
@@ -209,9 +227,7 @@ RigidBody four_square_body(const Clump& clump, int material) {
   return body;
 }
 
-Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, const Recording& setup,
-                               const LabOptions& options, const RunContext& context) {
-  if (options.trials < 1) return fail(ErrorCode::InvalidArgument, "the number of trials must be at least 1");
+Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, const Recording& setup, const LabOptions& options) {
   if (clump.spheres.empty() || !(clump.mass > 0.0)) return fail(ErrorCode::InvalidArgument, "the clump has no spheres or no mass");
   auto particle = table.find(options.particle_material);
   if (!particle) return std::unexpected(particle.error());
@@ -228,7 +244,8 @@ Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, c
   if (auto ok = validate_interaction(interaction, fmt::format("{} on {}", options.particle_material, setup.surface)); !ok) {
     return std::unexpected(ok.error());
   }
-  World world;
+  LabWorld lab;
+  World& world = lab.world;
   const int p = add_material(world, **particle);
   const int s = add_material(world, **surface);
   set_interaction(world, p, s, interaction);
@@ -236,8 +253,13 @@ Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, c
   set_interaction(world, s, s, interaction);
   world.contact = options.contact;
   world.terms = options.terms;
-  world.bodies.push_back(setup.test == LabTest::Tilt && setup.composite == Composite::FourSquare ? four_square_body(clump, p)
-                                                                                                  : make_body(clump, p));
+  RigidBody body = setup.test == LabTest::Tilt && setup.composite == Composite::FourSquare ? four_square_body(clump, p) : make_body(clump, p);
+  if (!options.com_offset.isZero()) {
+    for (auto& sphere : body.spheres) sphere.centre -= options.com_offset;
+    update_bounding_radius(body);
+    lab.tracked_point = -options.com_offset;
+  }
+  world.bodies.push_back(std::move(body));
   Wall floor;
   floor.material = s;
   if (setup.test == LabTest::Roll) {
@@ -259,20 +281,79 @@ Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, c
                               : setup.test == LabTest::Roll
                                   ? std::sqrt(2 * 9.81 * setup.start_distance * std::sin(setup.incline_deg * kPi / 180.0)) + 0.2
                                   : 0.1;
+  lab.estimate = estimate_time_step(world, impact_speed);
+  lab.time_step = options.time_step.value_or(lab.estimate.chosen);
+  if (auto ok = check_time_step(lab.time_step, lab.estimate); !ok) return std::unexpected(ok.error());
+  lab.interaction = interaction;
+  return lab;
+}
+
+std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& setup, const Eigen::Quaterniond& orientation,
+                                       const LabOptions& options, const ReplayOptions& replay) {
+  World world = lab.world;
+  RigidBody& body = world.bodies[0];
+  const double dt = lab.time_step;
+  switch (setup.test) {
+    case LabTest::Drop: place_drop(body, setup, orientation); break;
+    case LabTest::Roll: place_roll(body, setup, orientation); break;
+    case LabTest::Tilt: place_tilt(body, orientation); break;
+  }
+  double origin = 0.0, rate = 0.0;
+  if (setup.test == LabTest::Tilt) {
+    while (world.time < replay.settle) step(world, dt);
+    rate = (setup.tilt_rate_deg_per_s ? *setup.tilt_rate_deg_per_s : options.tilt_rate_deg_per_s) * kPi / 180.0;
+    world.walls[0].spin = {0, -rate, 0};
+    origin = world.time;
+  }
+  std::vector<ReplaySample> samples;
+  samples.reserve(static_cast<std::size_t>(replay.duration / replay.sample_interval) + 2);
+  double next = origin;
+  const double end = origin + replay.duration;
+  for (;;) {
+    if (world.time + 1e-12 >= next) {
+      const RigidBody& b = world.bodies[0];
+      ReplaySample sample;
+      sample.t = world.time - origin;
+      const Eigen::Vector3d p = b.position + b.orientation * lab.tracked_point;
+      sample.x = p.x();
+      sample.z = p.z();
+      const Eigen::Vector3d axis = b.orientation * Eigen::Vector3d::UnitX();
+      sample.angle = std::atan2(axis.z(), axis.x());
+      sample.tilt_deg = rate * (world.time - origin) * 180.0 / kPi;
+      sample.speed = b.velocity.norm();
+      sample.contacts = static_cast<int>(world.history.size());
+      for (const auto& entry : world.history) {
+        if ((entry.first >> 63) == 0) sample.wall = std::max(sample.wall, static_cast<int>(entry.first & 0xFFF));  // wall contacts
+      }
+      samples.push_back(sample);
+      next += replay.sample_interval;
+    }
+    if (world.time >= end) break;
+    step(world, dt);
+  }
+  return samples;
+}
+
+Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, const Recording& setup,
+                               const LabOptions& options, const RunContext& context) {
+  if (options.trials < 1) return fail(ErrorCode::InvalidArgument, "the number of trials must be at least 1");
+  auto made = make_lab_world(clump, table, setup, options);
+  if (!made) return std::unexpected(made.error());
+  const World& world = made->world;
   LabResult result;
-  result.estimate = estimate_time_step(world, impact_speed);
-  result.time_step = options.time_step.value_or(result.estimate.chosen);
-  if (auto ok = check_time_step(result.time_step, result.estimate); !ok) return std::unexpected(ok.error());
-  result.interaction = interaction;
+  result.estimate = made->estimate;
+  result.time_step = made->time_step;
+  result.interaction = made->interaction;
+  const Eigen::Vector3d tracked = made->tracked_point;
 
   std::vector<TrialOutcome> outcomes(static_cast<std::size_t>(options.trials));
   std::atomic<int> done{0};
   tbb::parallel_for(0, options.trials, [&](int i) {
     Rng rng(options.seed, static_cast<std::uint64_t>(i));
     switch (setup.test) {
-      case LabTest::Drop: outcomes[i] = drop_trial(world, setup, options, result.time_step, rng); break;
-      case LabTest::Roll: outcomes[i] = roll_trial(world, setup, options, result.time_step, rng); break;
-      case LabTest::Tilt: outcomes[i] = tilt_trial(world, setup, options, result.time_step, rng); break;
+      case LabTest::Drop: outcomes[i] = drop_trial(world, setup, options, tracked, result.time_step, rng); break;
+      case LabTest::Roll: outcomes[i] = roll_trial(world, setup, options, tracked, result.time_step, rng); break;
+      case LabTest::Tilt: outcomes[i] = tilt_trial(world, setup, options, tracked, result.time_step, rng); break;
     }
     context.report(fmt::format("{} trials", to_string(setup.test)), static_cast<double>(++done) / options.trials);
   });

@@ -24,6 +24,9 @@ struct LabOptions {
   double max_time = 6.0;            ///< [s] simulated time limit of a drop or roll trial (a tilt runs to 89 deg)
   std::string particle_material = "tuber";
   std::vector<PhysicsTerm> terms;   ///< extra physics
+  /// Centre of mass relative to the visible centroid, in the clump's body frame [m]: a
+  /// non-uniform density. The spheres (the shape) move by -offset; tracks follow the shape.
+  Eigen::Vector3d com_offset = Eigen::Vector3d::Zero();
 };
 
 /// What a drop trial's impact did, to explain a rebound (drop tests only).
@@ -43,6 +46,38 @@ struct LabResult {
   double time_step = 0.0;           ///< [s]
   std::uint64_t steps = 0;          ///< over all trials
 };
+
+/// A test's world ready for trials: the particle, the plate(s), materials and the time step.
+struct LabWorld {
+  World world;                    ///< the particle is bodies[0], not yet placed
+  Eigen::Vector3d tracked_point = Eigen::Vector3d::Zero();  ///< visible centroid, body frame [m]
+  Interaction interaction;
+  TimeStepEstimate estimate;
+  double time_step = 0.0;         ///< [s]
+};
+Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, const Recording& setup, const LabOptions& options);
+
+/// One dense sample of a replayed trial (the tracked point, not the centre of mass).
+struct ReplaySample {
+  double t = 0.0;          ///< [s] since release (tilt: since the plate started turning)
+  double x = 0.0, z = 0.0; ///< tracked point [m]
+  double angle = 0.0;      ///< in-plane angle of the body's x axis [rad]
+  double tilt_deg = 0.0;   ///< plate angle (tilt)
+  double speed = 0.0;      ///< centre-of-mass speed [m/s]
+  int contacts = 0;        ///< sphere-wall contacts
+  int wall = -1;           ///< the wall touched (roll: 0 incline, 1 flat), -1 none
+};
+
+struct ReplayOptions {
+  double duration = 1.0;         ///< [s] simulated after release
+  double sample_interval = 1e-4; ///< [s]
+  double settle = 0.05;          ///< tilt: settling before the plate turns [s]
+};
+
+/// Runs one trial of `setup` from the given initial orientation (the body placed as the
+/// test places it) and returns the tracked point every `sample_interval`.
+std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& setup, const Eigen::Quaterniond& orientation,
+                                       const LabOptions& options, const ReplayOptions& replay);
 
 /// Runs `options.trials` trials of `setup`'s test (its test, surface and set-up fields)
 /// with `clump` as the particle. Fails for an unknown surface or particle material, bad

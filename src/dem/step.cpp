@@ -46,6 +46,8 @@ double candidate_skin(const RigidBody& body) {
 // physics term adjust the contact's inputs.
 void adjust_by_terms(const World& world, ContactInput& in, ContactState& state) {
   if (state.impact_speed < 0.0) state.impact_speed = std::max(0.0, -in.relative_velocity.dot(in.normal));
+  state.max_overlap = std::max(state.max_overlap, in.overlap);
+  in.rolling = world.contact.rolling;
   for (const auto& term : world.terms) {
     std::visit([&](const auto& t) {
       if constexpr (ContactTerm<std::decay_t<decltype(t)>>) adjust_contact(t, in, state);

@@ -54,11 +54,6 @@ struct Wall {
   Eigen::Vector3d velocity_at(const Eigen::Vector3d& p) const { return spin.cross(p - pivot); }
 };
 
-enum class RollingModel {
-  None,
-  ConstantTorque,  ///< EDEM standard / Ai et al. type A / LIGGGHTS `cdt`: mu_r Fn R opposing omega
-  Epsd,            ///< Ai et al. type C, LIGGGHTS `epsd`: elastic-plastic spring-dashpot
-};
 /// The lever arm of the rolling torque.
 enum class RollingArm {
   SphereRadius,     ///< LIGGGHTS: the element sphere's radius
