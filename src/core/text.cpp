@@ -28,18 +28,25 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
   return row[b.size()];
 }
 
-std::string did_you_mean(std::string_view input, std::initializer_list<std::string_view> candidates) {
+namespace {
+template <class Range>
+std::string closest(std::string_view input, const Range& candidates) {
   std::string_view best;
   std::size_t best_distance = 3;
-  for (const auto candidate : candidates) {
+  for (const auto& candidate : candidates) {
     const std::size_t distance = edit_distance(input, candidate);
     if (distance < best_distance) {
       best_distance = distance;
-      best = candidate;
+      best = std::string_view(candidate);
     }
   }
   if (best.empty() || best == input) return {};
   return " (did you mean '" + std::string(best) + "'?)";
 }
+
+}  // namespace
+
+std::string did_you_mean(std::string_view input, std::initializer_list<std::string_view> candidates) { return closest(input, candidates); }
+std::string did_you_mean(std::string_view input, std::span<const std::string> candidates) { return closest(input, candidates); }
 
 }  // namespace clumpforge

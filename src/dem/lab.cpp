@@ -307,10 +307,10 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
   }
   std::vector<ReplaySample> samples;
   samples.reserve(static_cast<std::size_t>(replay.duration / replay.sample_interval) + 2);
-  double next = origin;
+  double next = origin, slid_at = -1.0, rest_since = -1.0;
   const double end = origin + replay.duration;
   for (;;) {
-    if (world.time + 1e-12 >= next) {
+    if (world.time + 1e-12 >= next && (samples.empty() || world.time - origin + 1e-12 >= replay.record_from)) {
       const RigidBody& b = world.bodies[0];
       ReplaySample sample;
       sample.t = world.time - origin;
@@ -321,14 +321,31 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
       sample.angle = std::atan2(axis.z(), axis.x());
       sample.tilt_deg = rate * (world.time - origin) * 180.0 / kPi;
       sample.speed = b.velocity.norm();
+      sample.lowest = lowest_height(b);
+      sample.along_plate = (b.position - world.walls[0].pivot).dot(world.walls[0].u_axis);
       sample.contacts = static_cast<int>(world.history.size());
       for (const auto& entry : world.history) {
         if ((entry.first >> 63) == 0) sample.wall = std::max(sample.wall, static_cast<int>(entry.first & 0xFFF));  // wall contacts
       }
       samples.push_back(sample);
       next += replay.sample_interval;
+    } else if (world.time + 1e-12 >= next) {
+      next += replay.sample_interval;
     }
     if (world.time >= end) break;
+    if (replay.stop_after_rest >= 0.0 && world.time - origin > 0.05) {
+      const RigidBody& b = world.bodies[0];
+      const bool still = b.velocity.norm() < 2e-3 && b.angular_velocity().norm() * b.bounding_radius < 2e-3;
+      if (!still) rest_since = -1.0;
+      else if (rest_since < 0.0) rest_since = world.time;
+      if (rest_since >= 0.0 && world.time - rest_since > replay.stop_after_rest) break;
+    }
+    if (replay.stop_after_slip >= 0.0 && !samples.empty()) {
+      const RigidBody& b = world.bodies[0];
+      const double along = (b.position - world.walls[0].pivot).dot(world.walls[0].u_axis);
+      if (slid_at < 0.0 && std::abs(along - samples.front().along_plate) > 0.01) slid_at = world.time;
+      if (slid_at >= 0.0 && world.time - slid_at > replay.stop_after_slip) break;
+    }
     step(world, dt);
   }
   return samples;

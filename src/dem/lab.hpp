@@ -64,6 +64,8 @@ struct ReplaySample {
   double angle = 0.0;      ///< in-plane angle of the body's x axis [rad]
   double tilt_deg = 0.0;   ///< plate angle (tilt)
   double speed = 0.0;      ///< centre-of-mass speed [m/s]
+  double lowest = 0.0;     ///< height of the body's lowest point above z = 0 [m]
+  double along_plate = 0.0;  ///< tilt: centre-of-mass coordinate along the plate's downhill axis [m]
   int contacts = 0;        ///< sphere-wall contacts
   int wall = -1;           ///< the wall touched (roll: 0 incline, 1 flat), -1 none
 };
@@ -72,6 +74,9 @@ struct ReplayOptions {
   double duration = 1.0;         ///< [s] simulated after release
   double sample_interval = 1e-4; ///< [s]
   double settle = 0.05;          ///< tilt: settling before the plate turns [s]
+  double record_from = 0.0;      ///< [s] samples before this are left out (the first one is kept)
+  double stop_after_rest = -1.0;  ///< end this long after the body came to rest (speed < 2 mm/s) [s]; < 0 never
+  double stop_after_slip = -1.0; ///< tilt: end this long after 10 mm of slip along the plate [s]; < 0 never
 };
 
 /// Runs one trial of `setup` from the given initial orientation (the body placed as the

@@ -1,0 +1,329 @@
+#include "diagnose/conceal.hpp"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/rng.hpp"
+#include "diagnose/model.hpp"
+#include "diagnose/tracks.hpp"
+
+namespace clumpforge {
+namespace {
+
+struct Setup {
+  Recording recording;
+  std::string name;
+};
+
+std::vector<Setup> setups(const ConcealOptions& o) {
+  std::vector<Setup> out;
+  for (double h : o.drop_heights) {
+    Recording r;
+    r.test = LabTest::Drop;
+    r.surface = o.surface;
+    r.release_height = h;
+    out.push_back({r, fmt::format("drop-{:g}m", h)});
+  }
+  for (double d : o.roll_starts) {
+    Recording r;
+    r.test = LabTest::Roll;
+    r.surface = o.surface;
+    r.incline_deg = o.incline_deg;
+    r.start_distance = d;
+    out.push_back({r, fmt::format("roll-{:g}mm", d * 1000.0)});
+  }
+  if (o.tilt) {
+    Recording r;
+    r.test = LabTest::Tilt;
+    r.surface = o.surface;
+    r.composite = Composite::FourSquare;  // the study's: four glued tubers slide rather than roll
+    r.tilt_rate_deg_per_s = o.tilt_rate_deg_per_s;
+    out.push_back({r, "tilt"});
+  }
+  return out;
+}
+
+Eigen::Quaterniond trial_orientation(LabTest test, Rng& rng) {
+  if (test == LabTest::Tilt) return Eigen::Quaterniond(Eigen::AngleAxisd(rng.uniform(0.0, 2.0 * std::numbers::pi), Eigen::Vector3d::UnitZ()));
+  Eigen::Quaterniond q(rng.normal(), rng.normal(), rng.normal(), rng.normal());
+  return q.normalized();
+}
+
+// How long to replay a trial of `r` (the camera's window is cut from it afterwards).
+ReplayOptions replay_options(const Recording& r) {
+  ReplayOptions o;
+  o.sample_interval = 1e-4;
+  switch (r.test) {
+    case LabTest::Drop: o.duration = std::sqrt(2.0 * r.release_height / 9.81) * 2.8 + 0.1; break;
+    case LabTest::Roll:
+      o.duration = 3.0;
+      o.stop_after_rest = 0.15;
+      break;
+    case LabTest::Tilt:
+      o.duration = 89.0 / *r.tilt_rate_deg_per_s;
+      o.stop_after_slip = 0.15;
+      break;
+  }
+  return o;
+}
+
+// The camera's window [start, end] in replay time.
+std::pair<double, double> camera_window(const std::vector<ReplaySample>& replay, LabTest test, Rng& rng) {
+  const double pre = rng.uniform(0.005, 0.03);
+  switch (test) {
+    case LabTest::Drop: {
+      // Until 40 ms after the second landing.
+      int phase = 0;
+      for (const auto& s : replay) {
+        if (phase == 0 && s.contacts > 0) phase = 1;
+        else if (phase == 1 && s.contacts == 0) phase = 2;
+        else if (phase == 2 && s.contacts > 0) return {-pre, std::min(replay.back().t, s.t + 0.04)};
+      }
+      return {-pre, replay.back().t};
+    }
+    case LabTest::Roll: {
+      // Until 0.1 s after it comes to rest.
+      double still = -1.0;
+      for (const auto& s : replay) {
+        if (s.t < 0.05) continue;
+        if (s.speed < 2e-3) {
+          if (still < 0.0) still = s.t;
+          if (s.t - still > 0.05) return {-pre, std::min(replay.back().t, still + 0.1)};
+        } else {
+          still = -1.0;
+        }
+      }
+      return {-pre, replay.back().t};
+    }
+    case LabTest::Tilt: {
+      // From 1 s before 1 mm of slip until 10 mm of slip (or 0.15 s after 1 mm).
+      const double start = replay.front().along_plate;
+      double onset = -1.0;
+      for (const auto& s : replay) {
+        const double moved = std::abs(s.along_plate - start);
+        if (onset < 0.0 && moved > 1e-3) onset = s.t;
+        if (onset >= 0.0 && (moved > 0.01 || s.t > onset + 0.15)) return {std::max(0.0, onset - 1.0), s.t};
+      }
+      return {std::max(0.0, replay.back().t - 1.0), replay.back().t};
+    }
+  }
+  return {0.0, replay.back().t};
+}
+
+Track film(const std::vector<ReplaySample>& replay, LabTest test, const ConcealOptions& o, Rng& rng) {
+  const auto [start, end] = camera_window(replay, test, rng);
+  const double origin = rng.uniform(0.0, 100.0);
+  const double x_origin = test == LabTest::Roll ? 0.0 : rng.uniform(-0.01, 0.01);
+  const double interval = 1.0 / o.frame_rate_hz;
+  const auto frames = static_cast<long>((end - start) / interval);
+  long gap_start = -1, gap_length = 0;
+  if (rng.uniform() < o.gap_probability) {
+    gap_start = static_cast<long>(rng.below(static_cast<std::uint64_t>(std::max(1L, frames))));
+    gap_length = 3 + static_cast<long>(rng.below(13));
+  }
+  Track track;
+  for (long k = 0; k <= frames; ++k) {
+    const double t = start + static_cast<double>(k) * interval;
+    const bool lost = rng.uniform() < o.drop_frame_probability || (k >= gap_start && k < gap_start + gap_length);
+    const double nx = rng.normal(0.0, o.noise_m), nz = rng.normal(0.0, o.noise_m);
+    const bool empty_x = rng.uniform() < o.empty_cell_probability, empty_z = rng.uniform() < o.empty_cell_probability;
+    if (lost && k != 0 && k != frames) continue;
+    const ReplayPoint p = interpolate(replay, t);
+    track.t.push_back(std::round((origin + t) * 1e6) / 1e6);
+    track.x.push_back(empty_x ? std::numeric_limits<double>::quiet_NaN() : p.x + x_origin + nx);
+    track.z.push_back(empty_z ? std::numeric_limits<double>::quiet_NaN() : p.z + nz);
+    if (test == LabTest::Tilt) track.tilt.push_back(std::max(0.0, t) * o.tilt_rate_deg_per_s);
+  }
+  return track;
+}
+
+
+struct Generated {
+  std::vector<std::vector<ReplaySample>> replays;  // per trial
+  std::vector<double> summaries;
+};
+
+Result<Generated> run_setup(const Clump& clump, const MaterialTable& table, const Recording& setup, const LabOptions& options,
+                            const std::vector<Eigen::Quaterniond>& orientations, bool keep) {
+  auto lab = make_lab_world(clump, table, setup, options);
+  if (!lab) return std::unexpected(lab.error());
+  Generated g;
+  g.replays.resize(orientations.size());
+  g.summaries.resize(orientations.size());
+  const ReplayOptions replay = replay_options(setup);
+  tbb::parallel_for(std::size_t{0}, orientations.size(), [&](std::size_t i) {
+    auto samples = replay_trial(*lab, setup, orientations[i], options, replay);
+    g.summaries[i] = replay_summary(samples, setup.test);
+    if (keep) g.replays[i] = std::move(samples);
+  });
+  return g;
+}
+
+double mean(const std::vector<double>& v) {
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+}
+
+double& coefficient(Interaction& i, LabTest test) {
+  return test == LabTest::Drop ? i.restitution : test == LabTest::Roll ? i.rolling_friction : i.static_friction;
+}
+std::pair<double, double> coefficient_bounds(LabTest test) {
+  return test == LabTest::Drop ? std::pair{0.05, 1.0} : test == LabTest::Roll ? std::pair{0.0, 0.5} : std::pair{0.01, 2.0};
+}
+
+}  // namespace
+
+Result<ConcealResult> make_concealed_recordings(const Clump& clump, const MaterialTable& table, const ConcealOptions& options,
+                                                const RunContext& context) {
+  if (options.trials < 1 || options.trials > 1000) return fail(ErrorCode::InvalidArgument, "trials per recording must be 1 to 1000");
+  if (!(options.noise_m >= 0.0) || !(options.frame_rate_hz > 0.0)) return fail(ErrorCode::InvalidArgument, "noise must be >= 0 and the frame rate positive");
+  const auto library = effect_library();
+  ConcealResult result;
+  if (options.effect) {
+    const EffectSpec& spec = effect_spec(library, *options.effect);
+    result.values = options.values;
+    if (result.values.empty()) {
+      for (const auto& p : spec.parameters) result.values.push_back(p.realistic);
+    }
+    if (result.values.size() != spec.parameters.size()) {
+      return fail(ErrorCode::InvalidArgument, fmt::format("{} takes {} parameter(s), not {}", spec.name, spec.parameters.size(), result.values.size()));
+    }
+    for (std::size_t k = 0; k < result.values.size(); ++k) {
+      const auto& p = spec.parameters[k];
+      if (!(result.values[k] >= p.lower && result.values[k] <= p.upper)) {
+        return fail(ErrorCode::InvalidArgument, fmt::format("{} = {} is outside [{}, {}]", p.name, result.values[k], p.lower, p.upper));
+      }
+    }
+  }
+  if (options.base) {
+    result.baseline = *options.base;
+  } else {
+    auto pair = table.interaction(options.lab.particle_material, options.surface);
+    if (!pair) return std::unexpected(pair.error());
+    result.baseline = *pair;
+  }
+  auto all = setups(options);
+  std::vector<std::vector<Eigen::Quaterniond>> orientations(all.size());
+  for (std::size_t r = 0; r < all.size(); ++r) {
+    Rng rng(options.seed, 1000 + r);
+    for (int i = 0; i < options.trials; ++i) orientations[r].push_back(trial_orientation(all[r].recording.test, rng));
+  }
+  auto with = [&](const Interaction& interaction, bool effect) {
+    LabOptions lab = options.lab;
+    lab.interaction = interaction;
+    if (effect && options.effect) apply_effect(*options.effect, result.values, lab);
+    return lab;
+  };
+  // The study's set-ups: the first recording of each test.
+  std::vector<std::size_t> reference;
+  // Friction first: it acts in every test; rolling last: the roll depends on all three.
+  for (LabTest test : {LabTest::Tilt, LabTest::Drop, LabTest::Roll}) {
+    for (std::size_t r = 0; r < all.size(); ++r) {
+      if (all[r].recording.test == test) {
+        reference.push_back(r);
+        break;
+      }
+    }
+  }
+  std::vector<double> target(all.size(), 0.0);
+  for (std::size_t r : reference) {
+    auto g = run_setup(clump, table, all[r].recording, with(result.baseline, false), orientations[r], false);
+    if (!g) return std::unexpected(g.error());
+    target[r] = mean(g->summaries);
+  }
+  result.truth = result.baseline;
+  if (options.effect && options.conceal) {
+    // Secant steps on each test's own coefficient until its summary mean matches the baseline's.
+    for (int round = 0; round < 1; ++round) {
+      const auto& shown = effect_spec(library, *options.effect).tests;
+      for (std::size_t r : reference) {
+        const LabTest test = all[r].recording.test;
+        if (std::find(shown.begin(), shown.end(), test) == shown.end()) continue;  // the effect does not act there
+        auto [low, high] = coefficient_bounds(test);
+        auto mismatch = [&](double value) -> Result<double> {
+          Interaction trial = result.truth;
+          coefficient(trial, test) = value;
+          auto g = run_setup(clump, table, all[r].recording, with(trial, true), orientations[r], false);
+          if (!g) return std::unexpected(g.error());
+          return mean(g->summaries) - target[r];
+        };
+        // A coarse then a fine grid: irregular bodies make the mean rough in the coefficient
+        // (a roll's distance jumps when a tumble changes), so root finders stall.
+        double best = coefficient(result.truth, test), best_error = std::numeric_limits<double>::infinity();
+        double centre = best, half = test == LabTest::Roll ? std::max(0.5 * centre, 0.01) : 0.3 * centre;
+        for (int level = 0; level < 2; ++level) {
+          for (int k = -5; k <= 5; ++k) {
+            const double value = std::clamp(centre + half * k / 5.0, low, high);
+            auto f = mismatch(value);
+            if (!f) return std::unexpected(f.error());
+            if (std::abs(*f) < best_error) {
+              best_error = std::abs(*f);
+              best = value;
+            }
+          }
+          centre = best;
+          half /= 6.0;
+        }
+        coefficient(result.truth, test) = best;
+      }
+      context.report("concealing", 0.5 * (round + 1) / 2.0);
+    }
+  }
+  for (std::size_t r = 0; r < all.size(); ++r) {
+    auto g = run_setup(clump, table, all[r].recording, with(result.truth, true), orientations[r], true);
+    if (!g) return std::unexpected(g.error());
+    Recording rec = all[r].recording;
+    rec.frame_rate_hz = options.frame_rate_hz;
+    Rng rng(options.seed, 2000 + r);
+    for (int i = 0; i < options.trials; ++i) {
+      Trial trial;
+      trial.id = fmt::format("{:02d}", i + 1);
+      trial.summary = g->summaries[static_cast<std::size_t>(i)];
+      trial.track = film(g->replays[static_cast<std::size_t>(i)], rec.test, options, rng);
+      const Eigen::Quaterniond& q = orientations[r][static_cast<std::size_t>(i)];
+      trial.extra_json = fmt::format("{{\"orientation_wxyz\": [{:.12f}, {:.12f}, {:.12f}, {:.12f}]}}", q.w(), q.x(), q.y(), q.z());
+      rec.trials.push_back(std::move(trial));
+    }
+    if (std::find(reference.begin(), reference.end(), r) != reference.end()) {
+      result.summaries.push_back({all[r].name, target[r], mean(g->summaries)});
+    }
+    result.recordings.push_back(std::move(rec));
+    result.names.push_back(all[r].name);
+    context.report("filming", 0.5 + 0.5 * static_cast<double>(r + 1) / static_cast<double>(all.size()));
+  }
+  return result;
+}
+
+std::string answer_json(const ConcealOptions& options, const ConcealResult& result) {
+  const auto library = effect_library();
+  std::string values = "{";
+  if (options.effect) {
+    const EffectSpec& spec = effect_spec(library, *options.effect);
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
+      values += fmt::format("{}\"{}\": {:.9g}", k ? ", " : "", spec.parameters[k].name, result.values[k]);
+    }
+  }
+  values += "}";
+  auto coefficients = [](const Interaction& i) {
+    return fmt::format("{{\"restitution\": {:.9g}, \"static_friction\": {:.9g}, \"rolling_friction\": {:.9g}}}", i.restitution,
+                       i.static_friction, i.rolling_friction);
+  };
+  std::string summaries = "[";
+  for (std::size_t k = 0; k < result.summaries.size(); ++k) {
+    const auto& s = result.summaries[k];
+    summaries += fmt::format("{}{{\"recording\": \"{}\", \"baseline_mean\": {:.9g}, \"effect_mean\": {:.9g}}}", k ? ", " : "", s.recording,
+                             s.baseline_mean, s.effect_mean);
+  }
+  summaries += "]";
+  return fmt::format("{{\n  \"format\": \"clumpforge-concealed-answer/1\",\n  \"effect\": \"{}\",\n  \"effect_parameters\": {},\n  \"surface\": \"{}\",\n"
+                     "  \"seed\": {},\n  \"baseline\": {},\n  \"truth\": {},\n  \"summary_means\": {}\n}}\n",
+                     options.effect ? effect_spec(library, *options.effect).name : std::string("none"), values, options.surface, options.seed,
+                     coefficients(result.baseline), coefficients(result.truth), summaries);
+}
+
+}  // namespace clumpforge

@@ -1,0 +1,60 @@
+#pragma once
+/// Recordings with one effect hidden in them, to prove the diagnosis blind. The DEM runs
+/// with the effect switched on; the base coefficients are then retuned so that the summary
+/// means of the study's set-ups (0.2 m drop, 35 mm roll, tilt) match the effect-free
+/// baseline's, so only the trajectories give the effect away. The camera adds noise, an
+/// unknown time origin, an unknown horizontal origin (drop, tilt), dropped frames and lost
+/// cells. The answer (effect, values, true coefficients) is returned separately.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/clump.hpp"
+#include "core/recording.hpp"
+#include "core/run_context.hpp"
+#include "diagnose/effects.hpp"
+#include "dem/lab.hpp"
+
+namespace clumpforge {
+
+struct ConcealOptions {
+  std::optional<Effect> effect;        ///< none: an effect-free control
+  std::vector<double> values;          ///< the effect's parameters (empty: its realistic magnitude)
+  std::string surface = "Q235";
+  std::optional<Interaction> base;     ///< the baseline coefficients (default: the table's)
+  int trials = 8;                      ///< per recording
+  std::vector<double> drop_heights{0.2, 0.5, 1.0};   ///< [m]; the first is the study's
+  std::vector<double> roll_starts{0.035, 0.10};      ///< [m]; the first is the study's
+  bool tilt = true;
+  double incline_deg = 30.0, tilt_rate_deg_per_s = 5.0;
+  double noise_m = 1e-4;               ///< camera noise, per coordinate
+  double frame_rate_hz = 1000.0;
+  double drop_frame_probability = 0.01;   ///< single frames lost
+  double gap_probability = 0.3;           ///< a run of 3-15 lost frames, per track
+  double empty_cell_probability = 0.005;  ///< a lost x or z cell
+  bool conceal = true;                 ///< retune the base coefficients to hide the effect in the summaries
+  std::uint64_t seed = 1;
+  LabOptions lab;                      ///< contact settings, particle material
+};
+
+struct SummaryMatch {
+  std::string recording;               ///< e.g. "drop-0.2m"
+  double baseline_mean = 0.0, effect_mean = 0.0;  ///< SI (deg for tilt)
+};
+
+struct ConcealResult {
+  std::vector<Recording> recordings;   ///< with tracks and summaries; trials carry "orientation_wxyz"
+  std::vector<std::string> names;      ///< a directory name per recording
+  Interaction baseline;                ///< coefficients of the effect-free model
+  Interaction truth;                   ///< coefficients used with the effect (after concealment)
+  std::vector<double> values;          ///< the effect's parameters used
+  std::vector<SummaryMatch> summaries; ///< study set-ups: baseline vs concealed effect
+};
+
+Result<ConcealResult> make_concealed_recordings(const Clump& clump, const MaterialTable& table, const ConcealOptions& options,
+                                                const RunContext& context = {});
+
+/// The answer as JSON, for the scorer only.
+std::string answer_json(const ConcealOptions& options, const ConcealResult& result);
+
+}  // namespace clumpforge

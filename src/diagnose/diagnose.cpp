@@ -1,0 +1,991 @@
+#include "diagnose/diagnose.hpp"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <ranges>
+
+#include "core/rng.hpp"
+#include "diagnose/model.hpp"
+#include "diagnose/optimize.hpp"
+#include "diagnose/phases.hpp"
+
+namespace clumpforge {
+namespace {
+
+constexpr double kNever = std::numeric_limits<double>::infinity();
+/// A phase is a mismatch only when its residual also exceeds the noise in size: chi^2 per
+/// value above 1.5 (an RMS misfit above 0.7 sigma). Replays of irregular bodies near their
+/// predictability horizon never match to a small fraction of the noise, and a statistically
+/// significant 0.02 mm is not a physics question.
+constexpr double kPracticalExcess = 1.5;
+
+std::optional<Eigen::Quaterniond> recorded_orientation(const std::string& extra_json) {
+  const auto extra = nlohmann::json::parse(extra_json, nullptr, false);
+  if (!extra.is_object() || !extra.contains("orientation_wxyz")) return std::nullopt;
+  const auto& q = extra["orientation_wxyz"];
+  if (!q.is_array() || q.size() != 4) return std::nullopt;
+  for (const auto& v : q) {
+    if (!v.is_number()) return std::nullopt;
+  }
+  Eigen::Quaterniond out(q[0].get<double>(), q[1].get<double>(), q[2].get<double>(), q[3].get<double>());
+  if (!(out.norm() > 0.5)) return std::nullopt;
+  return out.normalized();
+}
+
+/// Upper tail of chi^2 with n degrees of freedom (Wilson-Hilferty).
+double chi2_tail(double chi2, double n) {
+  if (n <= 0.0) return 1.0;
+  const double a = 2.0 / (9.0 * n);
+  const double z = (std::cbrt(chi2 / n) - (1.0 - a)) / std::sqrt(a);
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
+
+// ---- Parameters of a fit, mapped to the unit box ----------------------------------------
+
+enum class Coefficient { Restitution, StaticFriction, RollingFriction };
+
+struct FitParameter {
+  bool effect = false;
+  std::size_t index = 0;   ///< effect parameter index, or surface index
+  Coefficient coefficient = Coefficient::Restitution;
+  double lower = 0.0, upper = 1.0;
+  bool log_scale = false;
+  double to_unit(double v) const {
+    if (log_scale) return (std::log10(v) - std::log10(lower)) / (std::log10(upper) - std::log10(lower));
+    return (v - lower) / (upper - lower);
+  }
+  double from_unit(double u) const {
+    u = std::clamp(u, 0.0, 1.0);
+    if (log_scale) return std::pow(10.0, std::log10(lower) + u * (std::log10(upper) - std::log10(lower)));
+    return lower + u * (upper - lower);
+  }
+};
+
+double& coefficient_of(Interaction& i, Coefficient c) {
+  return c == Coefficient::Restitution ? i.restitution : c == Coefficient::StaticFriction ? i.static_friction : i.rolling_friction;
+}
+double coefficient_of(const Interaction& i, Coefficient c) {
+  return c == Coefficient::Restitution ? i.restitution : c == Coefficient::StaticFriction ? i.static_friction : i.rolling_friction;
+}
+
+Coefficient coefficient_for(LabTest test) {
+  return test == LabTest::Drop ? Coefficient::Restitution : test == LabTest::Tilt ? Coefficient::StaticFriction : Coefficient::RollingFriction;
+}
+
+std::pair<double, double> coefficient_range(Coefficient c) {
+  switch (c) {
+    case Coefficient::Restitution: return {0.05, 1.0};
+    case Coefficient::StaticFriction: return {0.05, 1.5};
+    case Coefficient::RollingFriction: return {0.0, 0.15};
+  }
+  return {0.0, 1.0};
+}
+
+Model apply_parameters(const Model& start, const std::vector<FitParameter>& parameters, const std::vector<double>& unit) {
+  Model m = start;
+  for (std::size_t k = 0; k < parameters.size(); ++k) {
+    const FitParameter& p = parameters[k];
+    const double v = p.from_unit(unit[k]);
+    if (p.effect) m.values[p.index] = v;
+    else coefficient_of(m.base[p.index].interaction, p.coefficient) = v;
+  }
+  return m;
+}
+
+// ---- Residual statistics per recording and phase -----------------------------------------
+
+struct GroupKey {
+  std::size_t recording = 0;
+  Phase phase = Phase::Hold;
+  auto operator<=>(const GroupKey&) const = default;
+};
+
+struct Segment {
+  std::vector<double> tau, rx, rz;  ///< time since the trial entered the phase, residuals (sigma units)
+};
+
+struct Group {
+  double chi2 = 0.0;
+  int values = 0;
+  double sum_x = 0.0, sum_z = 0.0;
+  int count_x = 0, count_z = 0;
+  double sq_x = 0.0, sq_z = 0.0;
+  std::vector<Segment> segments;
+};
+
+using Groups = std::map<GroupKey, Group>;
+
+/// Adds one trial's residuals, frame by frame, to its recording's phase groups.
+void accumulate(Groups& groups, std::size_t recording, LabTest test, const Track& track, const std::vector<ReplaySample>& replay, double sigma,
+                const Alignment& alignment, double cutoff) {
+  const PhaseMarks marks = phase_marks(replay, test);
+  const auto frames = residuals(track, replay, sigma, alignment);
+  Phase current = Phase::Hold;
+  double entered = 0.0;
+  Segment* segment = nullptr;
+  for (const auto& f : frames) {
+    if (f.t + alignment.shift > cutoff) break;
+    const Phase phase = phase_at(marks, test, f.t);
+    Group& g = groups[{recording, phase}];
+    if (segment == nullptr || phase != current) {
+      g.segments.emplace_back();
+      segment = &g.segments.back();
+      current = phase;
+      entered = f.t;
+    }
+    segment->tau.push_back(f.t - entered);
+    segment->rx.push_back(f.rx);
+    segment->rz.push_back(f.rz);
+    if (std::isfinite(f.rx)) {
+      g.chi2 += f.rx * f.rx;
+      g.sum_x += f.rx;
+      g.sq_x += f.rx * f.rx;
+      ++g.count_x;
+      ++g.values;
+    }
+    if (std::isfinite(f.rz)) {
+      g.chi2 += f.rz * f.rz;
+      g.sum_z += f.rz;
+      g.sq_z += f.rz * f.rz;
+      ++g.count_z;
+      ++g.values;
+    }
+  }
+}
+
+/// Least-squares r = a tau^k for k = 1..4 over the group's frames (one axis); the best k,
+/// its amplitude at tau_end and the share of the sum of squares it explains.
+struct Growth {
+  int power = 0;
+  double at_end = 0.0;
+  double explained = 0.0;
+};
+
+Growth growth_law(const Group& g, bool z_axis) {
+  std::vector<double> ends;
+  for (const auto& s : g.segments) {
+    if (!s.tau.empty()) ends.push_back(s.tau.back());
+  }
+  if (ends.empty()) return {};
+  std::nth_element(ends.begin(), ends.begin() + static_cast<std::ptrdiff_t>(ends.size() / 2), ends.end());
+  const double tau_end = std::max(ends[ends.size() / 2], 1e-3);
+  Growth best;
+  double total = 0.0;
+  for (const auto& s : g.segments) {
+    for (std::size_t i = 0; i < s.tau.size(); ++i) {
+      const double r = z_axis ? s.rz[i] : s.rx[i];
+      if (std::isfinite(r)) total += r * r;
+    }
+  }
+  if (total <= 0.0) return {};
+  for (int k = 0; k <= 4; ++k) {
+    double num = 0.0, den = 0.0;
+    for (const auto& s : g.segments) {
+      for (std::size_t i = 0; i < s.tau.size(); ++i) {
+        const double r = z_axis ? s.rz[i] : s.rx[i];
+        if (!std::isfinite(r)) continue;
+        const double b = std::pow(s.tau[i] / tau_end, k);
+        num += r * b;
+        den += b * b;
+      }
+    }
+    if (den <= 0.0) continue;
+    const double a = num / den;
+    const double explained = a * num / total;  // (sum r b)^2 / (sum b^2) / sum r^2
+    if (explained > best.explained + 0.02) best = {k, a, explained};
+  }
+  return best;
+}
+
+/// Chi^2 a smooth discrepancy (cubic in time, per trial segment and axis) removes from a group.
+double smooth_discrepancy_gain(const Group& g, int& parameters) {
+  double gain = 0.0;
+  parameters = 0;
+  for (const auto& s : g.segments) {
+    if (s.tau.size() < 12) continue;
+    const double span = std::max(s.tau.back(), 1e-6);
+    for (int axis = 0; axis < 2; ++axis) {
+      const auto& r = axis == 0 ? s.rx : s.rz;
+      Eigen::MatrixXd a(static_cast<Eigen::Index>(r.size()), 4);
+      Eigen::VectorXd b(static_cast<Eigen::Index>(r.size()));
+      Eigen::Index rows = 0;
+      for (std::size_t i = 0; i < r.size(); ++i) {
+        if (!std::isfinite(r[i])) continue;
+        const double u = 2.0 * s.tau[i] / span - 1.0;
+        a.row(rows) << 1.0, u, 1.5 * u * u - 0.5, 2.5 * u * u * u - 1.5 * u;
+        b(rows) = r[i];
+        ++rows;
+      }
+      if (rows < 8) continue;
+      const Eigen::MatrixXd am = a.topRows(rows);
+      const Eigen::VectorXd bm = b.head(rows);
+      const Eigen::VectorXd c = am.colPivHouseholderQr().solve(bm);
+      gain += bm.squaredNorm() - (bm - am * c).squaredNorm();
+      parameters += 4;
+    }
+  }
+  return gain;
+}
+
+// ---- The diagnosis ------------------------------------------------------------------------
+
+struct Context {
+  Evaluator ev;
+  std::vector<std::string> names;
+  std::vector<std::size_t> training, heldout, all;
+  int evaluations = 0;
+  const RunContext* run = nullptr;
+};
+
+Result<std::vector<TrialScore>> score(Context& c, const Model& m, const std::vector<std::size_t>& which, bool keep) {
+  c.evaluations += static_cast<int>(which.size());
+  return evaluate(c.ev, m, which, keep);
+}
+
+std::vector<std::size_t> subset(const Context& c, const std::vector<std::size_t>& from, const std::vector<LabTest>& tests) {
+  std::vector<std::size_t> out;
+  for (std::size_t i : from) {
+    const LabTest t = (*c.ev.recordings)[c.ev.trials[i].recording].test;
+    if (std::find(tests.begin(), tests.end(), t) != tests.end()) out.push_back(i);
+  }
+  return out;
+}
+
+/// Predictability horizon of every trial under `model` (see TrackedTrial::horizon).
+Result<void> set_horizons(Context& c, const Model& model, double perturbation) {
+  const auto& recs = *c.ev.recordings;
+  std::vector<std::optional<LabWorld>> worlds(recs.size());
+  std::vector<LabOptions> options(recs.size());
+  for (std::size_t r = 0; r < recs.size(); ++r) {
+    options[r] = lab_options_for(c.ev, model, recs[r]);
+    auto made = make_lab_world(*c.ev.clump, *c.ev.table, recs[r], options[r]);
+    if (!made) return std::unexpected(made.error());
+    worlds[r] = std::move(*made);
+  }
+  c.evaluations += 3 * static_cast<int>(c.ev.trials.size());
+  tbb::parallel_for(std::size_t{0}, c.ev.trials.size(), [&](std::size_t i) {
+    TrackedTrial& tt = c.ev.trials[i];
+    const Recording& rec = recs[tt.recording];
+    ReplayOptions replay;
+    replay.duration = tt.duration;
+    replay.sample_interval = c.ev.sample_interval;
+    replay.record_from = tt.record_from;
+    const auto nominal = replay_trial(*worlds[tt.recording], rec, tt.orientation, options[tt.recording], replay);
+    double horizon = kNever;
+    const double sigma = c.ev.sigma[tt.recording];
+    for (const Eigen::Vector3d& axis : {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()}) {
+      const Eigen::Quaterniond q = Eigen::Quaterniond(Eigen::AngleAxisd(perturbation, axis)) * tt.orientation;
+      const auto other = replay_trial(*worlds[tt.recording], rec, q, options[tt.recording], replay);
+      for (std::size_t k = 0; k < std::min(nominal.size(), other.size()); ++k) {
+        if (std::hypot(nominal[k].x - other[k].x, nominal[k].z - other[k].z) > 0.5 * sigma) {
+          horizon = std::min(horizon, nominal[k].t);
+          break;
+        }
+      }
+    }
+    tt.horizon = horizon;
+    tt.cutoff = c.ev.shift.size() == c.ev.trials.size() ? c.ev.shift[i] + horizon : kNever;
+  });
+  return {};
+}
+
+/// Block-coordinate fit of the base coefficients: each on its own test's training trials.
+Result<Model> fit_baseline(Context& c, Model model, bool narrow) {
+  const auto& recs = *c.ev.recordings;
+  for (std::size_t s = 0; s < model.base.size(); ++s) {
+    for (LabTest test : {LabTest::Tilt, LabTest::Drop, LabTest::Roll}) {
+      std::vector<std::size_t> which;
+      for (std::size_t i : c.training) {
+        const Recording& r = recs[c.ev.trials[i].recording];
+        if (r.test == test && r.surface == model.base[s].surface) which.push_back(i);
+      }
+      if (which.empty()) continue;
+      const Coefficient coefficient = coefficient_for(test);
+      auto [low, high] = coefficient_range(coefficient);
+      const double current = coefficient_of(model.base[s].interaction, coefficient);
+      if (narrow) {
+        const double half = std::max(0.15 * current, coefficient == Coefficient::RollingFriction ? 0.006 : 0.02);
+        low = std::max(low, current - half);
+        high = std::min(high, current + half);
+      }
+      std::optional<Error> failure;
+      auto chi2 = [&](double v) {
+        Model m = model;
+        coefficient_of(m.base[s].interaction, coefficient) = v;
+        auto scores = score(c, m, which, false);
+        if (!scores) {
+          failure = scores.error();
+          return kNever;
+        }
+        return total_chi_squared(*scores);
+      };
+      // A coarse grid (the chi^2 of irregular bodies can have several dips), then golden section.
+      const int grid = narrow ? 5 : 9;
+      double best = current, best_value = chi2(current);
+      for (int k = 0; k < grid; ++k) {
+        const double v = low + (high - low) * k / (grid - 1);
+        const double f = chi2(v);
+        if (f < best_value) {
+          best_value = f;
+          best = v;
+        }
+      }
+      if (failure) return std::unexpected(*failure);
+      const double cell = (high - low) / (grid - 1);
+      const double tolerance = coefficient == Coefficient::RollingFriction ? 2e-4 : 1e-3;
+      auto refined = golden_section(chi2, std::max(low, best - cell), std::min(high, best + cell), tolerance, 14);
+      if (failure) return std::unexpected(*failure);
+      if (refined.value < best_value) best = refined.x[0];
+      coefficient_of(model.base[s].interaction, coefficient) = best;
+    }
+  }
+  return model;
+}
+
+struct Fitted {
+  Model model;
+  double chi2 = 0.0;
+  int evaluations = 0;
+};
+
+/// Fits `effect` with the base coefficients of the tests it acts in, on `which`.
+/// With `spec` null, the baseline refitted the same way (its coefficients on the same tests):
+/// the fair null of the nested comparison.
+Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpec* spec, const std::vector<LabTest>& tests,
+                              const std::vector<std::size_t>& which, int max_evaluations) {
+  const auto& recs = *c.ev.recordings;
+  Model start = baseline;
+  std::vector<FitParameter> parameters;
+  if (spec != nullptr) {
+    start.effect = spec->effect;
+    for (const auto& p : spec->parameters) start.values.push_back(p.start);
+    for (std::size_t k = 0; k < spec->parameters.size(); ++k) {
+      const auto& p = spec->parameters[k];
+      parameters.push_back({true, k, Coefficient::Restitution, p.lower, p.upper, p.log_scale});
+    }
+  }
+  for (std::size_t s = 0; s < baseline.base.size(); ++s) {
+    for (LabTest test : tests) {
+      const bool present = std::any_of(which.begin(), which.end(), [&](std::size_t i) {
+        const Recording& r = recs[c.ev.trials[i].recording];
+        return r.test == test && r.surface == baseline.base[s].surface;
+      });
+      if (!present) continue;
+      const Coefficient coefficient = coefficient_for(test);
+      auto [low, high] = coefficient_range(coefficient);
+      const double current = coefficient_of(baseline.base[s].interaction, coefficient);
+      // Within +-40 % of the baseline's value: an effect changes a coefficient, not its order.
+      const double half = std::max(0.4 * current, coefficient == Coefficient::RollingFriction ? 0.01 : 0.05);
+      parameters.push_back({false, s, coefficient, std::max(low, current - half), std::min(high, current + half), false});
+    }
+  }
+  std::optional<Error> failure;
+  Fitted out;
+  auto chi2 = [&](const std::vector<double>& unit) {
+    ++out.evaluations;
+    auto scores = score(c, apply_parameters(start, parameters, unit), which, false);
+    if (!scores) {
+      failure = scores.error();
+      return kNever;
+    }
+    return total_chi_squared(*scores);
+  };
+  std::vector<double> unit;
+  for (std::size_t k = 0; k < parameters.size(); ++k) {
+    const FitParameter& p = parameters[k];
+    const double v = p.effect ? start.values[p.index] : coefficient_of(start.base[p.index].interaction, p.coefficient);
+    unit.push_back(std::clamp(p.to_unit(v), 0.0, 1.0));
+  }
+  // The effect's first parameter alone first (a grid over its range), then everything.
+  double best_value = chi2(unit);
+  std::vector<double> best_unit = unit;
+  for (double u : spec != nullptr ? std::vector<double>{0.0, 0.08, 0.2, 0.4, 0.7} : std::vector<double>{}) {
+    std::vector<double> trial = unit;
+    trial[0] = u;
+    const double f = chi2(trial);
+    if (f < best_value) {
+      best_value = f;
+      best_unit = trial;
+    }
+  }
+  if (failure) return std::unexpected(*failure);
+  std::vector<double> step(parameters.size(), 0.0);
+  for (std::size_t k = 0; k < parameters.size(); ++k) step[k] = parameters[k].effect ? 0.08 : 0.06;
+  auto minimum = nelder_mead(chi2, best_unit, step, max_evaluations, 0.5);
+  if (failure) return std::unexpected(*failure);
+  if (minimum.value < best_value) {
+    best_value = minimum.value;
+    best_unit = minimum.x;
+  }
+  out.model = apply_parameters(start, parameters, best_unit);
+  out.chi2 = best_value;
+  return out;
+}
+
+/// Fixes each trial's release orientation: the recorded one, or the best of a seeded set.
+Result<void> choose_orientations(Context& c, const Model& model, const std::vector<std::size_t>& unknown, int candidates, std::uint64_t seed) {
+  const auto& recs = *c.ev.recordings;
+  for (std::size_t i : unknown) {
+    TrackedTrial& tt = c.ev.trials[i];
+    Rng rng(seed, 5000 + i);
+    double best = kNever;
+    Eigen::Quaterniond chosen = Eigen::Quaterniond::Identity();
+    for (int k = 0; k < candidates; ++k) {
+      Eigen::Quaterniond q;
+      if (recs[tt.recording].test == LabTest::Tilt) {
+        q = Eigen::Quaterniond(Eigen::AngleAxisd(2.0 * 3.141592653589793 * k / candidates, Eigen::Vector3d::UnitZ()));
+      } else {
+        q = Eigen::Quaterniond(rng.normal(), rng.normal(), rng.normal(), rng.normal()).normalized();
+      }
+      tt.orientation = q;
+      Evaluator probe = c.ev;
+      probe.shift.clear();
+      c.evaluations += 1;
+      auto scores = evaluate(probe, model, {i}, false);
+      if (!scores) return std::unexpected(scores.error());
+      if ((*scores)[0].alignment.chi_squared < best) {
+        best = (*scores)[0].alignment.chi_squared;
+        chosen = q;
+      }
+    }
+    tt.orientation = chosen;
+  }
+  return {};
+}
+
+double rms_mm(const Context& c, const std::vector<std::size_t>& which, const std::vector<TrialScore>& scores) {
+  double sum = 0.0;
+  int values = 0;
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const double sigma = c.ev.sigma[c.ev.trials[which[k]].recording];
+    sum += scores[k].alignment.chi_squared * sigma * sigma;
+    values += scores[k].alignment.values;
+  }
+  return values > 0 ? 1000.0 * std::sqrt(sum / values) : 0.0;
+}
+
+double summary_scale(LabTest test) { return test == LabTest::Tilt ? 1.0 : 1000.0; }  // mm, or deg
+
+FitQuality quality(const Context& c, const std::vector<TrialScore>& scores) {
+  FitQuality q;
+  std::vector<std::size_t> train_pos, held_pos;
+  std::vector<TrialScore> train_scores, held_scores;
+  std::vector<std::size_t> train_idx, held_idx;
+  for (std::size_t k = 0; k < c.all.size(); ++k) {
+    const std::size_t i = c.all[k];
+    (c.ev.trials[i].training ? train_scores : held_scores).push_back(scores[k]);
+    (c.ev.trials[i].training ? train_idx : held_idx).push_back(i);
+  }
+  q.train_rms_mm = rms_mm(c, train_idx, train_scores);
+  q.heldout_rms_mm = rms_mm(c, held_idx, held_scores);
+  q.train_chi2_per_value = total_values(train_scores) > 0 ? total_chi_squared(train_scores) / total_values(train_scores) : 0.0;
+  q.heldout_chi2_per_value = total_values(held_scores) > 0 ? total_chi_squared(held_scores) / total_values(held_scores) : 0.0;
+  const auto& recs = *c.ev.recordings;
+  for (std::size_t r = 0; r < recs.size(); ++r) {
+    double model_sum = 0.0, measured_sum = 0.0;
+    int count = 0;
+    for (std::size_t k = 0; k < c.all.size(); ++k) {
+      const TrackedTrial& tt = c.ev.trials[c.all[k]];
+      if (tt.recording != r) continue;
+      const auto& summary = recs[r].trials[tt.trial].summary;
+      if (!summary || !std::isfinite(scores[k].summary)) continue;
+      model_sum += scores[k].summary;
+      measured_sum += *summary;
+      ++count;
+    }
+    if (count > 0) q.summary_error.emplace_back(c.names[r], summary_scale(recs[r].test) * (model_sum - measured_sum) / count);
+  }
+  return q;
+}
+
+Groups phase_groups(const Context& c, const std::vector<std::size_t>& which, const std::vector<TrialScore>& scores) {
+  Groups groups;
+  const auto& recs = *c.ev.recordings;
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const TrackedTrial& tt = c.ev.trials[which[k]];
+    const Recording& rec = recs[tt.recording];
+    accumulate(groups, tt.recording, rec.test, *rec.trials[tt.trial].track, scores[k].replay, c.ev.sigma[tt.recording], scores[k].alignment,
+               tt.cutoff);
+  }
+  return groups;
+}
+
+std::string recording_label(const Recording& r, const std::string& name) {
+  switch (r.test) {
+    case LabTest::Drop: return fmt::format("{} (drop from {:g} m on {})", name, r.release_height, r.surface);
+    case LabTest::Roll: return fmt::format("{} (roll from {:g} mm on {})", name, r.start_distance * 1000.0, r.surface);
+    case LabTest::Tilt: return fmt::format("{} (tilt on {})", name, r.surface);
+  }
+  return name;
+}
+
+std::vector<PhaseReport> locate(const Context& c, const Groups& groups) {
+  std::vector<PhaseReport> out;
+  const auto& recs = *c.ev.recordings;
+  const double threshold = 1e-3 / std::max<std::size_t>(1, groups.size());
+  for (const auto& [key, g] : groups) {
+    if (key.phase == Phase::Hold || g.values < 10) continue;
+    PhaseReport p;
+    p.recording = c.names[key.recording];
+    p.phase = std::string(phase_name(key.phase));
+    p.values = g.values;
+    p.chi2_per_value = g.chi2 / g.values;
+    p.p_value = chi2_tail(g.chi2, g.values);
+    p.significant = p.p_value < threshold && p.chi2_per_value > kPracticalExcess;
+    const double sigma_mm = c.ev.sigma[key.recording] * 1000.0;
+    p.bias_x_mm = g.count_x ? sigma_mm * g.sum_x / g.count_x : 0.0;
+    p.bias_z_mm = g.count_z ? sigma_mm * g.sum_z / g.count_z : 0.0;
+    const bool z_axis = g.sq_z >= g.sq_x;
+    p.axis = z_axis ? "z" : "x";
+    const Growth growth = growth_law(g, z_axis);
+    p.growth_power = growth.explained > 0.3 ? growth.power : 0;
+    p.end_residual_mm = sigma_mm * growth.at_end;
+    const std::string where = fmt::format("{} phases of {}", p.phase, recording_label(recs[key.recording], p.recording));
+    if (!p.significant) {
+      p.statement = fmt::format("{}: consistent with the noise (chi^2/value {:.2f}, p = {:.2g})", where, p.chi2_per_value, p.p_value);
+    } else {
+      std::string shape = p.growth_power == 0 ? "a constant offset"
+                          : p.growth_power == 1 ? "growing linearly in time"
+                                                : fmt::format("growing like t^{}", p.growth_power);
+      if (growth.explained < 0.3) shape = "no simple growth law (scattered)";
+      p.statement = fmt::format("{}: the recording lies {:+.2f} mm from the model in {} by the phase's end, {}; chi^2/value {:.2f} (p = {:.2g})",
+                                where, p.end_residual_mm, p.axis, shape, p.chi2_per_value, p.p_value);
+    }
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+/// Excess chi^2 (chi^2 - values) over the groups flagged in `flagged`.
+double flagged_excess(const Groups& groups, const std::vector<GroupKey>& flagged) {
+  double excess = 0.0;
+  for (const auto& key : flagged) {
+    const auto it = groups.find(key);
+    if (it != groups.end()) excess += it->second.chi2 - it->second.values;
+  }
+  return excess;
+}
+
+std::string experiment_for(const std::string& a, const std::string& b) {
+  auto pair_is = [&](std::string_view x, std::string_view y) { return (a == x && b == y) || (a == y && b == x); };
+  auto involves = [&](std::string_view x) { return a == x || b == x; };
+  if (pair_is("viscoelastic_restitution", "elastic_plastic_restitution"))
+    return "drops from more heights, especially low ones (0.05 and 0.1 m) and a high one (2 m): the two laws part below the yield speed and at high speed";
+  if (involves("air_drag")) return "drops from 0.5 and 1.0 m with the image scale calibrated in the object plane: drag bends the flights like t^4, contact effects change only the impacts";
+  if (pair_is("viscous_rolling", "epsd_rolling")) return "rolls from two more start distances: a viscous torque's stopping distance grows like v0, a constant torque's like v0^2, and an EPSD spring rocks back at rest";
+  if (involves("adhesion")) return "repeat the tests with particles of a different mass: adhesion's share of the load falls with the weight, other effects do not";
+  if (involves("com_offset")) return "track a marked axis on the particle (angle_rad) or film a second view: a centre-of-mass offset makes a once-per-turn wobble of the centroid";
+  if (involves("plastic_substrate")) return "film the impacts at 5000 fps or more: a plastic substrate leaves the particle resting in a dent and lengthens the contact";
+  if (involves("static_kinetic_friction")) return "tilt more slowly and film the first 10 mm of sliding: a kinetic coefficient below the static one makes the block jump ahead at onset";
+  return "add set-ups that load the two effects differently (other drop heights, start distances, particle masses)";
+}
+
+}  // namespace
+
+Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, const std::vector<Recording>& recordings,
+                                const std::vector<std::string>& names, const DiagnoseOptions& options, const RunContext& run) {
+  const auto started = std::chrono::steady_clock::now();
+  if (recordings.empty()) return fail(ErrorCode::InvalidArgument, "no recordings to diagnose");
+  if (names.size() != recordings.size()) return fail(ErrorCode::InvalidArgument, "one name per recording is needed");
+  bool any_track = false;
+  for (const auto& r : recordings) {
+    for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
+  }
+  if (!any_track) return diagnose_summaries(clump, table, recordings, names, options, run);
+
+  DiagnoseResult result;
+  Context c;
+  c.names = names;
+  c.run = &run;
+  c.ev.clump = &clump;
+  c.ev.table = &table;
+  c.ev.recordings = &recordings;
+  c.ev.lab = options.lab;
+  // Noise level per recording, from its own tracks.
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    std::vector<const Track*> tracks;
+    for (const auto& t : recordings[r].trials) {
+      if (t.track) tracks.push_back(&*t.track);
+    }
+    double sigma = estimate_noise(tracks);
+    if (recordings[r].position_noise_m) {
+      result.notes.push_back(fmt::format("{}: the lab states {:.3g} mm of noise; the tracks show {:.3g} mm (used)", names[r],
+                                         *recordings[r].position_noise_m * 1000.0, sigma * 1000.0));
+      if (!std::isfinite(sigma)) sigma = *recordings[r].position_noise_m;
+    }
+    c.ev.sigma.push_back(sigma);
+    if (!tracks.empty()) result.noise_m.emplace_back(names[r], sigma);
+  }
+  // The trials that can be used.
+  std::vector<std::size_t> unknown_orientation;
+  std::vector<std::string> too_short;
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    const Recording& rec = recordings[r];
+    int used = 0;
+    for (std::size_t i = 0; i < rec.trials.size(); ++i) {
+      const auto& track = rec.trials[i].track;
+      if (!track) continue;
+      int frames = 0;
+      for (std::size_t k = 0; k < track->size(); ++k) frames += std::isfinite(track->x[k]) && std::isfinite(track->z[k]);
+      if (frames < 30 || !std::isfinite(c.ev.sigma[r])) {
+        too_short.push_back(fmt::format("{} trial {} ({} usable frames)", names[r], rec.trials[i].id, frames));
+        continue;
+      }
+      TrackedTrial tt;
+      tt.recording = r;
+      tt.trial = i;
+      tt.training = used % 2 == 0;
+      const double rate = rec.tilt_rate_deg_per_s.value_or(options.lab.tilt_rate_deg_per_s);
+      tt.shift_guess = guess_shift(*track, rec.test, rate);
+      const double last = track->t.back() - tt.shift_guess;
+      tt.duration = std::clamp(last + 0.05, 0.05, rec.test == LabTest::Tilt ? 89.0 / rate : 6.0);
+      if (rec.test == LabTest::Tilt) tt.record_from = std::max(0.0, track->t.front() - tt.shift_guess - 0.05);
+      if (auto q = recorded_orientation(rec.trials[i].extra_json)) tt.orientation = *q;
+      else unknown_orientation.push_back(c.ev.trials.size());
+      (tt.training ? c.training : c.heldout).push_back(c.ev.trials.size());
+      c.all.push_back(c.ev.trials.size());
+      c.ev.trials.push_back(tt);
+      ++used;
+    }
+  }
+  result.tracked_trials = static_cast<int>(c.ev.trials.size());
+  result.training_trials = static_cast<int>(c.training.size());
+  if (!too_short.empty()) result.notes.push_back(fmt::format("left out (too short or no noise estimate): {}", fmt::join(too_short, ", ")));
+  double worst_sigma = 0.0;
+  for (double s : c.ev.sigma) {
+    if (std::isfinite(s)) worst_sigma = std::max(worst_sigma, s);
+  }
+  auto undecidable = [&](std::string why) {
+    result.verdict = "undecidable";
+    result.statement = std::move(why);
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return result;
+  };
+  if (c.ev.trials.size() < 2 || c.training.empty() || c.heldout.empty()) {
+    return undecidable(fmt::format("only {} usable tracked trial(s): at least two (one to fit, one held out), each with 30 or more frames, are "
+                                   "needed to decide anything",
+                                   c.ev.trials.size()));
+  }
+  if (worst_sigma > 1e-3) {
+    return undecidable(fmt::format("the tracks are too noisy to decide anything: {:.2f} mm of camera noise, where the effects in the "
+                                   "library move the tracked point by 0.1 to a few mm; track with sub-pixel centroids (0.02 to 0.1 mm)",
+                                   worst_sigma * 1000.0));
+  }
+  // Base coefficients: the materials table's, per surface.
+  Model baseline;
+  for (const auto& rec : recordings) {
+    if (std::any_of(baseline.base.begin(), baseline.base.end(), [&](const auto& b) { return b.surface == rec.surface; })) continue;
+    auto pair = table.interaction(options.lab.particle_material, rec.surface);
+    if (!pair) return std::unexpected(pair.error());
+    baseline.base.push_back({rec.surface, *pair});
+  }
+  run.report("aligning", 0.02);
+  if (!unknown_orientation.empty()) {
+    if (auto ok = choose_orientations(c, baseline, unknown_orientation, options.orientation_candidates, options.seed); !ok) return std::unexpected(ok.error());
+    result.notes.push_back(fmt::format("{} trial(s) had no recorded release orientation; the best of {} seeded candidates was used for each",
+                                       unknown_orientation.size(), options.orientation_candidates));
+  }
+  if (auto ok = initialise_shifts(c.ev, baseline); !ok) return std::unexpected(ok.error());
+  if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
+  run.report("baseline", 0.05);
+  auto fitted = fit_baseline(c, baseline, false);
+  if (!fitted) return std::unexpected(fitted.error());
+  baseline = *fitted;
+  c.ev.shift.clear();
+  if (auto ok = initialise_shifts(c.ev, baseline); !ok) return std::unexpected(ok.error());
+  if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
+  fitted = fit_baseline(c, baseline, true);
+  if (!fitted) return std::unexpected(fitted.error());
+  baseline = *fitted;
+  result.baseline = baseline.base;
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    std::vector<std::string> horizons;
+    for (const auto& tt : c.ev.trials) {
+      if (tt.recording == r) horizons.push_back(std::isfinite(tt.horizon) ? fmt::format("{:.3f}", tt.horizon) : std::string("end"));
+    }
+    if (!horizons.empty()) result.notes.push_back(fmt::format("{}: fitted up to {} s after release (per trial)", names[r], fmt::join(horizons, ", ")));
+  }
+  run.report("locating", 0.2);
+
+  auto base_scores = score(c, baseline, c.all, true);
+  if (!base_scores) return std::unexpected(base_scores.error());
+  std::vector<double> base_chi2(c.ev.trials.size(), 0.0);
+  for (std::size_t k = 0; k < c.all.size(); ++k) base_chi2[c.all[k]] = (*base_scores)[k].alignment.chi_squared;
+  auto sum_over = [&](const std::vector<std::size_t>& which, const std::vector<double>& chi2) {
+    double sum = 0.0;
+    for (std::size_t i : which) sum += chi2[i];
+    return sum;
+  };
+  const Groups all_groups = phase_groups(c, c.all, *base_scores);
+  result.phases = locate(c, all_groups);
+  // The training trials' groups, and the flagged ones, for the signature check.
+  std::vector<TrialScore> train_scores;
+  for (std::size_t k = 0; k < c.all.size(); ++k) {
+    if (c.ev.trials[c.all[k]].training) train_scores.push_back((*base_scores)[k]);
+  }
+  const Groups base_train_groups = phase_groups(c, c.training, train_scores);
+  std::vector<GroupKey> flagged;
+  for (const auto& [key, g] : all_groups) {
+    if (key.phase == Phase::Hold || g.values < 10) continue;
+    const double threshold = 1e-3 / std::max<std::size_t>(1, all_groups.size());
+    if (chi2_tail(g.chi2, g.values) < threshold && g.chi2 / g.values > kPracticalExcess) flagged.push_back(key);
+  }
+
+  // Name: every candidate, on the tests it acts in.
+  const auto library = effect_library();
+  std::vector<Effect> effects = options.effects;
+  if (effects.empty()) {
+    for (const auto& spec : library) effects.push_back(spec.effect);
+  }
+  std::vector<Fitted> fits;
+  std::vector<std::vector<std::size_t>> fit_train, fit_held;
+  std::map<std::string, double> null_chi2;
+  std::map<std::string, Model> null_models;
+  for (std::size_t h = 0; h < effects.size(); ++h) {
+    const EffectSpec& spec = effect_spec(library, effects[h]);
+    run.report("fitting effects", 0.2 + 0.65 * static_cast<double>(h) / static_cast<double>(effects.size()));
+    if (run.should_stop()) return fail(ErrorCode::Cancelled, "cancelled");
+    const auto train = subset(c, c.training, spec.tests);
+    const auto held = subset(c, c.heldout, spec.tests);
+    if (train.empty()) {
+      result.notes.push_back(fmt::format("{} not tested: no recordings of the tests it shows in", spec.name));
+      continue;
+    }
+    auto fit = fit_hypothesis(c, baseline, &spec, spec.tests, train, options.max_evaluations);
+    if (!fit) return std::unexpected(fit.error());
+    // The null refitted on the same trials with the same coefficients free (cached per test set).
+    std::string tests_key;
+    for (LabTest t : spec.tests) tests_key += to_string(t);
+    if (!null_chi2.contains(tests_key)) {
+      auto null_fit = fit_hypothesis(c, baseline, nullptr, spec.tests, train, std::max(12, options.max_evaluations / 2));
+      if (!null_fit) return std::unexpected(null_fit.error());
+      null_chi2[tests_key] = null_fit->chi2;
+      null_models.emplace(tests_key, null_fit->model);
+    }
+    HypothesisReport report;
+    report.name = spec.name;
+    report.evaluations = fit->evaluations;
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k) report.values.push_back({spec.parameters[k].name, fit->model.values[k], NAN, NAN});
+    report.base = fit->model.base;
+    const double chi2_0 = std::min(sum_over(train, base_chi2), null_chi2[tests_key]);
+    report.delta_chi2 = chi2_0 - fit->chi2;
+    auto train_scores_k = score(c, fit->model, train, true);
+    if (!train_scores_k) return std::unexpected(train_scores_k.error());
+    report.values_used = total_values(*train_scores_k);
+    report.delta_bic = report.delta_chi2 - static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
+    if (!held.empty()) {
+      auto held_scores = score(c, fit->model, held, false);
+      if (!held_scores) return std::unexpected(held_scores.error());
+      report.heldout_delta_chi2 = sum_over(held, base_chi2) - total_chi_squared(*held_scores);
+    }
+    report.improves_heldout = !held.empty() && report.heldout_delta_chi2 > 0.0;
+    report.plausible = true;
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
+      const double v = fit->model.values[k];
+      const auto& p = spec.parameters[k];
+      report.plausible = report.plausible && v >= p.plausible_low && v <= p.plausible_high;
+    }
+    if (spec.effect == Effect::ComOffset) {
+      const double offset = std::hypot(fit->model.values[0], fit->model.values[1]);
+      report.plausible = offset >= 2e-4 && offset <= 3e-3;
+    }
+    // Signature: the flagged phases of its tests, on the training trials.
+    std::vector<GroupKey> own;
+    for (const auto& key : flagged) {
+      if (std::find(spec.tests.begin(), spec.tests.end(), recordings[key.recording].test) != spec.tests.end()) own.push_back(key);
+    }
+    const Groups after = phase_groups(c, train, *train_scores_k);
+    report.flagged_excess_before = flagged_excess(base_train_groups, own);
+    report.flagged_excess_after = flagged_excess(after, own);
+    report.clears_signature = report.flagged_excess_before <= 0.0 || report.flagged_excess_after <= 0.5 * report.flagged_excess_before;
+    report.passes = report.delta_bic >= options.min_delta_bic && report.improves_heldout && report.plausible && report.clears_signature;
+    result.hypotheses.push_back(std::move(report));
+    fits.push_back(std::move(*fit));
+    fit_train.push_back(train);
+    fit_held.push_back(held);
+  }
+
+  // Decide.
+  std::vector<std::size_t> order(result.hypotheses.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return result.hypotheses[a].delta_bic > result.hypotheses[b].delta_bic; });
+  std::optional<std::size_t> named;
+  if (!order.empty() && result.hypotheses[order[0]].passes) {
+    const auto& best = result.hypotheses[order[0]];
+    std::vector<std::string> close;
+    for (std::size_t k = 1; k < order.size(); ++k) {
+      const auto& other = result.hypotheses[order[k]];
+      if (other.delta_bic >= options.min_delta_bic && best.delta_bic - other.delta_bic < options.min_delta_bic) close.push_back(other.name);
+    }
+    if (close.empty()) {
+      named = order[0];
+    } else {
+      result.verdict = "ambiguous";
+      result.candidates.push_back(best.name);
+      for (auto& n : close) result.candidates.push_back(n);
+      result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
+      result.statement = fmt::format("The recordings disagree with the baseline, and {} explain it about equally well (delta-BIC {:.1f} vs {:.1f}); "
+                                     "no single effect can be named. To separate them: {}.",
+                                     fmt::join(result.candidates, " and "), best.delta_bic, result.hypotheses[order[1]].delta_bic, result.experiment);
+    }
+  }
+
+  Model improved = baseline;
+  std::vector<TrialScore> improved_scores = *base_scores;
+  if (named) {
+    const std::size_t h = *named;
+    HypothesisReport& report = result.hypotheses[h];
+    improved = fits[h].model;
+    result.verdict = report.name;
+    // 95 % intervals of the effect's parameters from the chi^2 curvature (others held).
+    const EffectSpec& spec = effect_spec(library, *improved.effect);
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
+      const auto& p = spec.parameters[k];
+      const double v = improved.values[k];
+      const double step = p.log_scale ? v * 0.1 : std::max(0.05 * std::abs(v), 0.01 * (p.upper - p.lower));
+      auto chi2_at = [&](double value) -> Result<double> {
+        Model m = improved;
+        m.values[k] = value;
+        auto s = score(c, m, fit_train[h], false);
+        if (!s) return std::unexpected(s.error());
+        return total_chi_squared(*s);
+      };
+      auto lo = chi2_at(v - step), hi = chi2_at(v + step);
+      if (!lo || !hi) return std::unexpected(!lo ? lo.error() : hi.error());
+      const double curvature = (*lo + *hi - 2.0 * fits[h].chi2) / (step * step);
+      // Scaled by the fit's reduced chi^2 when it is above 1 (a misfit the noise does not explain).
+      const double inflation = std::sqrt(std::max(1.0, fits[h].chi2 / std::max(1, report.values_used)));
+      const double se = curvature > 0.0 ? inflation * std::sqrt(2.0 / curvature) : kNever;
+      report.values[k].low = std::max(p.lower, v - 1.96 * se);
+      report.values[k].high = std::min(p.upper, v + 1.96 * se);
+    }
+    result.effect_parameters = report.values;
+    auto s = score(c, improved, c.all, true);
+    if (!s) return std::unexpected(s.error());
+    improved_scores = std::move(*s);
+    result.statement = fmt::format("Missing physics found: {} ({}), {}; it improves the training fit by delta-chi^2 {:.0f} (delta-BIC {:.1f}, next best "
+                                   "{}) and the held-out trials by delta-chi^2 {:.0f}.",
+                                   report.name, spec.description,
+                                   fmt::join(report.values | std::views::transform([](const ParameterValue& p) {
+                                               return fmt::format("{} = {:.4g} [{:.4g}, {:.4g}]", p.name, p.value, p.low, p.high);
+                                             }),
+                                             ", "),
+                                   report.delta_chi2, report.delta_bic,
+                                   order.size() > 1 ? fmt::format("{} at {:.1f}", result.hypotheses[order[1]].name, result.hypotheses[order[1]].delta_bic)
+                                                    : std::string("none"),
+                                   report.heldout_delta_chi2);
+  }
+  result.improved = improved.base;
+  const Groups improved_groups = phase_groups(c, c.all, improved_scores);
+  // Whole tracks (beyond the horizons) for the summaries and the plots.
+  c.ev.full_duration = true;
+  auto full_base = score(c, baseline, c.all, true);
+  if (!full_base) return std::unexpected(full_base.error());
+  auto full_improved = named ? score(c, improved, c.all, true) : full_base;
+  if (!full_improved) return std::unexpected(full_improved.error());
+  c.ev.full_duration = false;
+  result.before = quality(c, *full_base);
+  result.after = quality(c, *full_improved);
+  for (auto& p : result.phases) {
+    for (const auto& [key, g] : improved_groups) {
+      if (c.names[key.recording] == p.recording && phase_name(key.phase) == p.phase && g.values > 0) p.improved_chi2_per_value = g.chi2 / g.values;
+    }
+  }
+  // A smooth discrepancy the named effect (or the baseline) leaves, phase by phase.
+  for (const auto& [key, g] : improved_groups) {
+    if (key.phase == Phase::Hold || g.values < 20) continue;
+    int parameters = 0;
+    const double gain = smooth_discrepancy_gain(g, parameters);
+    const double threshold = 1e-3 / std::max<std::size_t>(1, improved_groups.size());
+    if (parameters > 0 && gain - parameters * std::log(g.values) >= options.min_delta_bic && chi2_tail(g.chi2, g.values) < threshold &&
+        g.chi2 / g.values > kPracticalExcess) {
+      result.unexplained.push_back(fmt::format("{} phases of {}", phase_name(key.phase), recording_label(recordings[key.recording], c.names[key.recording])));
+    }
+  }
+  if (!named && result.verdict.empty()) {
+    if (!result.unexplained.empty()) {
+      result.verdict = "unexplained";
+      result.statement = fmt::format("Mismatch not explained by any known effect in: {}. A smooth per-phase discrepancy removes it (delta-BIC >= {:g}), "
+                                     "but none of the {} candidate effects passes every check.",
+                                     fmt::join(result.unexplained, "; "), options.min_delta_bic, result.hypotheses.size());
+      result.experiment = "look at the residual plots of these phases; add set-ups that isolate them";
+    } else {
+      result.verdict = "none";
+      // The smallest effect the data could have shown: the strong magnitude's signal, scaled.
+      std::vector<std::string> limits;
+      for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
+        auto& report = result.hypotheses[h];
+        const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
+        // Probed at a fifth of the realistic magnitude, where the signal grows about quadratically.
+        Model probe = baseline;
+        probe.effect = spec.effect;
+        for (const auto& p : spec.parameters) probe.values.push_back(p.log_scale ? p.realistic : 0.2 * p.realistic);
+        auto s = score(c, probe, fit_train[h], false);
+        if (!s) return std::unexpected(s.error());
+        const double signal = total_chi_squared(*s) - sum_over(fit_train[h], base_chi2);
+        const double needed = options.min_delta_bic + static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
+        const auto& first = spec.parameters[0];
+        if (first.log_scale) {
+          report.smallest_detectable = signal >= needed ? first.realistic : NAN;
+          limits.push_back(signal >= needed ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.realistic)
+                                            : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.realistic));
+        } else {
+          const double null_value = spec.effect == Effect::ComOffset ? 0.0 : first.lower;
+          const double probed = 0.2 * first.realistic;
+          report.smallest_detectable = signal > 0.0 ? null_value + (probed - null_value) * std::sqrt(needed / signal) : kNever;
+          limits.push_back(fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable));
+        }
+      }
+      result.statement = fmt::format("No missing physics found: no candidate passes every check and the residuals are consistent with the {:s} noise "
+                                     "level after the baseline fit. Smallest effects these recordings would have revealed (at delta-BIC {:g}, "
+                                     "base coefficients held): {}.",
+                                     "estimated", options.min_delta_bic, fmt::join(limits, "; "));
+    }
+  }
+  // Plots: each recording's first trial against both models.
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    for (std::size_t k = 0; k < c.all.size(); ++k) {
+      const TrackedTrial& tt = c.ev.trials[c.all[k]];
+      if (tt.recording != r) continue;
+      TrackComparison cmp;
+      cmp.recording = names[r];
+      cmp.horizon = tt.horizon;
+      const Track& track = *recordings[r].trials[tt.trial].track;
+      const Alignment& a = (*full_base)[k].alignment;
+      for (std::size_t f = 0; f < track.size(); ++f) {
+        cmp.t.push_back(track.t[f] - a.shift);
+        cmp.x.push_back(track.x[f] - a.x_offset);
+        cmp.z.push_back(track.z[f]);
+      }
+      const double end = cmp.t.back();
+      auto sampled = [&](const std::vector<ReplaySample>& replay, std::vector<double>& t, std::vector<double>& x, std::vector<double>& z) {
+        for (std::size_t s = 0; s < replay.size(); s += 10) {
+          if (replay[s].t < cmp.t.front() || replay[s].t > end) continue;
+          t.push_back(replay[s].t);
+          x.push_back(replay[s].x);
+          z.push_back(replay[s].z);
+        }
+      };
+      sampled((*full_base)[k].replay, cmp.baseline_t, cmp.baseline_x, cmp.baseline_z);
+      sampled((*full_improved)[k].replay, cmp.improved_t, cmp.improved_x, cmp.improved_z);
+      // The improved model's own x origin differs slightly: shift its curve onto the recording's frame.
+      const double dx = (*full_improved)[k].alignment.x_offset - a.x_offset;
+      for (double& x : cmp.improved_x) x += dx;
+      result.tracks.push_back(std::move(cmp));
+      break;
+    }
+  }
+  result.evaluations = c.evaluations;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  run.report("done", 1.0);
+  return result;
+}
+
+}  // namespace clumpforge

@@ -1,0 +1,121 @@
+#pragma once
+/// Mismatch diagnosis: where the DEM and the recordings disagree, which physics the model
+/// left out, and how much better the fit gets once it is added.
+///
+/// 1. Baseline: e, mu_s and mu_r per surface fitted to the tracks (training trials), with
+///    the measurement modelled: time origin and horizontal origin per track, noise level
+///    from the data, lost frames and cells skipped, the visible centroid tracked.
+/// 2. Locate: every frame gets a phase; per recording and phase the residual's chi^2,
+///    bias and growth law against the noise level.
+/// 3. Name: each candidate effect of the library refitted with the base parameters of
+///    the tests it acts in; judged by delta-BIC on training trials, the change on held-out
+///    trials, a plausible value, and whether the flagged phases are cleared.
+/// 4. Decide: a name only when one effect passes every check and beats the next best by the
+///    margin; otherwise "ambiguous" (with the experiment that separates them),
+///    "unexplained" (a smooth per-phase discrepancy the library cannot account for), "none"
+///    (with the smallest effect the data would have shown) or "undecidable" (too little or
+///    too noisy data).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/clump.hpp"
+#include "core/recording.hpp"
+#include "core/run_context.hpp"
+#include "diagnose/effects.hpp"
+#include "dem/lab.hpp"
+
+namespace clumpforge {
+
+struct DiagnoseOptions {
+  LabOptions lab;                  ///< contact settings, particle material, time step
+  std::vector<Effect> effects;     ///< candidates (empty: the whole library)
+  double min_delta_bic = 10.0;     ///< margin over the baseline and over the next best
+  int max_evaluations = 45;        ///< per hypothesis fit
+  double horizon_perturbation = 1e-4;  ///< [rad] release-orientation uncertainty for the predictability horizon
+  int orientation_candidates = 16; ///< tried per trial whose release orientation was not recorded
+  std::uint64_t seed = 1;
+};
+
+struct PhaseReport {
+  std::string recording;   ///< recording name
+  std::string phase;
+  int values = 0;          ///< residual cells (x and z)
+  double chi2_per_value = 0.0;
+  double p_value = 1.0;    ///< chi^2 against the noise level (Wilson-Hilferty)
+  bool significant = false;  ///< p below 0.001 / (number of groups) and chi^2/value above 1.1
+  double bias_x_mm = 0.0, bias_z_mm = 0.0;   ///< mean residual, recorded - model
+  int growth_power = 0;    ///< residual grows like t^k within the phase (0: no trend)
+  double end_residual_mm = 0.0;  ///< the fitted growth law at the phase's typical end (z, or x when larger)
+  std::string axis = "z";
+  std::string statement;
+  double improved_chi2_per_value = 0.0;  ///< under the improved model (= baseline when none)
+};
+
+struct ParameterValue {
+  std::string name;
+  double value = 0.0, low = 0.0, high = 0.0;  ///< 95 % interval [low, high]
+};
+
+struct HypothesisReport {
+  std::string name;
+  std::vector<ParameterValue> values;
+  std::vector<SurfaceParameters> base;
+  int values_used = 0;                 ///< training residual cells in its tests
+  double delta_chi2 = 0.0;             ///< training: baseline - hypothesis
+  double delta_bic = 0.0;              ///< delta_chi2 - k ln n
+  double heldout_delta_chi2 = 0.0;     ///< held-out trials: baseline - hypothesis
+  bool plausible = false, improves_heldout = false, clears_signature = false, passes = false;
+  double flagged_excess_before = 0.0, flagged_excess_after = 0.0;  ///< chi^2 - values in the baseline's flagged phases
+  int evaluations = 0;
+  double smallest_detectable = 0.0;    ///< of its first parameter (reported with verdict "none")
+};
+
+struct FitQuality {
+  double train_rms_mm = 0.0, heldout_rms_mm = 0.0;  ///< position residual RMS over fitted frames
+  double train_chi2_per_value = 0.0, heldout_chi2_per_value = 0.0;
+  std::vector<std::pair<std::string, double>> summary_error;  ///< per recording: model mean - recorded mean (mm or deg)
+};
+
+/// What the plots need: per recording, its first trial's track against both models.
+struct TrackComparison {
+  std::string recording;
+  std::vector<double> t, x, z;                   ///< recorded (replay time, horizontal origin removed)
+  std::vector<double> baseline_t, baseline_x, baseline_z;
+  std::vector<double> improved_t, improved_x, improved_z;
+  double horizon = 0.0;
+};
+
+struct DiagnoseResult {
+  std::string verdict;                 ///< "none", "ambiguous", "unexplained", "undecidable" or the effect's name
+  std::string statement;               ///< one paragraph for a person
+  std::vector<std::string> candidates; ///< ambiguous: the effects it could be
+  std::string experiment;              ///< what would separate them / reveal more
+  std::vector<ParameterValue> effect_parameters;
+  std::vector<std::pair<std::string, double>> noise_m;  ///< per recording, estimated
+  std::vector<SurfaceParameters> baseline, improved;
+  FitQuality before, after;
+  std::vector<PhaseReport> phases;
+  std::vector<HypothesisReport> hypotheses;
+  std::vector<std::string> unexplained;  ///< phases a smooth discrepancy explains and no effect does
+  std::vector<TrackComparison> tracks;
+  std::vector<std::string> notes;
+  bool summaries_only = false;         ///< no tracks: what summaries can and cannot decide (in `decidable`, `undecidable`)
+  std::vector<std::string> decidable, undecidable;
+  int tracked_trials = 0, training_trials = 0, evaluations = 0;
+  double seconds = 0.0;
+};
+
+/// Diagnoses `recordings` (names parallel to them) for `clump`. Recordings without tracks
+/// give the summaries-only statement (see diagnose_summaries).
+Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, const std::vector<Recording>& recordings,
+                                const std::vector<std::string>& names, const DiagnoseOptions& options, const RunContext& context = {});
+
+/// What summaries alone (no tracks) can and cannot decide: a joint calibration of the
+/// means, the restitution gap explained by multi-contact impacts and rotation, and the
+/// effects that need tracks or more set-ups. Verdict "none" with decidable = false notes.
+Result<DiagnoseResult> diagnose_summaries(const Clump& clump, const MaterialTable& table, const std::vector<Recording>& recordings,
+                                          const std::vector<std::string>& names, const DiagnoseOptions& options,
+                                          const RunContext& context = {});
+
+}  // namespace clumpforge

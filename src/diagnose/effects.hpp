@@ -1,0 +1,59 @@
+#pragma once
+/// The diagnosis's library of candidate physics: each effect is a DEM term (or the centre of
+/// mass offset) with one or two parameters, their search and plausible ranges, the tests it
+/// shows in, and how it is switched on in a lab run. Fixed before any data is seen.
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/recording.hpp"
+#include "dem/lab.hpp"
+
+namespace clumpforge {
+
+enum class Effect {
+  AirDrag,
+  ViscoelasticRestitution,
+  ElasticPlasticRestitution,
+  PlasticSubstrate,
+  ViscousRolling,
+  EpsdRolling,
+  Adhesion,
+  ComOffset,
+  StaticKineticFriction,
+};
+
+struct EffectParameter {
+  std::string name;     ///< JSON key, SI unit in the name (e.g. "drag_coefficient", "offset_x_m")
+  double lower = 0.0, upper = 1.0;           ///< search range
+  double plausible_low = 0.0, plausible_high = 1.0;  ///< physically plausible values
+  double start = 0.0;   ///< first guess of a fit
+  double realistic = 0.0, strong = 0.0;      ///< magnitudes for concealed-effect recordings
+  bool log_scale = false;  ///< searched in log10
+};
+
+struct EffectSpec {
+  Effect effect = Effect::AirDrag;
+  std::string name;          ///< the verdict's name, e.g. "air_drag"
+  std::string description;   ///< one line, for reports
+  std::vector<EffectParameter> parameters;
+  std::vector<LabTest> tests;  ///< where it shows (the fit uses these recordings)
+};
+
+/// The whole library, in a fixed order.
+std::vector<EffectSpec> effect_library();
+const EffectSpec& effect_spec(const std::vector<EffectSpec>& library, Effect effect);
+Result<Effect> parse_effect(std::string_view name);
+
+/// Switches `effect` on in `options` with parameter values `values` (one per parameter).
+void apply_effect(Effect effect, std::span<const double> values, LabOptions& options);
+
+/// The base parameters the diagnosis calibrates, per surface (the particle is the clump's material).
+struct SurfaceParameters {
+  std::string surface;
+  Interaction interaction;
+};
+
+}  // namespace clumpforge

@@ -1,0 +1,115 @@
+#include "diagnose/model.hpp"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace clumpforge {
+LabOptions lab_options_for(const Evaluator& ev, const Model& model, const Recording& recording) {
+  LabOptions options = ev.lab;
+  for (const auto& base : model.base) {
+    if (base.surface == recording.surface) options.interaction = base.interaction;
+  }
+  if (model.effect) apply_effect(*model.effect, model.values, options);
+  if (recording.tilt_rate_deg_per_s) options.tilt_rate_deg_per_s = *recording.tilt_rate_deg_per_s;
+  return options;
+}
+
+double replay_summary(const std::vector<ReplaySample>& replay, LabTest test) {
+  if (replay.empty()) return std::numeric_limits<double>::quiet_NaN();
+  switch (test) {
+    case LabTest::Drop: {
+      bool touched = false, left = false;
+      double apex = 0.0;
+      for (const auto& s : replay) {
+        if (!touched) {
+          touched = s.contacts > 0;
+          continue;
+        }
+        if (s.contacts == 0) left = true;
+        if (left && s.contacts > 0) break;
+        if (left) apex = std::max(apex, s.lowest);
+      }
+      return apex;
+    }
+    case LabTest::Roll: return std::max(0.0, replay.back().x);
+    case LabTest::Tilt: {
+      const double start = replay.front().along_plate;
+      for (const auto& s : replay) {
+        if (std::abs(s.along_plate - start) > 1e-3) return s.tilt_deg;
+      }
+      return 90.0;
+    }
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model, const std::vector<std::size_t>& which, bool keep_replays) {
+  const auto& recordings = *ev.recordings;
+  // One lab world per recording that is needed.
+  std::vector<std::optional<LabWorld>> worlds(recordings.size());
+  std::vector<LabOptions> options(recordings.size());
+  for (std::size_t i : which) {
+    const std::size_t r = ev.trials[i].recording;
+    if (worlds[r]) continue;
+    options[r] = lab_options_for(ev, model, recordings[r]);
+    auto made = make_lab_world(*ev.clump, *ev.table, recordings[r], options[r]);
+    if (!made) return std::unexpected(made.error());
+    worlds[r] = std::move(*made);
+  }
+  std::vector<TrialScore> scores(which.size());
+  tbb::parallel_for(std::size_t{0}, which.size(), [&](std::size_t k) {
+    const TrackedTrial& tt = ev.trials[which[k]];
+    const Recording& recording = recordings[tt.recording];
+    ReplayOptions replay;
+    replay.duration = ev.full_duration ? tt.duration : std::min(tt.duration, tt.horizon + 0.02);
+    replay.sample_interval = ev.sample_interval;
+    replay.record_from = tt.record_from;
+    auto samples = replay_trial(*worlds[tt.recording], recording, tt.orientation, options[tt.recording], replay);
+    const Track& track = *recording.trials[tt.trial].track;
+    const bool x_offset = recording.test != LabTest::Roll;
+    const double sigma = ev.sigma[tt.recording];
+    TrialScore& score = scores[k];
+    if (ev.shift.size() == ev.trials.size()) {
+      score.alignment = align(track, samples, sigma, x_offset, ev.shift[which[k]], ev.shift_window, ev.shift_window / 6.0, tt.cutoff);
+    } else {
+      score.alignment = align(track, samples, sigma, x_offset, tt.shift_guess, ev.shift_range[which[k]], 5e-4, tt.cutoff);
+    }
+    score.summary = replay_summary(samples, recording.test);
+    if (keep_replays) score.replay = std::move(samples);
+  });
+  return scores;
+}
+
+double total_chi_squared(const std::vector<TrialScore>& scores) {
+  double sum = 0.0;
+  for (const auto& s : scores) sum += s.alignment.chi_squared;
+  return sum;
+}
+
+int total_values(const std::vector<TrialScore>& scores) {
+  int sum = 0;
+  for (const auto& s : scores) sum += s.alignment.values;
+  return sum;
+}
+
+Result<void> initialise_shifts(Evaluator& ev, const Model& model) {
+  ev.shift.clear();
+  if (ev.shift_range.size() != ev.trials.size()) {
+    ev.shift_range.assign(ev.trials.size(), 0.0);
+    for (std::size_t i = 0; i < ev.trials.size(); ++i) {
+      const LabTest test = (*ev.recordings)[ev.trials[i].recording].test;
+      ev.shift_range[i] = test == LabTest::Drop ? 0.02 : test == LabTest::Tilt ? 0.02 : 0.3;
+    }
+  }
+  std::vector<std::size_t> all(ev.trials.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  auto scores = evaluate(ev, model, all, false);
+  if (!scores) return std::unexpected(scores.error());
+  ev.shift.resize(ev.trials.size());
+  for (std::size_t i = 0; i < all.size(); ++i) ev.shift[i] = (*scores)[i].alignment.shift;
+  return {};
+}
+
+}  // namespace clumpforge

@@ -1,0 +1,78 @@
+#pragma once
+/// Replaying every tracked trial under a candidate model and scoring it against the camera:
+/// the base parameters per surface, optionally one effect with its values, and the
+/// measurement nuisances (time shift and horizontal origin per track) fitted inside.
+#include <optional>
+#include <vector>
+
+#include "core/clump.hpp"
+#include "core/recording.hpp"
+#include "core/run_context.hpp"
+#include "diagnose/effects.hpp"
+#include "diagnose/tracks.hpp"
+#include "dem/lab.hpp"
+
+namespace clumpforge {
+
+struct TrackedTrial {
+  std::size_t recording = 0, trial = 0;  ///< indices into the recordings
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< release orientation
+  bool training = true;                  ///< false: held out of every fit
+  double shift_guess = 0.0;              ///< [s] from the data alone
+  double duration = 0.0;                 ///< [s] replayed after release
+  double record_from = 0.0;              ///< [s] first replay time the camera saw (tilt)
+  /// [s] replay time up to which the trajectory is predictable: replays from release
+  /// orientations 0.1 mrad apart stay within the noise level until then. An irregular
+  /// body's later bounces and tumbles depend on its release state beyond what any lab
+  /// knows, so frames after it are not fitted (they are still shown).
+  double horizon = std::numeric_limits<double>::infinity();
+  double cutoff = std::numeric_limits<double>::infinity();  ///< the horizon in the track's own time [s]
+};
+
+struct Model {
+  std::vector<SurfaceParameters> base;  ///< one per surface of the recordings
+  std::optional<Effect> effect;
+  std::vector<double> values;           ///< the effect's parameter values
+};
+
+struct TrialScore {
+  Alignment alignment;
+  std::vector<ReplaySample> replay;     ///< kept when asked
+  double summary = std::numeric_limits<double>::quiet_NaN();  ///< the replay's summary value (SI, deg for tilt)
+};
+
+/// The set-up shared by every evaluation of a diagnosis.
+struct Evaluator {
+  const Clump* clump = nullptr;
+  const MaterialTable* table = nullptr;
+  const std::vector<Recording>* recordings = nullptr;
+  std::vector<double> sigma;            ///< per recording [m]
+  std::vector<TrackedTrial> trials;
+  LabOptions lab;                       ///< contact settings, time step, particle material
+  double sample_interval = 1e-4;        ///< replay sampling [s]
+  double shift_window = 3e-3;           ///< the time shift is refitted within +-this of its first value [s]
+  std::vector<double> shift;            ///< per trial, fixed by `initialise`
+  std::vector<double> shift_range;      ///< per trial: half range of the first alignment [s]
+  bool full_duration = false;           ///< replay whole tracks, not only up to each trial's horizon (plots, summaries)
+};
+
+/// Replays and scores the trials `which` (indices into evaluator.trials) under `model`,
+/// in parallel; results do not depend on the thread count.
+Result<std::vector<TrialScore>> evaluate(const Evaluator& evaluator, const Model& model, const std::vector<std::size_t>& which,
+                                         bool keep_replays);
+
+/// The lab options of `model` for one recording (its surface's coefficients, the effect).
+LabOptions lab_options_for(const Evaluator& evaluator, const Model& model, const Recording& recording);
+
+/// Sum of the chi^2 of `scores`.
+double total_chi_squared(const std::vector<TrialScore>& scores);
+int total_values(const std::vector<TrialScore>& scores);
+
+/// First alignment of every trial under `model` over a wide window; fixes evaluator.shift.
+Result<void> initialise_shifts(Evaluator& evaluator, const Model& model);
+
+/// The summary a replay predicts: rebound apex of the lowest point (drop), distance on the
+/// flat at the end (roll), plate angle at 1 mm of slip (tilt).
+double replay_summary(const std::vector<ReplaySample>& replay, LabTest test);
+
+}  // namespace clumpforge

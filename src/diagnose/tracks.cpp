@@ -1,0 +1,159 @@
+#include "diagnose/tracks.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace clumpforge {
+
+double frame_interval(const Track& track) {
+  std::vector<double> gaps;
+  for (std::size_t i = 1; i < track.size(); ++i) gaps.push_back(track.t[i] - track.t[i - 1]);
+  if (gaps.empty()) return 0.0;
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+  return gaps[gaps.size() / 2];
+}
+
+double estimate_noise(const std::vector<const Track*>& tracks) {
+  std::vector<double> differences;
+  for (const Track* track : tracks) {
+    const double interval = frame_interval(*track);
+    for (std::size_t i = 3; i < track->size(); ++i) {
+      bool consecutive = true;
+      for (std::size_t k = i - 2; k <= i; ++k) consecutive = consecutive && std::abs(track->t[k] - track->t[k - 1] - interval) < 0.25 * interval;
+      if (!consecutive) continue;
+      for (const auto* column : {&track->x, &track->z}) {
+        const auto& c = *column;
+        const double d = c[i] - 3.0 * c[i - 1] + 3.0 * c[i - 2] - c[i - 3];
+        if (std::isfinite(d)) differences.push_back(std::abs(d));
+      }
+    }
+  }
+  if (differences.size() < 10) return std::numeric_limits<double>::quiet_NaN();
+  std::nth_element(differences.begin(), differences.begin() + static_cast<std::ptrdiff_t>(differences.size() / 2), differences.end());
+  // For Gaussian noise the median |d| is 0.6745 sd(d), sd(d) = sqrt(20) sigma.
+  return differences[differences.size() / 2] / (0.6744897501960817 * std::sqrt(20.0));
+}
+
+ReplayPoint interpolate(const std::vector<ReplaySample>& replay, double t) {
+  if (t <= replay.front().t) return {replay.front().x, replay.front().z, 0};
+  if (t >= replay.back().t) return {replay.back().x, replay.back().z, replay.size() - 1};
+  // Uniform after the first sample (a replay may skip a stretch after its first sample).
+  std::size_t i = 0;
+  if (replay.size() > 2 && t >= replay[1].t) {
+    const double interval = replay[2].t - replay[1].t;
+    i = 1 + static_cast<std::size_t>((t - replay[1].t) / interval);
+    i = std::min(i, replay.size() - 2);
+  }
+  while (i > 0 && replay[i].t > t) --i;
+  while (i + 2 < replay.size() && replay[i + 1].t <= t) ++i;
+  const double f = (t - replay[i].t) / (replay[i + 1].t - replay[i].t);
+  return {replay[i].x + f * (replay[i + 1].x - replay[i].x), replay[i].z + f * (replay[i + 1].z - replay[i].z), i};
+}
+
+Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, bool fit_x_offset, double cutoff) {
+  Alignment a;
+  a.shift = shift;
+  if (fit_x_offset) {
+    double sum = 0.0;
+    int count = 0;
+    for (std::size_t i = 0; i < track.size(); ++i) {
+      if (!std::isfinite(track.x[i]) || track.t[i] > cutoff) continue;
+      sum += track.x[i] - interpolate(replay, track.t[i] - shift).x;
+      ++count;
+    }
+    a.x_offset = count > 0 ? sum / count : 0.0;
+  }
+  double chi = 0.0;
+  int values = 0;
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    if (track.t[i] > cutoff) break;
+    const ReplayPoint p = interpolate(replay, track.t[i] - shift);
+    if (std::isfinite(track.x[i])) {
+      const double r = (track.x[i] - p.x - a.x_offset) / sigma;
+      chi += r * r;
+      ++values;
+    }
+    if (std::isfinite(track.z[i])) {
+      const double r = (track.z[i] - p.z) / sigma;
+      chi += r * r;
+      ++values;
+    }
+  }
+  a.chi_squared = chi;
+  a.values = values;
+  return a;
+}
+
+Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, bool fit_x_offset, double guess,
+                double half_range, double step, double cutoff) {
+  Alignment best = score(track, replay, sigma, guess, fit_x_offset, cutoff);
+  for (double s = guess - half_range; s <= guess + half_range + 1e-12; s += step) {
+    Alignment a = score(track, replay, sigma, s, fit_x_offset, cutoff);
+    if (a.chi_squared < best.chi_squared) best = a;
+  }
+  // Golden section on [best - step, best + step].
+  constexpr double kGolden = 0.6180339887498949;
+  double lo = best.shift - step, hi = best.shift + step;
+  double c = hi - kGolden * (hi - lo), d = lo + kGolden * (hi - lo);
+  Alignment fc = score(track, replay, sigma, c, fit_x_offset, cutoff), fd = score(track, replay, sigma, d, fit_x_offset, cutoff);
+  while (hi - lo > 1e-6) {
+    if (fc.chi_squared < fd.chi_squared) {
+      hi = d;
+      d = c;
+      fd = fc;
+      c = hi - kGolden * (hi - lo);
+      fc = score(track, replay, sigma, c, fit_x_offset, cutoff);
+    } else {
+      lo = c;
+      c = d;
+      fc = fd;
+      d = lo + kGolden * (hi - lo);
+      fd = score(track, replay, sigma, d, fit_x_offset, cutoff);
+    }
+  }
+  for (const Alignment& a : {fc, fd}) {
+    if (a.chi_squared < best.chi_squared) best = a;
+  }
+  return best;
+}
+
+double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s) {
+  if (track.size() == 0) return 0.0;
+  if (test == LabTest::Tilt && !track.tilt.empty() && tilt_rate_deg_per_s > 0.0) {
+    double sum = 0.0;
+    int count = 0;
+    for (std::size_t i = 0; i < track.size(); ++i) {
+      if (!std::isfinite(track.tilt[i])) continue;
+      sum += track.t[i] - track.tilt[i] / tilt_rate_deg_per_s;
+      ++count;
+    }
+    if (count > 0) return sum / count;
+  }
+  if (test == LabTest::Drop) {
+    double start = std::numeric_limits<double>::quiet_NaN();
+    for (std::size_t i = 0; i < track.size(); ++i) {
+      if (!std::isfinite(track.z[i])) continue;
+      if (std::isnan(start)) start = track.z[i];
+      if (track.z[i] < start - 2e-3) return track.t[i] - std::sqrt(2.0 * 2e-3 / 9.81);
+    }
+  }
+  return track.t.front();
+}
+
+std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, double sigma, const Alignment& a) {
+  std::vector<FrameResidual> out;
+  out.reserve(track.size());
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    const double t = track.t[i] - a.shift;
+    const ReplayPoint p = interpolate(replay, t);
+    FrameResidual r;
+    r.t = t;
+    r.sample = p.index;
+    r.rx = std::isfinite(track.x[i]) ? (track.x[i] - p.x - a.x_offset) / sigma : std::numeric_limits<double>::quiet_NaN();
+    r.rz = std::isfinite(track.z[i]) ? (track.z[i] - p.z) / sigma : std::numeric_limits<double>::quiet_NaN();
+    out.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace clumpforge

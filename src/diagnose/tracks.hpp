@@ -1,0 +1,61 @@
+#pragma once
+/// The measurement model: what a camera makes of a replayed trial. The recorded track's
+/// time origin is unknown (a shift is fitted per track), a drop's or tilt's horizontal origin
+/// too (an offset), frames may be missing and cells empty, and positions carry noise whose
+/// level is estimated from the data. The tracked point is the body's visible centroid.
+#include <limits>
+#include <vector>
+
+#include "core/recording.hpp"
+#include "dem/lab.hpp"
+
+namespace clumpforge {
+
+/// Camera noise [m] from a set of tracks: the median absolute third difference of x and z
+/// over runs of consecutive frames, scaled to a standard deviation (third differences of
+/// white noise have variance 20 sigma^2; smooth motion adds (jerk dt^3), negligible at high
+/// frame rates; impacts are outliers the median ignores). NaN when fewer than 10 differences.
+double estimate_noise(const std::vector<const Track*>& tracks);
+
+/// The frame interval of a track: the median spacing of its times [s].
+double frame_interval(const Track& track);
+
+/// Linear interpolation of a replay at time t (held at its first sample before it starts).
+struct ReplayPoint {
+  double x = 0.0, z = 0.0;
+  std::size_t index = 0;  ///< the sample at or before t
+};
+ReplayPoint interpolate(const std::vector<ReplaySample>& replay, double t);
+
+struct Alignment {
+  double shift = 0.0;     ///< t_replay = t_recorded - shift [s]
+  double x_offset = 0.0;  ///< x_recorded = x_replay + x_offset [m]
+  double chi_squared = 0.0;
+  int values = 0;         ///< recorded cells used
+};
+
+/// chi^2 of `track` against `replay` for a given shift (x offset fitted when asked), over
+/// the frames recorded up to `cutoff` (recorded time; beyond it the release state cannot
+/// predict the trajectory, see TrackedTrial::horizon). The cutoff does not move with the
+/// shift, so every shift is scored on the same frames.
+Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, bool fit_x_offset,
+                double cutoff = std::numeric_limits<double>::infinity());
+
+/// Best shift in [guess - half_range, guess + half_range]: a grid of `step`, then a golden
+/// section to 1 microsecond around the best grid point.
+Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, bool fit_x_offset, double guess,
+                double half_range, double step, double cutoff = std::numeric_limits<double>::infinity());
+
+/// A first guess of the shift from the data alone: for a drop, the release instant from the
+/// first 2 mm of fall; for a tilt, the plate angle column; otherwise the first frame.
+double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s);
+
+/// One recorded frame against the replay: residuals in units of sigma.
+struct FrameResidual {
+  double t = 0.0;           ///< replay time [s]
+  double rx = 0.0, rz = 0.0;  ///< (recorded - replay) / sigma; NaN for an empty cell
+  std::size_t sample = 0;   ///< replay sample index at t
+};
+std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, double sigma, const Alignment& a);
+
+}  // namespace clumpforge

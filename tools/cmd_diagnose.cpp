@@ -1,0 +1,276 @@
+// clumpforge diagnose --recordings DIR... (--mesh MESH | --clump CLUMP.h5) [--out DIR] [--json]
+// Where the DEM and the recordings disagree, which physics is missing, and the fit once it is added.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "core/atomic_file.hpp"
+#include "diagnose/diagnose.hpp"
+#include "fill/fill.hpp"
+#include "io/clump_library.hpp"
+#include "io/materials_io.hpp"
+#include "io/recording_io.hpp"
+#include "io/svg_plot.hpp"
+
+namespace fs = std::filesystem;
+
+namespace clumpforge::cli {
+namespace {
+
+struct DiagnoseArgs {
+  std::vector<std::string> recordings, effects;
+  std::string mesh, clump, clump_name, out, materials, units = "mm";
+  double density = 1085.0;
+  int spheres = 32, max_evaluations = 45;
+  std::uint64_t seed = 1;
+  bool json = false;
+};
+
+// A recording directory, or a directory of recording directories (sorted by name).
+Result<void> collect(const std::string& path, std::vector<Recording>& recordings, std::vector<std::string>& names) {
+  const fs::path p(path);
+  std::error_code ec;
+  if (fs::is_regular_file(p / "recording.json", ec) || (fs::is_regular_file(p, ec) && p.filename() == "recording.json")) {
+    auto r = read_recording(p);
+    if (!r) return std::unexpected(r.error());
+    recordings.push_back(std::move(*r));
+    names.push_back(fs::is_directory(p, ec) ? p.filename().string() : p.parent_path().filename().string());
+    if (names.back().empty()) names.back() = fs::absolute(p).filename().string();
+    return {};
+  }
+  if (!fs::is_directory(p, ec)) return fail(ErrorCode::NotFound, fmt::format("{}: no such recording directory", path));
+  std::vector<fs::path> children;
+  for (const auto& entry : fs::directory_iterator(p, ec)) {
+    if (entry.is_directory() && fs::is_regular_file(entry.path() / "recording.json")) children.push_back(entry.path());
+  }
+  if (children.empty()) return fail(ErrorCode::NotFound, fmt::format("{}: neither a recording (recording.json) nor a directory of recordings", path));
+  std::sort(children.begin(), children.end());
+  for (const auto& child : children) {
+    auto r = read_recording(child);
+    if (!r) return std::unexpected(r.error());
+    recordings.push_back(std::move(*r));
+    names.push_back(child.filename().string());
+  }
+  return {};
+}
+
+nlohmann::json coefficients_json(const std::vector<SurfaceParameters>& base) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& b : base) {
+    out[b.surface] = {{"restitution", b.interaction.restitution}, {"static_friction", b.interaction.static_friction},
+                      {"rolling_friction", b.interaction.rolling_friction}};
+  }
+  return out;
+}
+
+nlohmann::json quality_json(const FitQuality& q) {
+  nlohmann::json summary = nlohmann::json::object();
+  for (const auto& [name, v] : q.summary_error) summary[name] = v;
+  return {{"train_rms_mm", q.train_rms_mm}, {"heldout_rms_mm", q.heldout_rms_mm}, {"train_chi2_per_value", q.train_chi2_per_value},
+          {"heldout_chi2_per_value", q.heldout_chi2_per_value}, {"summary_error_mm_or_deg", summary}};
+}
+
+nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_name) {
+  nlohmann::json j;
+  j["format"] = "clumpforge-diagnosis/1";
+  j["clump"] = clump_name;
+  j["verdict"] = r.verdict;
+  j["statement"] = r.statement;
+  j["candidates"] = r.candidates;
+  j["experiment"] = r.experiment;
+  j["effect_parameters"] = nlohmann::json::object();
+  for (const auto& p : r.effect_parameters) j["effect_parameters"][p.name] = {{"value", p.value}, {"low", p.low}, {"high", p.high}};
+  j["summaries_only"] = r.summaries_only;
+  j["decidable"] = r.decidable;
+  j["undecidable"] = r.undecidable;
+  j["noise_m"] = nlohmann::json::object();
+  for (const auto& [name, s] : r.noise_m) j["noise_m"][name] = s;
+  j["baseline"] = coefficients_json(r.baseline);
+  j["improved"] = coefficients_json(r.improved);
+  j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
+  j["phases"] = nlohmann::json::array();
+  for (const auto& p : r.phases) {
+    j["phases"].push_back({{"recording", p.recording}, {"phase", p.phase}, {"values", p.values}, {"chi2_per_value", p.chi2_per_value},
+                           {"p_value", p.p_value}, {"significant", p.significant}, {"bias_x_mm", p.bias_x_mm}, {"bias_z_mm", p.bias_z_mm},
+                           {"axis", p.axis}, {"growth_power", p.growth_power}, {"end_residual_mm", p.end_residual_mm},
+                           {"improved_chi2_per_value", p.improved_chi2_per_value}, {"statement", p.statement}});
+  }
+  j["hypotheses"] = nlohmann::json::array();
+  for (const auto& h : r.hypotheses) {
+    nlohmann::json values = nlohmann::json::object();
+    for (const auto& v : h.values) values[v.name] = v.value;
+    j["hypotheses"].push_back({{"name", h.name}, {"values", values}, {"coefficients", coefficients_json(h.base)}, {"values_used", h.values_used},
+                               {"delta_chi2", h.delta_chi2}, {"delta_bic", h.delta_bic}, {"heldout_delta_chi2", h.heldout_delta_chi2},
+                               {"plausible", h.plausible}, {"improves_heldout", h.improves_heldout}, {"clears_signature", h.clears_signature},
+                               {"flagged_excess_before", h.flagged_excess_before}, {"flagged_excess_after", h.flagged_excess_after},
+                               {"passes", h.passes}, {"evaluations", h.evaluations},
+                               {"smallest_detectable", std::isfinite(h.smallest_detectable) ? nlohmann::json(h.smallest_detectable) : nlohmann::json()}});
+  }
+  j["unexplained"] = r.unexplained;
+  j["notes"] = r.notes;
+  j["tracked_trials"] = r.tracked_trials;
+  j["training_trials"] = r.training_trials;
+  j["trial_replays"] = r.evaluations;
+  j["seconds"] = r.seconds;
+  return j;
+}
+
+std::vector<std::pair<fs::path, std::string>> plots(const DiagnoseResult& r, const fs::path& dir) {
+  std::vector<std::pair<fs::path, std::string>> files;
+  for (const auto& t : r.tracks) {
+    for (int axis = 0; axis < 2; ++axis) {
+      Plot plot;
+      plot.title = fmt::format("{}: recorded vs baseline vs improved ({}; fitted up to {:.3f} s)", t.recording, r.verdict, std::min(t.horizon, 99.0));
+      plot.x_label = "time since release [s]";
+      plot.y_label = axis == 0 ? "height z [mm]" : "horizontal x [mm]";
+      auto mm = [](const std::vector<double>& v) {
+        std::vector<double> out;
+        for (double x : v) out.push_back(1000.0 * x);
+        return out;
+      };
+      const auto& rec_y = axis == 0 ? t.z : t.x;
+      PlotSeries recorded{"recorded", t.t, mm(rec_y), "#444444", false, true};
+      PlotSeries baseline{"baseline", t.baseline_t, mm(axis == 0 ? t.baseline_z : t.baseline_x), "#d62728", true, false};
+      PlotSeries improved{"improved", t.improved_t, mm(axis == 0 ? t.improved_z : t.improved_x), "#2ca02c", true, false};
+      plot.series = {recorded, baseline, improved};
+      files.emplace_back(dir / fmt::format("track-{}-{}.svg", t.recording, axis == 0 ? "z" : "x"), render_svg(plot));
+    }
+  }
+  // Residuals by phase: chi^2 per value, baseline and improved, one point per (recording, phase).
+  Plot plot;
+  plot.title = "residuals by phase: chi^2 per value (1 = noise level)";
+  plot.x_label = "phase index (see report.json phases[])";
+  plot.y_label = "chi^2 per value";
+  plot.log_y = true;
+  PlotSeries before{"baseline", {}, {}, "#d62728", false, true}, after{"improved", {}, {}, "#2ca02c", false, true};
+  for (std::size_t k = 0; k < r.phases.size(); ++k) {
+    before.x.push_back(static_cast<double>(k));
+    before.y.push_back(r.phases[k].chi2_per_value);
+    after.x.push_back(static_cast<double>(k));
+    after.y.push_back(r.phases[k].improved_chi2_per_value);
+  }
+  plot.series = {before, after};
+  plot.reference_lines = {{1.0, "noise"}};
+  files.emplace_back(dir / "residuals-by-phase.svg", render_svg(plot));
+  return files;
+}
+
+void print_text(const DiagnoseResult& r) {
+  std::cout << fmt::format("verdict: {}\n{}\n", r.verdict, r.statement);
+  if (r.summaries_only) return;
+  std::cout << "\nnoise (estimated from the tracks):";
+  for (const auto& [name, s] : r.noise_m) std::cout << fmt::format(" {} {:.3f} mm;", name, s * 1000.0);
+  std::cout << "\n\nwhere the baseline misses (phases beyond the noise):\n";
+  int shown = 0;
+  for (const auto& p : r.phases) {
+    if (!p.significant) continue;
+    std::cout << "  - " << p.statement << fmt::format(" -> {:.2f} after\n", p.improved_chi2_per_value);
+    ++shown;
+  }
+  if (shown == 0) std::cout << "  (none: every phase is within the noise)\n";
+  std::cout << "\ncandidate effects (training delta-chi^2, delta-BIC, held-out delta-chi^2, checks):\n";
+  for (const auto& h : r.hypotheses) {
+    std::string values;
+    for (const auto& v : h.values) values += fmt::format(" {}={:.3g}", v.name, v.value);
+    std::cout << fmt::format("  {:28s} {:9.1f} {:9.1f} {:9.1f}  {}{}{}{}{}\n", h.name, h.delta_chi2, h.delta_bic, h.heldout_delta_chi2,
+                             h.passes ? "PASS" : "fail", h.plausible ? "" : " implausible", h.improves_heldout ? "" : " no-held-out-gain",
+                             h.clears_signature ? "" : " signature-left", values);
+  }
+  std::cout << fmt::format("\nfit before -> after: training RMS {:.3f} -> {:.3f} mm, held-out RMS {:.3f} -> {:.3f} mm\n", r.before.train_rms_mm,
+                           r.after.train_rms_mm, r.before.heldout_rms_mm, r.after.heldout_rms_mm);
+  for (std::size_t k = 0; k < r.before.summary_error.size() && k < r.after.summary_error.size(); ++k) {
+    std::cout << fmt::format("  summary error {}: {:+.3g} -> {:+.3g}\n", r.before.summary_error[k].first, r.before.summary_error[k].second,
+                             r.after.summary_error[k].second);
+  }
+  for (const auto& note : r.notes) std::cout << "note: " << note << "\n";
+  std::cout << fmt::format("{} tracked trials ({} for fitting), {} trial replays, {:.1f} s\n", r.tracked_trials, r.training_trials, r.evaluations, r.seconds);
+}
+
+int run_diagnose(const DiagnoseArgs& args) {
+  constexpr std::string_view kCommand = "diagnose";
+  if (args.mesh.empty() == args.clump.empty()) return report_error(kCommand, {ErrorCode::InvalidArgument, "give exactly one of --mesh and --clump"});
+  if (args.spheres < 4 || args.spheres > 5000) return report_error(kCommand, {ErrorCode::InvalidArgument, "--spheres must be between 4 and 5000"});
+  if (args.max_evaluations < 5 || args.max_evaluations > 10000) return report_error(kCommand, {ErrorCode::InvalidArgument, "--max-evaluations must be between 5 and 10000"});
+  std::vector<Recording> recordings;
+  std::vector<std::string> names;
+  for (const auto& path : args.recordings) {
+    if (auto ok = collect(path, recordings, names); !ok) return report_error(kCommand, ok.error());
+  }
+  auto loaded_table = args.materials.empty() ? Result<MaterialTable>(default_material_table()) : read_materials(args.materials);
+  if (!loaded_table) return report_error(kCommand, loaded_table.error());
+  DiagnoseOptions options;
+  options.seed = args.seed;
+  options.max_evaluations = args.max_evaluations;
+  for (const auto& name : args.effects) {
+    auto e = parse_effect(name);
+    if (!e) return report_error(kCommand, e.error());
+    options.effects.push_back(*e);
+  }
+  for (const auto& r : recordings) {
+    if (auto s = loaded_table->find(r.surface); !s) return report_error(kCommand, s.error());
+  }
+  const RunContext context = progress_context(args.json);
+  Clump clump;
+  if (!args.clump.empty()) {
+    auto clumps = read_clump_library(args.clump);
+    if (!clumps) return report_error(kCommand, clumps.error());
+    auto chosen = select_clump(std::move(*clumps), args.clump_name, args.clump);
+    if (!chosen) return report_error(kCommand, chosen.error());
+    clump = std::move(*chosen);
+  } else {
+    SdfOptions sdf;
+    sdf.feature_size = 1e-3;
+    auto body = load_closed_body(args.mesh, args.units, args.density, sdf, context);
+    if (!body) return report_error(kCommand, body.error());
+    FillOptions fill;
+    fill.method = FillMethod::Adaptive;
+    fill.max_spheres = args.spheres;
+    auto filled = fill_body(body->body, fill, context);
+    if (!filled) return report_error(kCommand, Error{filled.error().code, fmt::format("'{}': {}", args.mesh, filled.error().message)});
+    clump = std::move(filled->clump);
+    clump.name = fmt::format("adaptive-{}", clump.spheres.size());
+  }
+  if (!args.out.empty()) {
+    std::error_code ec;
+    fs::create_directories(args.out, ec);
+    if (ec || !fs::is_directory(args.out)) return report_error(kCommand, {ErrorCode::IoError, fmt::format("cannot create '{}'", args.out)});
+  }
+  auto result = diagnose(clump, *loaded_table, recordings, names, options, context);
+  if (!result) return report_error(kCommand, result.error());
+  const nlohmann::json report = report_json(*result, clump.name);
+  if (!args.out.empty()) {
+    auto files = plots(*result, args.out);
+    files.emplace_back(fs::path(args.out) / "report.json", report.dump(2) + "\n");
+    if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
+  }
+  if (args.json) std::cout << report.dump(2) << "\n";
+  else print_text(*result);
+  return kExitOk;
+}
+
+}  // namespace
+
+Command add_diagnose_command(CLI::App& app) {
+  auto args = std::make_shared<DiagnoseArgs>();
+  auto* sub = app.add_subcommand("diagnose", "Locate where the DEM and recorded tracks disagree, name the missing physics, show the fit improve");
+  sub->add_option("--recordings", args->recordings, "Recording directories, or directories of them")->required()->expected(1, -1);
+  sub->add_option("--mesh", args->mesh, "The particle's closed mesh (filled adaptively with --spheres spheres)");
+  sub->add_option("--clump", args->clump, "The particle as a clump library (.h5)");
+  sub->add_option("--clump-name", args->clump_name, "Which clump of the library (needed when it holds several)");
+  sub->add_option("--spheres", args->spheres, "With --mesh: spheres of the adaptive clump (the DEM replays every trial many times)");
+  sub->add_option("--units", args->units, "With --mesh: its length unit (mm, cm, m)");
+  sub->add_option("--density", args->density, "With --mesh: bulk density [kg/m^3]");
+  sub->add_option("--effects", args->effects, "Candidate effects to test (default: the whole library)");
+  sub->add_option("--materials", args->materials, "Materials file (JSON) overriding the built-in table");
+  sub->add_option("--max-evaluations", args->max_evaluations, "Simplex evaluations per candidate fit");
+  sub->add_option("--seed", args->seed, "Seed (orientation candidates when a trial has none recorded)");
+  sub->add_option("--out", args->out, "Write report.json and SVG plots here");
+  sub->add_flag("--json", args->json, "Print the report as JSON");
+  return {sub, [args] { return run_diagnose(*args); }};
+}
+
+}  // namespace clumpforge::cli
