@@ -35,3 +35,7 @@ for scan in meshes/*.stl; do
   fi
   echo "clumps/$name.h5: lattice $n1 / $n2 / $n4 spheres; ${adaptive[*]}"
 done
+# The diagnosis's particle: the default scan as a small adaptive clump (the diagnosis replays
+# every tracked trial a few thousand times), and the bundled concealed-effect recordings.
+$cf repair meshes/tuber-default.stl -o "$work/diagnosis.stl" > /dev/null
+$cf fill "$work/diagnosis.stl" -o clumps/tuber-default-diagnosis.h5 --method adaptive --max-spheres 32 > /dev/null

@@ -59,7 +59,7 @@ class TrackSampler {
   Track track_;
 };
 
-bool any_wall_contact(const World& world) { return !world.history.empty(); }
+bool any_wall_contact(const World& world) { return active_contacts(world) > 0; }
 
 // Drop: lowest point `H` above the plate, at rest.
 void place_drop(RigidBody& body, const Recording& setup, const Eigen::Quaterniond& q) {
@@ -117,7 +117,7 @@ TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& o
     }
     if (!impacted) continue;
     if (touching && !airborne_after) {
-      out.impact.first_contacts = std::max(out.impact.first_contacts, static_cast<int>(world.history.size()));
+      out.impact.first_contacts = std::max(out.impact.first_contacts, active_contacts(world));
     }
     if (!touching && !airborne_after) {
       const RigidBody& b = world.bodies[0];
@@ -323,9 +323,9 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
       sample.speed = b.velocity.norm();
       sample.lowest = lowest_height(b);
       sample.along_plate = (b.position - world.walls[0].pivot).dot(world.walls[0].u_axis);
-      sample.contacts = static_cast<int>(world.history.size());
+      sample.contacts = active_contacts(world);
       for (const auto& entry : world.history) {
-        if ((entry.first >> 63) == 0) sample.wall = std::max(sample.wall, static_cast<int>(entry.first & 0xFFF));  // wall contacts
+        if ((entry.first >> 63) == 0 && entry.second.last_step == world.steps) sample.wall = std::max(sample.wall, static_cast<int>(entry.first & 0xFFF));  // wall contacts
       }
       samples.push_back(sample);
       next += replay.sample_interval;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -109,6 +110,12 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
   in.coefficients = world.interactions[body.material][wall.material];
   in.dt = dt;
   ContactState& state = world.history[wall_key(b, k, w)];
+  if (state.last_step + 1 < world.steps && state.impact_speed >= 0.0) {
+    // A new contact where a dent is remembered: fresh history, the dent kept.
+    const double dent = state.max_overlap;
+    state = ContactState{};
+    state.max_overlap = dent;
+  }
   state.last_step = world.steps;
   adjust_by_terms(world, in, state);
   const ContactOutput out = hertz_mindlin(in, world.contact, state);
@@ -220,8 +227,12 @@ void compute_forces(World& world, double dt) {
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = i + 1; j < n; ++j) sphere_contacts(world, i, j, dt, constants);
   }
-  // Contacts that ended this step lose their history.
-  std::erase_if(world.history, [&](const auto& entry) { return entry.second.last_step != world.steps; });
+  // Contacts that ended this step lose their history, except, on a plastic substrate, the
+  // dent a sphere left in the plate (its largest overlap), which later contacts unload into.
+  const bool plastic = std::any_of(world.terms.begin(), world.terms.end(), [](const PhysicsTerm& t) { return std::holds_alternative<PlasticSubstrate>(t); });
+  std::erase_if(world.history, [&](const auto& entry) {
+    return entry.second.last_step != world.steps && !(plastic && (entry.first >> 63) == 0 && entry.second.max_overlap > 0.0);
+  });
   world.forces_current = true;
 }
 

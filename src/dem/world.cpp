@@ -54,4 +54,10 @@ void set_interaction(World& world, int a, int b, const Interaction& interaction)
   world.interactions[b][a] = interaction;
 }
 
+int active_contacts(const World& world) {
+  int count = 0;
+  for (const auto& [key, state] : world.history) count += state.last_step == world.steps;
+  return count;
+}
+
 }  // namespace clumpforge

@@ -92,6 +92,9 @@ struct World {
   bool forces_current = false;
 };
 
+/// Contacts touching now (the history may also remember dents of contacts that ended).
+int active_contacts(const World& world);
+
 /// Adds `material` (if new) and returns its index; interactions default to `fallback`.
 int add_material(World& world, const Material& material);
 void set_interaction(World& world, int a, int b, const Interaction& interaction);

@@ -16,6 +16,16 @@ LabOptions lab_options_for(const Evaluator& ev, const Model& model, const Record
   return options;
 }
 
+double first_phase_end_time(const std::vector<ReplaySample>& replay, LabTest test) {
+  if (test == LabTest::Tilt) return std::numeric_limits<double>::infinity();  // the plate angle column fixes the origin
+  for (const auto& s : replay) {
+    if (s.t <= 0.0) continue;
+    if (test == LabTest::Drop && s.contacts > 0) return s.t - 0.001;
+    if (test == LabTest::Roll && s.wall == 1) return s.t - 0.005;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
 double replay_summary(const std::vector<ReplaySample>& replay, LabTest test) {
   if (replay.empty()) return std::numeric_limits<double>::quiet_NaN();
   switch (test) {
@@ -71,10 +81,15 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
     const bool x_offset = recording.test != LabTest::Roll;
     const double sigma = ev.sigma[tt.recording];
     TrialScore& score = scores[k];
+    // The time origin is chosen on the first phase (free fall, the incline), where the
+    // release alone decides the motion; a later misfit then shows where it is.
+    const double first_phase_end = first_phase_end_time(samples, recording.test);
     if (ev.shift.size() == ev.trials.size()) {
-      score.alignment = align(track, samples, sigma, x_offset, ev.shift[which[k]], ev.shift_window, ev.shift_window / 6.0, tt.cutoff);
+      score.alignment = align(track, samples, sigma, x_offset, ev.shift[which[k]], ev.shift_window, ev.shift_window / 6.0, tt.cutoff,
+                              ev.shift[which[k]] + first_phase_end);
     } else {
-      score.alignment = align(track, samples, sigma, x_offset, tt.shift_guess, ev.shift_range[which[k]], 5e-4, tt.cutoff);
+      score.alignment = align(track, samples, sigma, x_offset, tt.shift_guess, ev.shift_range[which[k]], 5e-4, tt.cutoff,
+                              tt.shift_guess + first_phase_end + (recording.test == LabTest::Drop ? 0.0 : ev.shift_range[which[k]]));
     }
     score.summary = replay_summary(samples, recording.test);
     if (keep_replays) score.replay = std::move(samples);

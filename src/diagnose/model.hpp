@@ -71,6 +71,9 @@ int total_values(const std::vector<TrialScore>& scores);
 /// First alignment of every trial under `model` over a wide window; fixes evaluator.shift.
 Result<void> initialise_shifts(Evaluator& evaluator, const Model& model);
 
+/// End of the first phase (drop: first contact; roll: reaching the flat; tilt: never) [s].
+double first_phase_end_time(const std::vector<ReplaySample>& replay, LabTest test);
+
 /// The summary a replay predicts: rebound apex of the lowest point (drop), distance on the
 /// flat at the end (roll), plate angle at 1 mm of slip (tilt).
 double replay_summary(const std::vector<ReplaySample>& replay, LabTest test);

@@ -50,9 +50,32 @@ ReplayPoint interpolate(const std::vector<ReplaySample>& replay, double t) {
   return {replay[i].x + f * (replay[i + 1].x - replay[i].x), replay[i].z + f * (replay[i + 1].z - replay[i].z), i};
 }
 
-Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, bool fit_x_offset, double cutoff) {
+namespace {
+// chi^2 at a given shift and horizontal offset, frames up to `cutoff`.
+Alignment chi_squared_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset, double cutoff) {
   Alignment a;
   a.shift = shift;
+  a.x_offset = x_offset;
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    if (track.t[i] > cutoff) break;
+    const ReplayPoint p = interpolate(replay, track.t[i] - shift);
+    if (std::isfinite(track.x[i])) {
+      const double r = (track.x[i] - p.x - x_offset) / sigma;
+      a.chi_squared += r * r;
+      ++a.values;
+    }
+    if (std::isfinite(track.z[i])) {
+      const double r = (track.z[i] - p.z) / sigma;
+      a.chi_squared += r * r;
+      ++a.values;
+    }
+  }
+  return a;
+}
+}  // namespace
+
+Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, bool fit_x_offset, double cutoff) {
+  double x_offset = 0.0;
   if (fit_x_offset) {
     double sum = 0.0;
     int count = 0;
@@ -61,60 +84,44 @@ Alignment score(const Track& track, const std::vector<ReplaySample>& replay, dou
       sum += track.x[i] - interpolate(replay, track.t[i] - shift).x;
       ++count;
     }
-    a.x_offset = count > 0 ? sum / count : 0.0;
+    x_offset = count > 0 ? sum / count : 0.0;
   }
-  double chi = 0.0;
-  int values = 0;
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    if (track.t[i] > cutoff) break;
-    const ReplayPoint p = interpolate(replay, track.t[i] - shift);
-    if (std::isfinite(track.x[i])) {
-      const double r = (track.x[i] - p.x - a.x_offset) / sigma;
-      chi += r * r;
-      ++values;
-    }
-    if (std::isfinite(track.z[i])) {
-      const double r = (track.z[i] - p.z) / sigma;
-      chi += r * r;
-      ++values;
-    }
-  }
-  a.chi_squared = chi;
-  a.values = values;
-  return a;
+  return chi_squared_at(track, replay, sigma, shift, x_offset, cutoff);
 }
 
 Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, bool fit_x_offset, double guess,
-                double half_range, double step, double cutoff) {
-  Alignment best = score(track, replay, sigma, guess, fit_x_offset, cutoff);
+                double half_range, double step, double cutoff, double align_cutoff) {
+  const double fit_cutoff = std::min(cutoff, align_cutoff);
+  Alignment best = score(track, replay, sigma, guess, fit_x_offset, fit_cutoff);
   for (double s = guess - half_range; s <= guess + half_range + 1e-12; s += step) {
-    Alignment a = score(track, replay, sigma, s, fit_x_offset, cutoff);
+    Alignment a = score(track, replay, sigma, s, fit_x_offset, fit_cutoff);
     if (a.chi_squared < best.chi_squared) best = a;
   }
   // Golden section on [best - step, best + step].
   constexpr double kGolden = 0.6180339887498949;
   double lo = best.shift - step, hi = best.shift + step;
   double c = hi - kGolden * (hi - lo), d = lo + kGolden * (hi - lo);
-  Alignment fc = score(track, replay, sigma, c, fit_x_offset, cutoff), fd = score(track, replay, sigma, d, fit_x_offset, cutoff);
+  Alignment fc = score(track, replay, sigma, c, fit_x_offset, fit_cutoff), fd = score(track, replay, sigma, d, fit_x_offset, fit_cutoff);
   while (hi - lo > 1e-6) {
     if (fc.chi_squared < fd.chi_squared) {
       hi = d;
       d = c;
       fd = fc;
       c = hi - kGolden * (hi - lo);
-      fc = score(track, replay, sigma, c, fit_x_offset, cutoff);
+      fc = score(track, replay, sigma, c, fit_x_offset, fit_cutoff);
     } else {
       lo = c;
       c = d;
       fc = fd;
       d = lo + kGolden * (hi - lo);
-      fd = score(track, replay, sigma, d, fit_x_offset, cutoff);
+      fd = score(track, replay, sigma, d, fit_x_offset, fit_cutoff);
     }
   }
   for (const Alignment& a : {fc, fd}) {
     if (a.chi_squared < best.chi_squared) best = a;
   }
-  return best;
+  if (fit_cutoff >= cutoff) return best;
+  return chi_squared_at(track, replay, sigma, best.shift, best.x_offset, cutoff);
 }
 
 double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s) {

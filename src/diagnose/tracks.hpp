@@ -42,9 +42,12 @@ Alignment score(const Track& track, const std::vector<ReplaySample>& replay, dou
                 double cutoff = std::numeric_limits<double>::infinity());
 
 /// Best shift in [guess - half_range, guess + half_range]: a grid of `step`, then a golden
-/// section to 1 microsecond around the best grid point.
+/// section to 1 microsecond around the best grid point. The shift (and x offset) is chosen
+/// on the frames up to `align_cutoff` (recorded time: the first phase, where the release
+/// alone decides the motion); the returned chi^2 covers the frames up to `cutoff`.
 Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, bool fit_x_offset, double guess,
-                double half_range, double step, double cutoff = std::numeric_limits<double>::infinity());
+                double half_range, double step, double cutoff = std::numeric_limits<double>::infinity(),
+                double align_cutoff = std::numeric_limits<double>::infinity());
 
 /// A first guess of the shift from the data alone: for a drop, the release instant from the
 /// first 2 mm of fall; for a tilt, the plate angle column; otherwise the first frame.

@@ -227,3 +227,145 @@ TEST(PhysicsTerms, QuadraticDragGivesTheTerminalSpeed) {
 }
 
 }  // namespace clumpforge
+
+namespace clumpforge {
+namespace {
+// A sphere of radius r dropped at `speed` onto the plate; returns the rebound ratio (and the
+// world after it left, or after `settle` s when it stays).
+double rebound_ratio(World world, double r, double speed) {
+  world.bodies[0].position = {0, 0, r + 1e-7};
+  world.bodies[0].velocity = {0, 0, -speed};
+  const double dt = contact_time(world, speed) / 1000.0;
+  bool touched = false;
+  for (int i = 0; i < 10'000'000; ++i) {
+    step(world, dt);
+    const bool touching = world.bodies[0].position.z() < r;
+    if (touching) touched = true;
+    if (touched && !touching) break;
+  }
+  return world.bodies[0].velocity.z() / speed;
+}
+}  // namespace
+
+TEST(PhysicsTerms, ElasticPlasticRestitutionFollowsThornton) {
+  // e = e_ref e_T(v) / e_T(v_ref); far above yield e_T ~ v^(-1/4), so 16 x the speed halves e
+  // (the closed form within 1 %; the DEM within 1.5 % of it).
+  EXPECT_NEAR(thornton_restitution(0.01, 0.05), 1.0, 1e-12);
+  EXPECT_NEAR(thornton_restitution(16e4, 1e-3) / thornton_restitution(1e4, 1e-3), 0.5, 0.005);
+  const double r = 5e-3, e_ref = 0.7, v_ref = 2.0, v_y = 0.1;
+  for (double speed : {2.0, 0.5}) {
+    SCOPED_TRACE(speed);
+    World world = test::sphere_over_plane(kSoft, kSteel, {e_ref, 0.0, 0.0}, r);
+    world.terms.push_back(ElasticPlasticRestitution{v_y, v_ref});
+    const double expected = e_ref * thornton_restitution(speed, v_y) / thornton_restitution(v_ref, v_y);
+    EXPECT_NEAR(rebound_ratio(world, r, speed), expected, 0.015 * expected);
+  }
+}
+
+TEST(PhysicsTerms, PlasticSubstrateDissipatesItsShareAndLeavesADent) {
+  // Undamped Hertz loading, Hertz unloading from d_max to zero force at lambda d_max: the
+  // returned work is (1 - lambda) of the stored, so e = sqrt(1 - lambda) (within 1 %).
+  const double r = 5e-3;
+  for (double lambda : {0.2, 0.5}) {
+    SCOPED_TRACE(lambda);
+    World world = test::sphere_over_plane(kSoft, kSteel, {1.0, 0.0, 0.0}, r);
+    world.terms.push_back(PlasticSubstrate{lambda});
+    EXPECT_NEAR(rebound_ratio(world, r, 1.0), std::sqrt(1.0 - lambda), 0.01 * std::sqrt(1.0 - lambda));
+  }
+  // At rest under gravity the sphere sits deeper by the dent (about lambda d_max).
+  auto rest_depth = [&](double lambda) {
+    World world = test::sphere_over_plane(kSoft, kSteel, {0.005, 0.0, 0.0}, r);  // lands and stays: one contact
+    world.gravity = {0, 0, -kG};
+    if (lambda > 0.0) world.terms.push_back(PlasticSubstrate{lambda});
+    world.bodies[0].position = {0, 0, r + 1e-7};
+    world.bodies[0].velocity = {0, 0, -1.0};
+    const double dt = contact_time(world, 1.0) / 200.0;
+    double deepest = 0.0;
+    for (int i = 0; i < 400000; ++i) {
+      step(world, dt);
+      deepest = std::max(deepest, r - world.bodies[0].position.z());
+
+    }
+    return std::pair{r - world.bodies[0].position.z(), deepest};
+  };
+  const auto [elastic_rest, elastic_peak] = rest_depth(0.0);
+  const auto [plastic_rest, plastic_peak] = rest_depth(0.4);
+  EXPECT_GT(plastic_rest - elastic_rest, 0.3 * plastic_peak);
+  EXPECT_LT(plastic_rest - elastic_rest, 0.45 * plastic_peak);
+  (void)elastic_peak;
+}
+
+TEST(PhysicsTerms, AdhesionAddsItsPullToTheLoad) {
+  // A sphere resting on the plate under gravity and a JKR pull 1.5 pi W R: the Hertz force
+  // carries m g + F, so the overlap is ((m g + F) / (4/3 E* sqrt(R)))^(2/3) (within 0.5 %).
+  const double r = 5e-3, w = 0.2;
+  World world = test::sphere_over_plane(kSoft, kSteel, {0.3, 0.5, 0.0}, r);
+  world.gravity = {0, 0, -kG};
+  world.terms.push_back(Adhesion{w});
+  world.bodies[0].position = {0, 0, r - 1e-7};
+  const double dt = contact_time(world, 0.1) / 200.0;
+  for (int i = 0; i < 300000; ++i) step(world, dt);
+  const double pull = 1.5 * kPi * w * r;
+  const double e_star = effective_youngs_modulus(kSoft, kSteel);
+  const double expected = std::pow((world.bodies[0].mass * kG + pull) / (4.0 / 3.0 * e_star * std::sqrt(r)), 2.0 / 3.0);
+  EXPECT_NEAR(r - world.bodies[0].position.z(), expected, 0.005 * expected);
+}
+
+TEST(PhysicsTerms, KineticFrictionBelowStaticOnceSliding) {
+  // A block (sphere with rolling locked out by a huge mu_r) on a 25 deg incline, mu_s 0.5 >
+  // tan 25 = 0.466 > mu_k 0.35: at rest it sticks; pushed, it slides and accelerates at
+  // g (sin - mu_k cos) (within 2 %).
+  const double r = 5e-3, theta = 25.0 * kPi / 180.0;
+  auto slide = [&](double push) {
+    World world = test::sphere_over_plane(kSoft, kSteel, {0.3, 0.5, 0.0}, r);
+    world.gravity = {kG * std::sin(theta), 0, -kG * std::cos(theta)};  // the incline as a tilted gravity
+    world.terms.push_back(StaticKineticFriction{0.15});
+    world.bodies[0].position = {0, 0, r - 1e-6};
+    world.bodies[0].inertia *= 1e9;  // no rolling: a sliding block
+    const double dt = contact_time(world, 0.1) / 100.0;
+    // Settle on a level plate first, then tilt it (gravity turns) and push.
+    const Eigen::Vector3d tilted = world.gravity;
+    world.gravity = {0, 0, -kG};
+    for (int i = 0; i < 20000; ++i) step(world, dt);
+    for (int i = 1; i <= 20000; ++i) {  // a slow tilt, not a jolt
+      world.gravity = (Eigen::Vector3d(0, 0, -kG) * (20000 - i) + tilted * i) / 20000.0;
+      world.gravity *= kG / world.gravity.norm();
+      step(world, dt);
+    }
+    world.bodies[0].velocity += Eigen::Vector3d(push, 0, 0);
+    for (int i = 0; i < 20000; ++i) step(world, dt);
+    const double v1 = world.bodies[0].velocity.x();
+    for (int i = 0; i < 20000; ++i) step(world, dt);
+    return std::pair{v1, (world.bodies[0].velocity.x() - v1) / (20000 * dt)};
+  };
+  const auto [v_rest, a_rest] = slide(0.0);
+  EXPECT_LT(std::abs(v_rest), 1e-3);
+  const auto [v_push, a_push] = slide(0.2);
+  const double expected = kG * (std::sin(theta) - 0.35 * std::cos(theta));
+  EXPECT_GT(v_push, 0.1);
+  EXPECT_NEAR(a_push, expected, 0.02 * expected);
+}
+
+TEST(PhysicsTerms, RollingTermsScaleTheTorque) {
+  ContactInput in;
+  in.normal = Eigen::Vector3d::UnitZ();
+  in.relative_spin = {0, 10.0, 0};
+  in.rolling_arm = 0.01;  // rolling speed 0.1 m/s
+  in.coefficients.rolling_friction = 0.02;
+  const ContactState state;
+  ContactInput viscous = in;
+  adjust_contact(ViscousRolling{1.0, 0.5}, viscous, state);
+  EXPECT_NEAR(viscous.coefficients.rolling_friction, 0.02 * 0.1 / 0.5, 1e-12);
+  ContactInput half = in;
+  adjust_contact(ViscousRolling{0.5, 0.5}, half, state);
+  EXPECT_NEAR(half.coefficients.rolling_friction, 0.02 * (0.5 + 0.5 * 0.2), 1e-12);
+  ContactInput epsd = in;
+  adjust_contact(EpsdRolling{3.0}, epsd, state);
+  EXPECT_EQ(epsd.rolling, RollingModel::Epsd);
+  EXPECT_NEAR(epsd.rolling_stiffness_scale, 0.25, 1e-12);
+  ContactInput none = in;
+  adjust_contact(EpsdRolling{0.0}, none, state);
+  EXPECT_EQ(none.rolling, RollingModel::ConstantTorque);
+}
+
+}  // namespace clumpforge

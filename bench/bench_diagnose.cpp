@@ -1,0 +1,247 @@
+// The blind benchmark of `clumpforge diagnose`: recordings with every effect of the library
+// hidden at a realistic and a strong magnitude, plus effect-free controls with varied base
+// coefficients, each diagnosed by the real command line (it sees only the recordings and
+// the clump); the answers are read only by the scorer here. Prints the confusion matrix,
+// the detection rate per effect, the false-positive rate on the controls and the median
+// held-out improvement; writes summary.json and summary.md into --out. Resumable: a case
+// whose report.json exists is not run again.
+//   bench_diagnose --clump clumps/tuber-default-diagnosis.h5 --cli build/tools/clumpforge --out bench-out/diagnose
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "core/rng.hpp"
+#include "diagnose/conceal.hpp"
+#include "io/clump_library.hpp"
+#include "io/recording_io.hpp"
+
+namespace fs = std::filesystem;
+using namespace clumpforge;
+
+namespace {
+
+struct Case {
+  std::string id;
+  std::optional<Effect> effect;
+  std::string magnitude;  // realistic, strong, control
+  ConcealOptions options;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Blind benchmark of clumpforge diagnose on concealed-effect recordings"};
+  std::string clump_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default-diagnosis.h5", clump_name, cli = CLUMPFORGE_CLI, out = "bench-out/diagnose";
+  int controls = 50, trials = 4;
+  std::uint64_t seed = 1;
+  std::vector<std::string> only;
+  bool full_set = false;
+  app.add_option("--clump", clump_file, "Clump library the recordings are made with and diagnosed against");
+  app.add_option("--clump-name", clump_name, "Which clump of the library");
+  app.add_option("--cli", cli, "The clumpforge executable");
+  app.add_option("--out", out, "Working directory (recordings, answers, reports, summary)");
+  app.add_option("--controls", controls, "Effect-free controls");
+  app.add_option("--trials", trials, "Trials per recording");
+  app.add_option("--seed", seed, "Seed of the whole benchmark");
+  app.add_option("--effects", only, "Only these effects (default: the library)");
+  app.add_flag("--full-set", full_set, "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
+  CLI11_PARSE(app, argc, argv);
+
+  auto clumps = read_clump_library(clump_file);
+  if (!clumps) {
+    std::cerr << clumps.error().message << "\n";
+    return 1;
+  }
+  auto clump = select_clump(std::move(*clumps), clump_name, clump_file);
+  if (!clump) {
+    std::cerr << clump.error().message << "\n";
+    return 1;
+  }
+  const MaterialTable table = default_material_table();
+  const auto library = effect_library();
+  std::vector<Case> cases;
+  auto base_options = [&](const std::string& surface, std::uint64_t case_seed) {
+    ConcealOptions o;
+    o.surface = surface;
+    o.trials = trials;
+    o.seed = case_seed;
+    if (!full_set) {
+      o.drop_heights = {0.2, 1.0};
+      o.roll_starts = {0.10};
+    }
+    return o;
+  };
+  std::uint64_t k = 0;
+  for (const auto& spec : library) {
+    if (!only.empty() && std::find(only.begin(), only.end(), spec.name) == only.end()) continue;
+    for (std::string magnitude : {"realistic", "strong"}) {
+      Case c;
+      c.id = fmt::format("{}-{}", spec.name, magnitude);
+      c.effect = spec.effect;
+      c.magnitude = magnitude;
+      c.options = base_options(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", seed * 1000 + ++k);
+      c.options.effect = spec.effect;
+      for (const auto& p : spec.parameters) c.options.values.push_back(magnitude == "realistic" ? p.realistic : p.strong);
+      cases.push_back(std::move(c));
+    }
+  }
+  for (int i = 0; i < controls; ++i) {
+    Case c;
+    c.id = fmt::format("control-{:02d}", i + 1);
+    c.magnitude = "control";
+    const std::string surface = i % 2 == 0 ? "Q235" : "soil";
+    c.options = base_options(surface, seed * 1000 + 500 + static_cast<std::uint64_t>(i));
+    Rng rng(seed, 9000 + static_cast<std::uint64_t>(i));
+    Interaction base = *table.interaction("tuber", surface);
+    base.restitution = std::min(0.95, base.restitution * rng.uniform(0.85, 1.1));
+    base.static_friction *= rng.uniform(0.85, 1.15);
+    base.rolling_friction *= rng.uniform(0.7, 1.3);
+    c.options.base = base;
+    cases.push_back(std::move(c));
+  }
+
+  // Interleaved (effect, control, effect, ...): a partial run already shows both rates.
+  {
+    std::vector<Case> effects_first(cases.begin(), cases.end());
+    std::vector<Case> interleaved;
+    std::size_t e = 0, c = 0;
+    const auto first_control = std::find_if(effects_first.begin(), effects_first.end(), [](const Case& x) { return !x.effect; });
+    const std::size_t n_effects = static_cast<std::size_t>(first_control - effects_first.begin());
+    while (e < n_effects || c < effects_first.size() - n_effects) {
+      if (e < n_effects) interleaved.push_back(effects_first[e++]);
+      if (c < effects_first.size() - n_effects) interleaved.push_back(effects_first[n_effects + c++]);
+    }
+    cases = std::move(interleaved);
+  }
+  fs::create_directories(out);
+  struct Outcome {
+    std::string truth, magnitude, verdict;
+    double heldout_before = NAN, heldout_after = NAN, seconds = NAN;
+    bool detected = false;
+  };
+  std::vector<Outcome> outcomes;
+  for (const auto& c : cases) {
+    const fs::path dir = fs::path(out) / c.id;
+    const fs::path report = dir / "report.json";
+    const std::string truth = c.effect ? effect_spec(library, *c.effect).name : "none";
+    if (!fs::exists(report)) {
+      auto made = make_concealed_recordings(*clump, table, c.options);
+      if (!made) {
+        std::cerr << c.id << ": " << made.error().message << "\n";
+        return 1;
+      }
+      fs::remove_all(dir);
+      for (std::size_t r = 0; r < made->recordings.size(); ++r) {
+        if (auto ok = write_recording(dir / "recordings" / made->names[r], made->recordings[r]); !ok) {
+          std::cerr << ok.error().message << "\n";
+          return 1;
+        }
+      }
+      std::ofstream(dir / "answer.json") << answer_json(c.options, *made);
+      // Blind: the diagnosis sees the recordings directory and the clump, nothing else.
+      const std::string command = fmt::format("'{}' diagnose --recordings '{}' --clump '{}' {} --json > '{}.tmp' 2> '{}'", cli,
+                                              (dir / "recordings").string(), clump_file, clump_name.empty() ? "" : "--clump-name '" + clump_name + "'",
+                                              report.string(), (dir / "stderr.txt").string());
+      if (std::system(command.c_str()) != 0) {
+        std::cerr << c.id << ": diagnose failed, see " << (dir / "stderr.txt").string() << "\n";
+        return 1;
+      }
+      fs::rename(report.string() + ".tmp", report);
+    }
+    std::ifstream in(report);
+    const auto j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded()) {
+      std::cerr << c.id << ": unreadable report\n";
+      return 1;
+    }
+    Outcome o;
+    o.truth = truth;
+    o.magnitude = c.magnitude;
+    o.verdict = j.value("verdict", "?");
+    o.detected = o.verdict == truth;
+    o.heldout_before = j["fit"]["before"].value("heldout_rms_mm", NAN);
+    o.heldout_after = j["fit"]["after"].value("heldout_rms_mm", NAN);
+    o.seconds = j.value("seconds", NAN);
+    std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id, truth, o.verdict,
+                             o.heldout_before, o.heldout_after, o.seconds)
+              << std::flush;
+    outcomes.push_back(o);
+  }
+
+  // Confusion matrix: rows are the truth (effect and magnitude), columns the verdicts.
+  std::vector<std::string> columns;
+  for (const auto& spec : library) columns.push_back(spec.name);
+  for (const char* v : {"none", "ambiguous", "unexplained", "undecidable"}) columns.emplace_back(v);
+  std::map<std::string, std::map<std::string, int>> matrix;
+  std::vector<std::string> rows;
+  for (const auto& o : outcomes) {
+    const std::string row = o.truth == "none" ? "none (controls)" : fmt::format("{} ({})", o.truth, o.magnitude);
+    if (!matrix.contains(row)) rows.push_back(row);
+    ++matrix[row][o.verdict];
+  }
+  std::string md = "| truth \\ verdict |";
+  for (const auto& col : columns) md += fmt::format(" {} |", col);
+  md += "\n|---|";
+  for (std::size_t i = 0; i < columns.size(); ++i) md += "---:|";
+  md += "\n";
+  for (const auto& row : rows) {
+    md += fmt::format("| {} |", row);
+    for (const auto& col : columns) md += fmt::format(" {} |", matrix[row][col] ? std::to_string(matrix[row][col]) : std::string("."));
+    md += "\n";
+  }
+  int control_count = 0, false_positives = 0;
+  std::vector<double> improvements, seconds;
+  nlohmann::json summary;
+  for (const auto& o : outcomes) {
+    seconds.push_back(o.seconds);
+    if (o.truth == "none") {
+      ++control_count;
+      false_positives += o.verdict != "none";
+    } else if (o.detected && o.heldout_before > 0.0) {
+      improvements.push_back((o.heldout_before - o.heldout_after) / o.heldout_before);
+    }
+  }
+  md += "\n| effect | realistic | strong |\n|---|---:|---:|\n";
+  for (const auto& spec : library) {
+    std::string cells;
+    for (const char* m : {"realistic", "strong"}) {
+      int n = 0, hit = 0;
+      for (const auto& o : outcomes) {
+        if (o.truth == spec.name && o.magnitude == m) {
+          ++n;
+          hit += o.detected;
+        }
+      }
+      cells += n ? fmt::format(" {}/{} |", hit, n) : std::string(" - |");
+      summary["detection"][spec.name][m] = n ? static_cast<double>(hit) / n : NAN;
+    }
+    md += fmt::format("| {} |{}\n", spec.name, cells);
+  }
+  const double fpr = control_count ? static_cast<double>(false_positives) / control_count : NAN;
+  md += fmt::format("\nfalse-positive rate on {} controls: {}/{} = {:.1f} %\n", control_count, false_positives, control_count, 100.0 * fpr);
+  md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n", 100.0 * median(improvements));
+  md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
+  std::cout << "\n" << md;
+  summary["false_positive_rate"] = fpr;
+  summary["controls"] = control_count;
+  summary["median_heldout_improvement"] = median(improvements);
+  summary["median_seconds"] = median(seconds);
+  summary["matrix_markdown"] = md;
+  std::ofstream(fs::path(out) / "summary.md") << md;
+  std::ofstream(fs::path(out) / "summary.json") << summary.dump(2) << "\n";
+  return 0;
+}
