@@ -38,4 +38,10 @@ for surface in Q235 soil; do
   $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test roll --surface "$surface" --trials 10 --out "$out/dem/roll-$surface"
 done
 echo
-echo "main job done: $out/ (repaired mesh, props JSON, clump library tuber-default.h5, exports/, dem/ recordings)"
+echo "== 6. diagnosis of a bundled recording set with a concealed effect (clumps/tuber-default-diagnosis/recordings:"
+echo "      drops from 0.2 and 1 m, a roll from 100 mm, a tilt; 4 tracked trials each, made by clumpforge-conceal)"
+$cf diagnose --recordings clumps/tuber-default-diagnosis/recordings --clump clumps/tuber-default-diagnosis.h5 --out "$out/diagnosis"
+echo
+echo "   the generator's answer (read only now, after the diagnosis): $(python3 -c 'import json; a=json.load(open("clumps/tuber-default-diagnosis/answer.json")); print(a["effect"], a["effect_parameters"])')"
+echo
+echo "main job done: $out/ (repaired mesh, props JSON, clump library tuber-default.h5, exports/, dem/ recordings, diagnosis/ report and plots)"

@@ -39,3 +39,6 @@ done
 # every tracked trial a few thousand times), and the bundled concealed-effect recordings.
 $cf repair meshes/tuber-default.stl -o "$work/diagnosis.stl" > /dev/null
 $cf fill "$work/diagnosis.stl" -o clumps/tuber-default-diagnosis.h5 --method adaptive --max-spheres 32 > /dev/null
+build/tools/clumpforge-conceal clumps/tuber-default-diagnosis.h5 --effect air_drag --magnitude realistic --small --trials 4 --seed 7 \
+  --out clumps/tuber-default-diagnosis/recordings --answer clumps/tuber-default-diagnosis/answer.json
+echo "clumps/tuber-default-diagnosis.h5: adaptive-32, with concealed-effect recordings in clumps/tuber-default-diagnosis/"

@@ -160,8 +160,15 @@ std::vector<std::pair<fs::path, std::string>> plots(const DiagnoseResult& r, con
 }
 
 void print_text(const DiagnoseResult& r) {
+  if (r.summaries_only) {
+    std::cout << fmt::format("verdict: {} (summaries only: no tracks, so no effect can be named)\n\nwhat these summaries decide:\n", r.verdict);
+    for (const auto& d : r.decidable) std::cout << "  - " << d << "\n";
+    std::cout << "\nwhat they cannot decide:\n";
+    for (const auto& d : r.undecidable) std::cout << "  - " << d << "\n";
+    std::cout << "\nto decide more: " << r.experiment << "\n";
+    return;
+  }
   std::cout << fmt::format("verdict: {}\n{}\n", r.verdict, r.statement);
-  if (r.summaries_only) return;
   std::cout << "\nnoise (estimated from the tracks):";
   for (const auto& [name, s] : r.noise_m) std::cout << fmt::format(" {} {:.3f} mm;", name, s * 1000.0);
   std::cout << "\n\nwhere the baseline misses (phases beyond the noise):\n";

@@ -97,9 +97,9 @@ Result<DiagnoseResult> diagnose_summaries(const Clump& clump, const MaterialTabl
   result.undecidable = {
       fmt::format("air drag: its t^4 bending of the flights needs tracks of drops from 0.5 m or more (drops here: {})",
                   drop_heights.empty() ? "none" : fmt::format("{}", fmt::join(drop_heights, ", "))),
-      fmt::format("speed-dependent restitution (viscoelastic or elastic-plastic): needs the rebound at two or more drop heights, or "
-                  "tracked multiple bounces (drop heights here: {})",
-                  drop_heights.size()),
+      fmt::format("speed-dependent restitution (viscoelastic or elastic-plastic): needs the rebound at two or more drop heights on one "
+                  "surface, or tracked multiple bounces (drops here: {})",
+                  drop_heights.empty() ? "none" : fmt::format("{}", fmt::join(drop_heights, ", "))),
       "plastic substrate: needs tracks (the particle resting in its dent, the contact's length) or the rest height after landing",
       fmt::format("rolling resistance form (viscous or elastic-plastic vs constant torque): needs two or more start distances or tracked "
                   "speed on the flat (start distances here: {})",

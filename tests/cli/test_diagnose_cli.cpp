@@ -1,0 +1,82 @@
+// End-to-end: diagnose on bad input, on summaries only (the study's tables), and its report.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "support/test_support.hpp"
+
+namespace clumpforge {
+namespace {
+std::string clump() { return (test::source_dir() / "clumps" / "tuber-default-diagnosis.h5").string(); }
+
+void write(const std::filesystem::path& path, const std::string& text) {
+  std::filesystem::create_directories(path.parent_path());
+  std::ofstream(path) << text;
+}
+
+const char* kManifest = R"({
+  "format": "recording/1", "test": "drop", "surface": "Q235",
+  "setup": { "release_height_m": 0.2 },
+  "camera": { "frame_rate_hz": 1000 },
+  "trials": [ { "id": "01", "track": "trial-01.csv" } ]
+})";
+}  // namespace
+
+TEST(DiagnoseCli, BadInputIsAClearError) {
+  test::ScratchDir dir("diagnose-bad");
+  // A track whose time goes backwards: refused with the file and the line.
+  write(dir / "rec" / "recording.json", kManifest);
+  write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n0.0005,0,0.21\n");
+  auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --out '{}'", (dir / "rec").string(), clump(),
+                                              (dir / "out").string()));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("trial-01.csv:4"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("does not increase"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "report.json"));
+  // An unknown column.
+  write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m,speed\n0.000,0,0.21,0\n");
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}'", (dir / "rec").string(), clump()));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("unknown column 'speed'"), std::string::npos) << run.err;
+  // Both particle sources, neither, a missing directory, an unknown effect.
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --mesh x.stl", (dir / "rec").string(), clump()));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("exactly one of --mesh and --clump"), std::string::npos) << run.err;
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}'", (dir / "nowhere").string(), clump()));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("nowhere"), std::string::npos) << run.err;
+  write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n");
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --effects air_drga", (dir / "rec").string(), clump()));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("did you mean 'air_drag'"), std::string::npos) << run.err;
+  // A track too short to decide anything: that verdict, not a guess.
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --json", (dir / "rec").string(), clump()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out)["verdict"], "undecidable");
+}
+
+TEST(DiagnoseCli, SummariesOnlySayWhatTheyCanDecide) {
+  // The study's tables have no tracks: no effect is named; the restitution gap is explained
+  // by the impacts of an irregular body; drag and speed dependence are undecidable.
+  test::ScratchDir dir("diagnose-paper");
+  const auto paper = test::shared_dir() / "data" / "paper";
+  const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' '{}' --clump '{}' --json --out '{}'",
+                                                    (paper / "drop-Q235").string(), (paper / "roll-Q235").string(), clump(),
+                                                    (dir / "out").string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["verdict"], "none");
+  EXPECT_TRUE(j["summaries_only"].get<bool>());
+  EXPECT_TRUE(j["effect_parameters"].empty());
+  const std::string decidable = j["decidable"].dump(), undecidable = j["undecidable"].dump();
+  EXPECT_NE(decidable.find("multi-contact"), std::string::npos) << decidable;
+  EXPECT_NE(undecidable.find("air drag"), std::string::npos) << undecidable;
+  EXPECT_NE(undecidable.find("speed-dependent restitution"), std::string::npos) << undecidable;
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "report.json"));
+}
+
+}  // namespace clumpforge

@@ -1,0 +1,159 @@
+// The diagnosis: its measurement model on known tracks, the concealed-effect generator, and
+// a fast blind subset (a control and a strong effect on drop recordings).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/rng.hpp"
+#include "diagnose/conceal.hpp"
+#include "diagnose/diagnose.hpp"
+#include "diagnose/tracks.hpp"
+#include "io/clump_library.hpp"
+#include "io/recording_io.hpp"
+#include "support/test_support.hpp"
+
+namespace clumpforge {
+namespace {
+
+Clump diagnosis_clump() {
+  auto clumps = read_clump_library(test::source_dir() / "clumps" / "tuber-default-diagnosis.h5");
+  EXPECT_TRUE(clumps) << clumps.error().message;
+  return clumps->front();
+}
+
+// A free fall from rest at t0 (in the track's own time), filmed at 1000 fps with noise.
+Track falling_track(double t0, double sigma, std::uint64_t seed) {
+  Rng rng(seed);
+  Track track;
+  for (int k = 0; k < 300; ++k) {
+    const double t = 10.0 + k * 1e-3;
+    const double fall = t > t0 ? 0.5 * 9.81 * (t - t0) * (t - t0) : 0.0;
+    track.t.push_back(t);
+    track.x.push_back(0.002 + rng.normal(0.0, sigma));
+    track.z.push_back(0.5 - fall + rng.normal(0.0, sigma));
+  }
+  return track;
+}
+
+}  // namespace
+
+TEST(DiagnoseMeasurement, NoiseLevelFromThirdDifferences) {
+  // The median absolute third difference recovers sigma within 5 % (600 differences).
+  for (double sigma : {2e-5, 1e-4, 5e-4}) {
+    const Track track = falling_track(10.05, sigma, 3);
+    EXPECT_NEAR(estimate_noise({&track}), sigma, 0.05 * sigma) << sigma;
+  }
+}
+
+TEST(DiagnoseMeasurement, AlignmentFindsTheTimeOriginAndHorizontalOrigin) {
+  // A replay of the same fall (released at replay time 0, x = 0) against a track released at
+  // 10.0731 s and 2 mm to the side: the shift within 20 microseconds, the offset within 20 um.
+  std::vector<ReplaySample> replay;
+  for (int k = 0; k <= 5000; ++k) {
+    ReplaySample s;
+    s.t = k * 1e-4;
+    s.z = 0.5 - 0.5 * 9.81 * s.t * s.t;
+    replay.push_back(s);
+  }
+  const Track track = falling_track(10.0731, 1e-4, 5);
+  const double guess = guess_shift(track, LabTest::Drop, 5.0);
+  EXPECT_NEAR(guess, 10.0731, 0.003);
+  const Alignment a = align(track, replay, 1e-4, true, guess, 0.02, 5e-4);
+  EXPECT_NEAR(a.shift, 10.0731, 2e-5);
+  EXPECT_NEAR(a.x_offset, 0.002, 2e-5);
+  EXPECT_NEAR(a.chi_squared / a.values, 1.0, 0.15);
+}
+
+TEST(ConcealedRecordings, HideTheEffectInTheSummariesAndReadBack) {
+  const Clump clump = diagnosis_clump();
+  ConcealOptions options;
+  options.effect = Effect::AirDrag;
+  options.values = {1.5};
+  options.trials = 4;
+  options.drop_heights = {0.2, 1.0};
+  options.roll_starts = {};
+  options.tilt = false;
+  auto made = make_concealed_recordings(clump, default_material_table(), options);
+  ASSERT_TRUE(made) << made.error().message;
+  ASSERT_EQ(made->recordings.size(), 2u);
+  ASSERT_EQ(made->summaries.size(), 1u);  // the study's set-up: the 0.2 m drop
+  // The summary mean of the study's set-up matches the effect-free baseline's within 2 %.
+  EXPECT_NEAR(made->summaries[0].effect_mean, made->summaries[0].baseline_mean, 0.02 * made->summaries[0].baseline_mean);
+  test::ScratchDir dir("conceal");
+  ASSERT_TRUE(write_recording(dir / "drop", made->recordings[1]));
+  auto back = read_recording(dir / "drop");
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_EQ(back->trials.size(), 4u);
+  ASSERT_TRUE(back->trials[0].track);
+  EXPECT_NE(back->trials[0].extra_json.find("orientation_wxyz"), std::string::npos);
+  EXPECT_NE(answer_json(options, *made).find("\"effect\": \"air_drag\""), std::string::npos);
+}
+
+// The fast blind subset: recordings made by the generator, diagnosed by the library against
+// a fixed candidate list (the same for every case); the answer is only compared afterwards.
+TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
+  const Clump clump = diagnosis_clump();
+  const MaterialTable table = default_material_table();
+  DiagnoseOptions options;
+  options.effects = {Effect::AirDrag, Effect::ViscoelasticRestitution, Effect::StaticKineticFriction};
+  options.max_evaluations = 30;
+  for (bool with_drag : {false, true}) {
+    SCOPED_TRACE(with_drag);
+    ConcealOptions conceal;
+    conceal.trials = 4;
+    conceal.drop_heights = {1.0};
+    conceal.roll_starts = {};
+    conceal.tilt = false;
+    conceal.seed = 11;
+    if (with_drag) {
+      conceal.effect = Effect::AirDrag;
+      conceal.values = {1.5};
+    }
+    auto made = make_concealed_recordings(clump, table, conceal);
+    ASSERT_TRUE(made) << made.error().message;
+    auto result = diagnose(clump, table, made->recordings, made->names, options);
+    ASSERT_TRUE(result) << result.error().message;
+    if (!with_drag) {
+      EXPECT_EQ(result->verdict, "none") << result->statement;
+      EXPECT_NEAR(result->before.train_rms_mm, 0.1, 0.02);  // the camera's noise, nothing else
+    } else {
+      ASSERT_EQ(result->verdict, "air_drag") << result->statement;
+      ASSERT_EQ(result->effect_parameters.size(), 1u);
+      EXPECT_NEAR(result->effect_parameters[0].value, 1.5, 0.3);
+      EXPECT_LT(result->after.heldout_rms_mm, 0.5 * result->before.heldout_rms_mm);
+    }
+  }
+}
+
+TEST(DiagnoseBlind, TooShortOrTooNoisyIsUndecidable) {
+  const Clump clump = diagnosis_clump();
+  const MaterialTable table = default_material_table();
+  ConcealOptions conceal;
+  conceal.trials = 2;
+  conceal.drop_heights = {0.2};
+  conceal.roll_starts = {};
+  conceal.tilt = false;
+  conceal.noise_m = 3e-3;  // 3 mm: a blurred, hand-clicked track
+  auto noisy = make_concealed_recordings(clump, table, conceal);
+  ASSERT_TRUE(noisy) << noisy.error().message;
+  auto result = diagnose(clump, table, noisy->recordings, noisy->names, {});
+  ASSERT_TRUE(result) << result.error().message;
+  EXPECT_EQ(result->verdict, "undecidable");
+  EXPECT_NE(result->statement.find("too noisy"), std::string::npos) << result->statement;
+  // Tracks of 20 frames each.
+  conceal.noise_m = 1e-4;
+  auto made = make_concealed_recordings(clump, table, conceal);
+  ASSERT_TRUE(made);
+  for (auto& trial : made->recordings[0].trials) {
+    Track& t = *trial.track;
+    t.t.resize(20);
+    t.x.resize(20);
+    t.z.resize(20);
+  }
+  result = diagnose(clump, table, made->recordings, made->names, {});
+  ASSERT_TRUE(result) << result.error().message;
+  EXPECT_EQ(result->verdict, "undecidable");
+  EXPECT_NE(result->statement.find("usable tracked trial"), std::string::npos) << result->statement;
+}
+
+}  // namespace clumpforge
