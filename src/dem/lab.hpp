@@ -19,6 +19,9 @@ struct LabOptions {
   std::optional<Interaction> interaction;  ///< overrides the table's particle-surface pair
   ContactSettings contact;          ///< contact law settings (rolling model, limitForce, ...)
   std::optional<double> time_step;  ///< [s]; default: the estimate's choice
+  /// Default time step: at least this many steps per Hertz contact (50 = the estimate's
+  /// choice; the diagnosis, which replays trials thousands of times, uses 25).
+  int steps_per_contact = 50;
   double frame_rate_hz = 1000.0;    ///< track sampling, like a high-speed camera
   double tilt_rate_deg_per_s = 5.0; ///< used when the recording has none
   double max_time = 6.0;            ///< [s] simulated time limit of a drop or roll trial (a tilt runs to 89 deg)

@@ -12,6 +12,7 @@
 #include "core/clump.hpp"
 #include "core/recording.hpp"
 #include "core/run_context.hpp"
+#include "diagnose/diagnose.hpp"
 #include "diagnose/effects.hpp"
 #include "dem/lab.hpp"
 
@@ -34,7 +35,7 @@ struct ConcealOptions {
   double empty_cell_probability = 0.005;  ///< a lost x or z cell
   bool conceal = true;                 ///< retune the base coefficients to hide the effect in the summaries
   std::uint64_t seed = 1;
-  LabOptions lab;                      ///< contact settings, particle material
+  LabOptions lab = diagnosis_lab_options();  ///< contact settings, particle material, steps per contact
 };
 
 struct SummaryMatch {

@@ -27,11 +27,19 @@
 
 namespace clumpforge {
 
+/// The lab options the diagnosis and the generator share: 25 steps per Hertz contact (the
+/// replays run thousands of times; both sides must step the same way).
+inline LabOptions diagnosis_lab_options() {
+  LabOptions lab;
+  lab.steps_per_contact = 25;
+  return lab;
+}
+
 struct DiagnoseOptions {
-  LabOptions lab;                  ///< contact settings, particle material, time step
+  LabOptions lab = diagnosis_lab_options();  ///< contact settings, particle material, time step
   std::vector<Effect> effects;     ///< candidates (empty: the whole library)
   double min_delta_bic = 10.0;     ///< margin over the baseline and over the next best
-  int max_evaluations = 45;        ///< per hypothesis fit
+  int max_evaluations = 45;        ///< simplex evaluations per hypothesis fit
   double horizon_perturbation = 1e-4;  ///< [rad] release-orientation uncertainty for the predictability horizon
   int orientation_candidates = 16; ///< tried per trial whose release orientation was not recorded
   std::uint64_t seed = 1;

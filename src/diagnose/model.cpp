@@ -55,7 +55,8 @@ double replay_summary(const std::vector<ReplaySample>& replay, LabTest test) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model, const std::vector<std::size_t>& which, bool keep_replays) {
+Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model, const std::vector<std::size_t>& which, bool keep_replays,
+                                         bool keep_residuals) {
   const auto& recordings = *ev.recordings;
   // One lab world per recording that is needed.
   std::vector<std::optional<LabWorld>> worlds(recordings.size());
@@ -84,14 +85,25 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
     // The time origin is chosen on the first phase (free fall, the incline), where the
     // release alone decides the motion; a later misfit then shows where it is.
     const double first_phase_end = first_phase_end_time(samples, recording.test);
-    if (ev.shift.size() == ev.trials.size()) {
-      score.alignment = align(track, samples, sigma, x_offset, ev.shift[which[k]], ev.shift_window, ev.shift_window / 6.0, tt.cutoff,
+    if (ev.fixed_alignment.size() == ev.trials.size() && ev.fixed_alignment[which[k]]) {
+      const Alignment& fixed = *ev.fixed_alignment[which[k]];
+      score.alignment = score_at(track, samples, sigma, fixed.shift, fixed.x_offset, tt.cutoff);
+    } else if (ev.shift.size() == ev.trials.size()) {
+      score.alignment = align(track, samples, sigma, x_offset, ev.shift[which[k]], ev.shift_window, ev.shift_window, tt.cutoff,
                               ev.shift[which[k]] + first_phase_end);
     } else {
       score.alignment = align(track, samples, sigma, x_offset, tt.shift_guess, ev.shift_range[which[k]], 5e-4, tt.cutoff,
                               tt.shift_guess + first_phase_end + (recording.test == LabTest::Drop ? 0.0 : ev.shift_range[which[k]]));
     }
     score.summary = replay_summary(samples, recording.test);
+    if (keep_residuals) {
+      // The same cells every time (frames up to the cutoff, non-empty cells), in order.
+      for (const auto& f : residuals(track, samples, sigma, score.alignment)) {
+        if (f.t + score.alignment.shift > tt.cutoff) break;
+        if (std::isfinite(f.rx)) score.residuals.push_back(f.rx);
+        if (std::isfinite(f.rz)) score.residuals.push_back(f.rz);
+      }
+    }
     if (keep_replays) score.replay = std::move(samples);
   });
   return scores;

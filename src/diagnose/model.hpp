@@ -39,6 +39,7 @@ struct TrialScore {
   Alignment alignment;
   std::vector<ReplaySample> replay;     ///< kept when asked
   double summary = std::numeric_limits<double>::quiet_NaN();  ///< the replay's summary value (SI, deg for tilt)
+  std::vector<double> residuals;        ///< (recorded - replay) / sigma of every fitted cell, when asked
 };
 
 /// The set-up shared by every evaluation of a diagnosis.
@@ -54,12 +55,15 @@ struct Evaluator {
   std::vector<double> shift;            ///< per trial, fixed by `initialise`
   std::vector<double> shift_range;      ///< per trial: half range of the first alignment [s]
   bool full_duration = false;           ///< replay whole tracks, not only up to each trial's horizon (plots, summaries)
+  /// Per trial: when set, its time shift and x offset are used as they are (no search), so
+  /// that finite differences in the physics are not blurred by the search's own tolerance.
+  std::vector<std::optional<Alignment>> fixed_alignment;
 };
 
 /// Replays and scores the trials `which` (indices into evaluator.trials) under `model`,
 /// in parallel; results do not depend on the thread count.
 Result<std::vector<TrialScore>> evaluate(const Evaluator& evaluator, const Model& model, const std::vector<std::size_t>& which,
-                                         bool keep_replays);
+                                         bool keep_replays, bool keep_residuals = false);
 
 /// The lab options of `model` for one recording (its surface's coefficients, the effect).
 LabOptions lab_options_for(const Evaluator& evaluator, const Model& model, const Recording& recording);

@@ -50,9 +50,7 @@ ReplayPoint interpolate(const std::vector<ReplaySample>& replay, double t) {
   return {replay[i].x + f * (replay[i + 1].x - replay[i].x), replay[i].z + f * (replay[i + 1].z - replay[i].z), i};
 }
 
-namespace {
-// chi^2 at a given shift and horizontal offset, frames up to `cutoff`.
-Alignment chi_squared_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset, double cutoff) {
+Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset, double cutoff) {
   Alignment a;
   a.shift = shift;
   a.x_offset = x_offset;
@@ -72,7 +70,6 @@ Alignment chi_squared_at(const Track& track, const std::vector<ReplaySample>& re
   }
   return a;
 }
-}  // namespace
 
 Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, bool fit_x_offset, double cutoff) {
   double x_offset = 0.0;
@@ -86,7 +83,7 @@ Alignment score(const Track& track, const std::vector<ReplaySample>& replay, dou
     }
     x_offset = count > 0 ? sum / count : 0.0;
   }
-  return chi_squared_at(track, replay, sigma, shift, x_offset, cutoff);
+  return score_at(track, replay, sigma, shift, x_offset, cutoff);
 }
 
 Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, bool fit_x_offset, double guess,
@@ -121,7 +118,7 @@ Alignment align(const Track& track, const std::vector<ReplaySample>& replay, dou
     if (a.chi_squared < best.chi_squared) best = a;
   }
   if (fit_cutoff >= cutoff) return best;
-  return chi_squared_at(track, replay, sigma, best.shift, best.x_offset, cutoff);
+  return score_at(track, replay, sigma, best.shift, best.x_offset, cutoff);
 }
 
 double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s) {

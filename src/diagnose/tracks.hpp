@@ -41,6 +41,10 @@ struct Alignment {
 Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, bool fit_x_offset,
                 double cutoff = std::numeric_limits<double>::infinity());
 
+/// chi^2 at a given shift and horizontal offset, frames recorded up to `cutoff`.
+Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset,
+                   double cutoff = std::numeric_limits<double>::infinity());
+
 /// Best shift in [guess - half_range, guess + half_range]: a grid of `step`, then a golden
 /// section to 1 microsecond around the best grid point. The shift (and x offset) is chosen
 /// on the frames up to `align_cutoff` (recorded time: the first phase, where the release
