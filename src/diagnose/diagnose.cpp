@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -302,7 +303,7 @@ Result<void> set_horizons(Context& c, const Model& model, double perturbation) {
     const auto nominal = replay_trial(*worlds[0][r], rec, tt.orientation, options[0][r], replay);
     const double limit = 0.5 * c.ev.sigma[r];
     double horizon = kNever;
-    for (const Eigen::Vector3d axis : {Eigen::Vector3d(Eigen::Vector3d::UnitX()), Eigen::Vector3d(Eigen::Vector3d::UnitY())}) {
+    for (const auto& axis : std::array<Eigen::Vector3d, 2>{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()}) {
       const Eigen::Quaterniond q = Eigen::Quaterniond(Eigen::AngleAxisd(perturbation, axis)) * tt.orientation;
       const auto other = replay_trial(*worlds[0][r], rec, q, options[0][r], replay);
       for (std::size_t k = 0; k < std::min(nominal.size(), other.size()); ++k) {
@@ -330,6 +331,11 @@ Result<void> set_horizons(Context& c, const Model& model, double perturbation) {
     if (rec.test == LabTest::Drop) horizon = std::min(horizon, phase_marks(nominal, rec.test).second_contact - 0.01);
     tt.horizon = horizon;
     tt.cutoff = c.ev.shift.size() == c.ev.trials.size() ? c.ev.shift[i] + horizon : kNever;
+    // The first stage of a fit: up to the first phase's end and the impact after it (drop:
+    // first landing + 20 ms; roll: the incline; tilt: the whole stick phase and onset).
+    const PhaseMarks marks = phase_marks(nominal, rec.test);
+    const double early = rec.test == LabTest::Drop ? marks.first_contact + 0.02 : rec.test == LabTest::Roll ? marks.floor_contact : marks.slip + 0.05;
+    tt.early_cutoff = std::min(tt.cutoff, c.ev.shift.size() == c.ev.trials.size() ? c.ev.shift[i] + early : kNever);
   });
   return {};
 }
@@ -425,14 +431,9 @@ Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::v
   double lambda = 1e-3;
   out.evaluations = 1;
   for (int iteration = 0; iteration < iterations; ++iteration) {
-    // The Jacobian with every track's time and horizontal origin held where they are now.
-    {
-      auto current = evaluate(c.ev, apply_parameters(start, parameters, unit), which, false);
-      c.evaluations += static_cast<int>(which.size());
-      if (!current) return std::unexpected(current.error());
-      c.ev.fixed_alignment.assign(c.ev.trials.size(), std::nullopt);
-      for (std::size_t k = 0; k < which.size(); ++k) c.ev.fixed_alignment[which[k]] = (*current)[k].alignment;
-    }
+    // The Jacobian of the residuals with the track origins refitted (profiled): the origins
+    // absorb part of a change (a later fall is partly a later release), and the step must
+    // know it. The origin search is a golden section in a single bowl, smooth to 1 us.
     auto held = residual_vector(unit);
     if (!held) {
       c.ev.fixed_alignment.clear();
@@ -573,6 +574,26 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
     }
   }
   if (failure) return std::unexpected(*failure);
+  if (spec != nullptr) {
+    // Stage 1: the early window only (the first flight, the first impact), where an effect
+    // and the coefficients are far from the narrow valleys later bounces make; then the
+    // whole window from there.
+    std::vector<double> cutoffs;
+    for (auto& tt : c.ev.trials) {
+      cutoffs.push_back(tt.cutoff);
+      tt.cutoff = tt.early_cutoff;
+    }
+    auto early = levenberg_marquardt(c, start, parameters, which, best_unit, max_evaluations / 5);
+    for (std::size_t i = 0; i < c.ev.trials.size(); ++i) c.ev.trials[i].cutoff = cutoffs[i];
+    if (!early) return std::unexpected(early.error());
+    out.evaluations += early->evaluations;
+    const double at_early = chi2(early->x);
+    if (failure) return std::unexpected(*failure);
+    if (at_early < best_value) {
+      best_value = at_early;
+      best_unit = early->x;
+    }
+  }
   auto minimum = levenberg_marquardt(c, start, parameters, which, best_unit, max_evaluations / 5);
   if (!minimum) return std::unexpected(minimum.error());
   out.evaluations += minimum->evaluations;
@@ -586,6 +607,32 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
   if (minimum->value < best_value) {
     best_value = minimum->value;
     best_unit = minimum->x;
+  }
+  if (spec != nullptr) {
+    // A line search along the effect's first parameter (the rest held), then Levenberg-
+    // Marquardt again from there: Gauss-Newton can creep along the effect when the track
+    // origins absorb part of its signal.
+    auto along = [&](double u) {
+      std::vector<double> trial = best_unit;
+      trial[0] = u;
+      return chi2(trial);
+    };
+    auto line = golden_section(along, std::max(0.0, best_unit[0] - 0.2), std::min(1.0, best_unit[0] + 0.2), 1e-3, 12);
+    if (failure) return std::unexpected(*failure);
+    out.evaluations += line.evaluations;
+    if (line.value < best_value) {
+      std::vector<double> from = best_unit;
+      from[0] = line.x[0];
+      auto again = levenberg_marquardt(c, start, parameters, which, from, std::max(2, max_evaluations / 10));
+      if (!again) return std::unexpected(again.error());
+      out.evaluations += again->evaluations;
+      best_value = line.value;
+      best_unit = from;
+      if (again->value < best_value) {
+        best_value = again->value;
+        best_unit = again->x;
+      }
+    }
   }
   out.model = apply_parameters(start, parameters, best_unit);
   out.chi2 = best_value;

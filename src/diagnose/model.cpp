@@ -89,7 +89,10 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
       const Alignment& fixed = *ev.fixed_alignment[which[k]];
       score.alignment = score_at(track, samples, sigma, fixed.shift, fixed.x_offset, tt.cutoff);
     } else if (ev.shift.size() == ev.trials.size()) {
-      score.alignment = align(track, samples, sigma, x_offset, ev.shift[which[k]], ev.shift_window, ev.shift_window, tt.cutoff,
+      // Wide enough for a model that falls or rolls milliseconds later than the first one
+      // (strong drag); the first phase's chi^2 is a single bowl in the shift.
+      const double window = recording.test == LabTest::Tilt ? ev.shift_window : 5.0 * ev.shift_window;
+      score.alignment = align(track, samples, sigma, x_offset, ev.shift[which[k]], window, window, tt.cutoff,
                               ev.shift[which[k]] + first_phase_end);
     } else {
       score.alignment = align(track, samples, sigma, x_offset, tt.shift_guess, ev.shift_range[which[k]], 5e-4, tt.cutoff,

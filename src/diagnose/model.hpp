@@ -27,6 +27,7 @@ struct TrackedTrial {
   /// knows, so frames after it are not fitted (they are still shown).
   double horizon = std::numeric_limits<double>::infinity();
   double cutoff = std::numeric_limits<double>::infinity();  ///< the horizon in the track's own time [s]
+  double early_cutoff = std::numeric_limits<double>::infinity();  ///< the end of the first phase (+ the impact), track time [s]
 };
 
 struct Model {

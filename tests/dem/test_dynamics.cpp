@@ -190,6 +190,24 @@ TEST(TimeStep, EstimatesAndRefusalOfTooLargeSteps) {
 
 namespace clumpforge {
 
+namespace {
+// A sphere of radius r dropped at `speed` onto the plate; returns the rebound ratio (and the
+// world after it left, or after `settle` s when it stays).
+double rebound_ratio(World world, double r, double speed) {
+  world.bodies[0].position = {0, 0, r + 1e-7};
+  world.bodies[0].velocity = {0, 0, -speed};
+  const double dt = contact_time(world, speed) / 1000.0;
+  bool touched = false;
+  for (int i = 0; i < 10'000'000; ++i) {
+    step(world, dt);
+    const bool touching = world.bodies[0].position.z() < r;
+    if (touching) touched = true;
+    if (touched && !touching) break;
+  }
+  return world.bodies[0].velocity.z() / speed;
+}
+}  // namespace
+
 TEST(PhysicsTerms, ViscoelasticRestitutionFollowsTheImpactSpeed) {
   // e(v) = 1 - (1 - e_ref) (v / v_ref)^(1/5): e_ref at v_ref, higher for slower impacts (1 %).
   const double r = 5e-3, e_ref = 0.6, v_ref = 2.0;
@@ -197,18 +215,8 @@ TEST(PhysicsTerms, ViscoelasticRestitutionFollowsTheImpactSpeed) {
     SCOPED_TRACE(speed);
     World world = test::sphere_over_plane(kSoft, kSteel, {e_ref, 0.0, 0.0}, r);
     world.terms.push_back(ViscoelasticRestitution{v_ref});
-    world.bodies[0].position = {0, 0, r + 1e-7};
-    world.bodies[0].velocity = {0, 0, -speed};
-    const double dt = contact_time(world, speed) / 1000.0;
-    bool touched = false;
-    for (int i = 0; i < 10'000'000; ++i) {
-      step(world, dt);
-      const bool touching = world.bodies[0].position.z() < r;
-      if (touching) touched = true;
-      if (touched && !touching) break;
-    }
     const double expected = 1.0 - (1.0 - e_ref) * std::pow(speed / v_ref, 0.2);
-    EXPECT_NEAR(world.bodies[0].velocity.z() / speed, expected, 0.01 * expected);
+    EXPECT_NEAR(rebound_ratio(world, r, speed), expected, 0.01 * expected);
   }
 }
 
@@ -229,23 +237,6 @@ TEST(PhysicsTerms, QuadraticDragGivesTheTerminalSpeed) {
 }  // namespace clumpforge
 
 namespace clumpforge {
-namespace {
-// A sphere of radius r dropped at `speed` onto the plate; returns the rebound ratio (and the
-// world after it left, or after `settle` s when it stays).
-double rebound_ratio(World world, double r, double speed) {
-  world.bodies[0].position = {0, 0, r + 1e-7};
-  world.bodies[0].velocity = {0, 0, -speed};
-  const double dt = contact_time(world, speed) / 1000.0;
-  bool touched = false;
-  for (int i = 0; i < 10'000'000; ++i) {
-    step(world, dt);
-    const bool touching = world.bodies[0].position.z() < r;
-    if (touching) touched = true;
-    if (touched && !touching) break;
-  }
-  return world.bodies[0].velocity.z() / speed;
-}
-}  // namespace
 
 TEST(PhysicsTerms, ElasticPlasticRestitutionFollowsThornton) {
   // e = e_ref e_T(v) / e_T(v_ref); far above yield e_T ~ v^(-1/4), so 16 x the speed halves e
