@@ -273,7 +273,7 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_option("--density", args->density, "With --mesh: bulk density [kg/m^3]");
   sub->add_option("--effects", args->effects, "Candidate effects to test (default: the whole library)");
   sub->add_option("--materials", args->materials, "Materials file (JSON) overriding the built-in table");
-  sub->add_option("--max-evaluations", args->max_evaluations, "Simplex evaluations per candidate fit");
+  sub->add_option("--max-evaluations", args->max_evaluations, "Fit budget per candidate (Levenberg-Marquardt iterations: a fifth of it)");
   sub->add_option("--seed", args->seed, "Seed (orientation candidates when a trial has none recorded)");
   sub->add_option("--out", args->out, "Write report.json and SVG plots here");
   sub->add_flag("--json", args->json, "Print the report as JSON");

@@ -434,11 +434,7 @@ Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::v
     // The Jacobian of the residuals with the track origins refitted (profiled): the origins
     // absorb part of a change (a later fall is partly a later release), and the step must
     // know it. The origin search is a golden section in a single bowl, smooth to 1 us.
-    auto held = residual_vector(unit);
-    if (!held) {
-      c.ev.fixed_alignment.clear();
-      return std::unexpected(held.error());
-    }
+    const Eigen::VectorXd* held = &r;
     Eigen::MatrixXd jacobian(held->size(), p);
     bool same_size = held->size() == r.size();
     for (Eigen::Index k = 0; k < p && same_size; ++k) {
@@ -447,17 +443,13 @@ Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::v
       u[static_cast<std::size_t>(k)] += h;
       auto rk = residual_vector(u);
       ++out.evaluations;
-      if (!rk) {
-        c.ev.fixed_alignment.clear();
-        return std::unexpected(rk.error());
-      }
+      if (!rk) return std::unexpected(rk.error());
       if (rk->size() != held->size()) {
         same_size = false;
         break;
       }
       jacobian.col(k) = (*rk - *held) / h;
     }
-    c.ev.fixed_alignment.clear();
     if (!same_size) break;
     const Eigen::MatrixXd jtj = jacobian.transpose() * jacobian;
     const Eigen::VectorXd jtr = jacobian.transpose() * r;

@@ -39,7 +39,7 @@ struct DiagnoseOptions {
   LabOptions lab = diagnosis_lab_options();  ///< contact settings, particle material, time step
   std::vector<Effect> effects;     ///< candidates (empty: the whole library)
   double min_delta_bic = 10.0;     ///< margin over the baseline and over the next best
-  int max_evaluations = 45;        ///< simplex evaluations per hypothesis fit
+  int max_evaluations = 45;        ///< fit budget per candidate: Levenberg-Marquardt iterations are a fifth of it
   double horizon_perturbation = 1e-4;  ///< [rad] release-orientation uncertainty for the predictability horizon
   int orientation_candidates = 16; ///< tried per trial whose release orientation was not recorded
   std::uint64_t seed = 1;

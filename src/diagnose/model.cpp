@@ -85,10 +85,7 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
     // The time origin is chosen on the first phase (free fall, the incline), where the
     // release alone decides the motion; a later misfit then shows where it is.
     const double first_phase_end = first_phase_end_time(samples, recording.test);
-    if (ev.fixed_alignment.size() == ev.trials.size() && ev.fixed_alignment[which[k]]) {
-      const Alignment& fixed = *ev.fixed_alignment[which[k]];
-      score.alignment = score_at(track, samples, sigma, fixed.shift, fixed.x_offset, tt.cutoff);
-    } else if (ev.shift.size() == ev.trials.size()) {
+    if (ev.shift.size() == ev.trials.size()) {
       // Wide enough for a model that falls or rolls milliseconds later than the first one
       // (strong drag); the first phase's chi^2 is a single bowl in the shift.
       const double window = recording.test == LabTest::Tilt ? ev.shift_window : 5.0 * ev.shift_window;

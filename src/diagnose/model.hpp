@@ -56,9 +56,6 @@ struct Evaluator {
   std::vector<double> shift;            ///< per trial, fixed by `initialise`
   std::vector<double> shift_range;      ///< per trial: half range of the first alignment [s]
   bool full_duration = false;           ///< replay whole tracks, not only up to each trial's horizon (plots, summaries)
-  /// Per trial: when set, its time shift and x offset are used as they are (no search), so
-  /// that finite differences in the physics are not blurred by the search's own tolerance.
-  std::vector<std::optional<Alignment>> fixed_alignment;
 };
 
 /// Replays and scores the trials `which` (indices into evaluator.trials) under `model`,
