@@ -101,4 +101,15 @@ double f_distribution_upper_tail(double f, double d1, double d2) {
   return incomplete_beta(d2 / 2.0, d1 / 2.0, d2 / (d2 + d1 * f));
 }
 
+SampleSpread sample_spread(const std::vector<double>& values) {
+  SampleSpread s;
+  if (values.empty()) return s;
+  for (double v : values) s.mean += v;
+  s.mean /= static_cast<double>(values.size());
+  double squares = 0.0;
+  for (double v : values) squares += (v - s.mean) * (v - s.mean);
+  s.sd = values.size() > 1 ? std::sqrt(squares / static_cast<double>(values.size() - 1)) : 0.0;
+  return s;
+}
+
 }  // namespace clumpforge

@@ -20,6 +20,12 @@ QuadraticFit fit_quadratic(const std::vector<double>& x, const std::vector<doubl
 /// Solutions of fit(x) = target with low <= x <= high, ascending.
 std::vector<double> solve_in_range(const QuadraticFit& fit, double target, double low, double high);
 
+/// Mean and sample standard deviation (n - 1); zeros for an empty sample.
+struct SampleSpread {
+  double mean = 0.0, sd = 0.0;
+};
+SampleSpread sample_spread(const std::vector<double>& values);
+
 /// Regularized incomplete beta function I_x(a, b) (Lentz continued fraction).
 double incomplete_beta(double a, double b, double x);
 /// Upper tail of the F distribution with (d1, d2) degrees of freedom.

@@ -6,25 +6,10 @@
 #include <numeric>
 
 #include "diagnose/diagnose.hpp"
+#include "calibrate/stats.hpp"
 #include "diagnose/optimize.hpp"
 
 namespace clumpforge {
-namespace {
-
-struct Spread {
-  double mean = 0.0, sd = 0.0;
-};
-Spread spread(const std::vector<double>& v) {
-  Spread s;
-  if (v.empty()) return s;
-  s.mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-  double sq = 0.0;
-  for (double x : v) sq += (x - s.mean) * (x - s.mean);
-  s.sd = v.size() > 1 ? std::sqrt(sq / static_cast<double>(v.size() - 1)) : 0.0;
-  return s;
-}
-
-}  // namespace
 
 Result<DiagnoseResult> diagnose_summaries(const Clump& clump, const MaterialTable& table, const std::vector<Recording>& recordings,
                                           const std::vector<std::string>& names, const DiagnoseOptions& options, const RunContext& run) {
@@ -43,7 +28,7 @@ Result<DiagnoseResult> diagnose_summaries(const Clump& clump, const MaterialTabl
     drop_heights.push_back(fmt::format("{:g} m on {}", rec.release_height, rec.surface));
     std::vector<double> ratios;
     for (double h : values) ratios.push_back(std::sqrt(std::max(h, 0.0) / rec.release_height));
-    const Spread measured = spread(ratios);
+    const SampleSpread measured = sample_spread(ratios);
     auto pair = table.interaction(options.lab.particle_material, rec.surface);
     if (!pair) return std::unexpected(pair.error());
     // The contact restitution whose DEM drops reproduce the measured mean rebound.
@@ -64,8 +49,7 @@ Result<DiagnoseResult> diagnose_summaries(const Clump& clump, const MaterialTabl
         return 1e9;
       }
       last = std::move(*out);
-      const Spread s = spread(last.recording.summaries());
-      return std::abs(s.mean - spread(values).mean);
+      return std::abs(sample_spread(last.recording.summaries()).mean - sample_spread(values).mean);
     };
     auto best = golden_section(mismatch, 0.05, 1.0, 2e-3, 20);
     if (failure) return std::unexpected(*failure);
