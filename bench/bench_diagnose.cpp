@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   int controls = 50, trials = 4;
   std::uint64_t seed = 1;
   std::vector<std::string> only;
-  bool full_set = false;
+  bool full_set = false, existing_only = false;
   app.add_option("--clump", clump_file, "Clump library the recordings are made with and diagnosed against");
   app.add_option("--clump-name", clump_name, "Which clump of the library");
   app.add_option("--cli", cli, "The clumpforge executable");
@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "Seed of the whole benchmark");
   app.add_option("--effects", only, "Only these effects (default: the library)");
   app.add_flag("--full-set", full_set, "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
+  app.add_flag("--existing-only", existing_only, "Score only the cases already diagnosed in --out (a partial run's figures), run none");
   CLI11_PARSE(app, argc, argv);
 
   auto clumps = read_clump_library(clump_file);
@@ -138,6 +139,7 @@ int main(int argc, char** argv) {
     const fs::path dir = fs::path(out) / c.id;
     const fs::path report = dir / "report.json";
     const std::string truth = c.effect ? effect_spec(library, *c.effect).name : "none";
+    if (!fs::exists(report) && existing_only) continue;
     if (!fs::exists(report)) {
       auto made = make_concealed_recordings(*clump, table, c.options);
       if (!made) {
