@@ -169,9 +169,6 @@ double mean(const std::vector<double>& v) {
   return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
 }
 
-double& coefficient(Interaction& i, LabTest test) {
-  return test == LabTest::Drop ? i.restitution : test == LabTest::Roll ? i.rolling_friction : i.static_friction;
-}
 std::pair<double, double> coefficient_bounds(LabTest test) {
   return test == LabTest::Drop ? std::pair{0.05, 1.0} : test == LabTest::Roll ? std::pair{0.0, 0.5} : std::pair{0.01, 2.0};
 }
@@ -247,14 +244,14 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
         auto [low, high] = coefficient_bounds(test);
         auto mismatch = [&](double value) -> Result<double> {
           Interaction trial = result.truth;
-          coefficient(trial, test) = value;
+          coefficient_of(trial, coefficient_for(test)) = value;
           auto g = run_setup(clump, table, all[r].recording, with(trial, true), orientations[r], false);
           if (!g) return std::unexpected(g.error());
           return mean(g->summaries) - target[r];
         };
         // A coarse then a fine grid: irregular bodies make the mean rough in the coefficient
         // (a roll's distance jumps when a tumble changes), so root finders stall.
-        double best = coefficient(result.truth, test), best_error = std::numeric_limits<double>::infinity();
+        double best = coefficient_of(result.truth, coefficient_for(test)), best_error = std::numeric_limits<double>::infinity();
         double centre = best, half = test == LabTest::Roll ? std::max(0.5 * centre, 0.01) : 0.3 * centre;
         for (int level = 0; level < 2; ++level) {
           for (int k = -5; k <= 5; ++k) {
@@ -269,7 +266,7 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
           centre = best;
           half /= 6.0;
         }
-        coefficient(result.truth, test) = best;
+        coefficient_of(result.truth, coefficient_for(test)) = best;
       }
       context.report("concealing", 0.5 * (round + 1) / 2.0);
     }

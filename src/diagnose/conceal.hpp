@@ -12,7 +12,6 @@
 #include "core/clump.hpp"
 #include "core/recording.hpp"
 #include "core/run_context.hpp"
-#include "diagnose/diagnose.hpp"
 #include "diagnose/effects.hpp"
 #include "dem/lab.hpp"
 

@@ -48,9 +48,14 @@ double chi2_tail(double chi2, double n) {
   return 0.5 * std::erfc(z / std::sqrt(2.0));
 }
 
+/// A phase's residual beyond the noise: significant after a Bonferroni correction over the
+/// `groups` phases, and large (kPracticalExcess).
+bool beyond_noise(double chi2, int values, std::size_t groups) {
+  return values > 0 && chi2_tail(chi2, values) < 1e-3 / std::max<std::size_t>(1, groups) && chi2 / values > kPracticalExcess;
+}
+
 // ---- Parameters of a fit, mapped to the unit box ----------------------------------------
 
-enum class Coefficient { Restitution, StaticFriction, RollingFriction };
 
 struct FitParameter {
   bool effect = false;
@@ -69,16 +74,7 @@ struct FitParameter {
   }
 };
 
-double& coefficient_of(Interaction& i, Coefficient c) {
-  return c == Coefficient::Restitution ? i.restitution : c == Coefficient::StaticFriction ? i.static_friction : i.rolling_friction;
-}
-double coefficient_of(const Interaction& i, Coefficient c) {
-  return c == Coefficient::Restitution ? i.restitution : c == Coefficient::StaticFriction ? i.static_friction : i.rolling_friction;
-}
 
-Coefficient coefficient_for(LabTest test) {
-  return test == LabTest::Drop ? Coefficient::Restitution : test == LabTest::Tilt ? Coefficient::StaticFriction : Coefficient::RollingFriction;
-}
 
 std::pair<double, double> coefficient_range(Coefficient c) {
   switch (c) {
@@ -148,20 +144,16 @@ void accumulate(Groups& groups, std::size_t recording, LabTest test, const Track
     segment->tau.push_back(f.t - entered);
     segment->rx.push_back(f.rx);
     segment->rz.push_back(f.rz);
-    if (std::isfinite(f.rx)) {
-      g.chi2 += f.rx * f.rx;
-      g.sum_x += f.rx;
-      g.sq_x += f.rx * f.rx;
-      ++g.count_x;
+    auto add = [&g](double r, double& sum, double& squares, int& count) {
+      if (!std::isfinite(r)) return;
+      g.chi2 += r * r;
+      sum += r;
+      squares += r * r;
+      ++count;
       ++g.values;
-    }
-    if (std::isfinite(f.rz)) {
-      g.chi2 += f.rz * f.rz;
-      g.sum_z += f.rz;
-      g.sq_z += f.rz * f.rz;
-      ++g.count_z;
-      ++g.values;
-    }
+    };
+    add(f.rx, g.sum_x, g.sq_x, g.count_x);
+    add(f.rz, g.sum_z, g.sq_z, g.count_z);
   }
 }
 
@@ -677,7 +669,6 @@ double summary_scale(LabTest test) { return test == LabTest::Tilt ? 1.0 : 1000.0
 
 FitQuality quality(const Context& c, const std::vector<TrialScore>& scores) {
   FitQuality q;
-  std::vector<std::size_t> train_pos, held_pos;
   std::vector<TrialScore> train_scores, held_scores;
   std::vector<std::size_t> train_idx, held_idx;
   for (std::size_t k = 0; k < c.all.size(); ++k) {
@@ -731,7 +722,6 @@ std::string recording_label(const Recording& r, const std::string& name) {
 std::vector<PhaseReport> locate(const Context& c, const Groups& groups) {
   std::vector<PhaseReport> out;
   const auto& recs = *c.ev.recordings;
-  const double threshold = 1e-3 / std::max<std::size_t>(1, groups.size());
   for (const auto& [key, g] : groups) {
     if (key.phase == Phase::Hold || key.phase == Phase::LaterBounces || g.values < 10) continue;
     PhaseReport p;
@@ -740,7 +730,7 @@ std::vector<PhaseReport> locate(const Context& c, const Groups& groups) {
     p.values = g.values;
     p.chi2_per_value = g.chi2 / g.values;
     p.p_value = chi2_tail(g.chi2, g.values);
-    p.significant = p.p_value < threshold && p.chi2_per_value > kPracticalExcess;
+    p.significant = beyond_noise(g.chi2, g.values, groups.size());
     const double sigma_mm = c.ev.sigma[key.recording] * 1000.0;
     p.bias_x_mm = g.count_x ? sigma_mm * g.sum_x / g.count_x : 0.0;
     p.bias_z_mm = g.count_z ? sigma_mm * g.sum_z / g.count_z : 0.0;
@@ -943,8 +933,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
   std::vector<GroupKey> flagged;
   for (const auto& [key, g] : all_groups) {
     if (key.phase == Phase::Hold || key.phase == Phase::LaterBounces || g.values < 10) continue;
-    const double threshold = 1e-3 / std::max<std::size_t>(1, all_groups.size());
-    if (chi2_tail(g.chi2, g.values) < threshold && g.chi2 / g.values > kPracticalExcess) flagged.push_back(key);
+    if (beyond_noise(g.chi2, g.values, all_groups.size())) flagged.push_back(key);
   }
 
   // Name: every candidate, on the tests it acts in.
@@ -1104,9 +1093,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
     if (key.phase == Phase::Hold || key.phase == Phase::LaterBounces || g.values < 20) continue;
     int parameters = 0;
     const double gain = smooth_discrepancy_gain(g, parameters);
-    const double threshold = 1e-3 / std::max<std::size_t>(1, improved_groups.size());
-    if (parameters > 0 && gain - parameters * std::log(g.values) >= options.min_delta_bic && chi2_tail(g.chi2, g.values) < threshold &&
-        g.chi2 / g.values > kPracticalExcess) {
+    if (parameters > 0 && gain - parameters * std::log(g.values) >= options.min_delta_bic && beyond_noise(g.chi2, g.values, improved_groups.size())) {
       result.unexplained.push_back(fmt::format("{} phases of {}", phase_name(key.phase), recording_label(recordings[key.recording], c.names[key.recording])));
     }
   }

@@ -27,14 +27,6 @@
 
 namespace clumpforge {
 
-/// The lab options the diagnosis and the generator share: 25 steps per Hertz contact (the
-/// replays run thousands of times; both sides must step the same way).
-inline LabOptions diagnosis_lab_options() {
-  LabOptions lab;
-  lab.steps_per_contact = 25;
-  return lab;
-}
-
 struct DiagnoseOptions {
   LabOptions lab = diagnosis_lab_options();  ///< contact settings, particle material, time step
   std::vector<Effect> effects;     ///< candidates (empty: the whole library)

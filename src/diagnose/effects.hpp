@@ -50,6 +50,26 @@ Result<Effect> parse_effect(std::string_view name);
 /// Switches `effect` on in `options` with parameter values `values` (one per parameter).
 void apply_effect(Effect effect, std::span<const double> values, LabOptions& options);
 
+/// The base coefficient a test measures: e (drop), mu_s (tilt), mu_r (roll).
+enum class Coefficient { Restitution, StaticFriction, RollingFriction };
+inline Coefficient coefficient_for(LabTest test) {
+  return test == LabTest::Drop ? Coefficient::Restitution : test == LabTest::Tilt ? Coefficient::StaticFriction : Coefficient::RollingFriction;
+}
+inline double& coefficient_of(Interaction& i, Coefficient c) {
+  return c == Coefficient::Restitution ? i.restitution : c == Coefficient::StaticFriction ? i.static_friction : i.rolling_friction;
+}
+inline double coefficient_of(const Interaction& i, Coefficient c) {
+  return c == Coefficient::Restitution ? i.restitution : c == Coefficient::StaticFriction ? i.static_friction : i.rolling_friction;
+}
+
+/// The lab options the diagnosis and the generator share: 25 steps per Hertz contact (the
+/// replays run thousands of times; both sides must step the same way).
+inline LabOptions diagnosis_lab_options() {
+  LabOptions lab;
+  lab.steps_per_contact = 25;
+  return lab;
+}
+
 /// The base parameters the diagnosis calibrates, per surface (the particle is the clump's material).
 struct SurfaceParameters {
   std::string surface;
