@@ -90,6 +90,7 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
   j["noise_m"] = nlohmann::json::object();
   for (const auto& [name, s] : r.noise_m) j["noise_m"][name] = s;
   j["baseline"] = coefficients_json(r.baseline);
+  j["refitted_on_all"] = r.refitted_on_all.empty() ? nlohmann::json() : coefficients_json(r.refitted_on_all);
   j["improved"] = coefficients_json(r.improved);
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
   j["phases"] = nlohmann::json::array();
@@ -106,6 +107,8 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
     j["hypotheses"].push_back({{"name", h.name}, {"values", values}, {"coefficients", coefficients_json(h.base)}, {"values_used", h.values_used},
                                {"delta_chi2", h.delta_chi2}, {"delta_bic", h.delta_bic}, {"heldout_delta_chi2", h.heldout_delta_chi2},
                                {"plausible", h.plausible}, {"improves_heldout", h.improves_heldout}, {"clears_signature", h.clears_signature},
+                               {"all_trials_delta_bic", std::isfinite(h.all_trials_delta_bic) ? nlohmann::json(h.all_trials_delta_bic) : nlohmann::json()},
+                               {"beats_refitted_null", h.beats_refitted_null},
                                {"flagged_excess_before", h.flagged_excess_before}, {"flagged_excess_after", h.flagged_excess_after},
                                {"passes", h.passes}, {"evaluations", h.evaluations},
                                {"smallest_detectable", std::isfinite(h.smallest_detectable) ? nlohmann::json(h.smallest_detectable) : nlohmann::json()}});
@@ -183,9 +186,11 @@ void print_text(const DiagnoseResult& r) {
   for (const auto& h : r.hypotheses) {
     std::string values;
     for (const auto& v : h.values) values += fmt::format(" {}={:.3g}", v.name, v.value);
-    std::cout << fmt::format("  {:28s} {:9.1f} {:9.1f} {:9.1f}  {}{}{}{}{}\n", h.name, h.delta_chi2, h.delta_bic, h.heldout_delta_chi2,
+    const std::string refitted =
+        std::isfinite(h.all_trials_delta_bic) && !h.beats_refitted_null ? fmt::format(" refitted-coefficients-do-as-well({:.1f})", h.all_trials_delta_bic) : "";
+    std::cout << fmt::format("  {:28s} {:9.1f} {:9.1f} {:9.1f}  {}{}{}{}{}{}\n", h.name, h.delta_chi2, h.delta_bic, h.heldout_delta_chi2,
                              h.passes ? "PASS" : "fail", h.plausible ? "" : " implausible", h.improves_heldout ? "" : " no-held-out-gain",
-                             h.clears_signature ? "" : " signature-left", values);
+                             h.clears_signature ? "" : " signature-left", refitted, values);
   }
   std::cout << fmt::format("\nfit before -> after: training RMS {:.3f} -> {:.3f} mm, held-out RMS {:.3f} -> {:.3f} mm\n", r.before.train_rms_mm,
                            r.after.train_rms_mm, r.before.heldout_rms_mm, r.after.heldout_rms_mm);

@@ -65,7 +65,8 @@ struct HypothesisReport {
   double delta_chi2 = 0.0;             ///< training: baseline - hypothesis
   double delta_bic = 0.0;              ///< delta_chi2 - k ln n
   double heldout_delta_chi2 = 0.0;     ///< held-out trials: baseline - hypothesis
-  bool plausible = false, improves_heldout = false, clears_signature = false, passes = false;
+  double all_trials_delta_bic = NAN;   ///< every trial: against the coefficients refitted on every trial (set for candidates passing the rest)
+  bool plausible = false, improves_heldout = false, clears_signature = false, beats_refitted_null = false, passes = false;
   double flagged_excess_before = 0.0, flagged_excess_after = 0.0;  ///< chi^2 - values in the baseline's flagged phases
   int evaluations = 0;
   double smallest_detectable = 0.0;    ///< of its first parameter (reported with verdict "none")
@@ -94,6 +95,7 @@ struct DiagnoseResult {
   std::vector<ParameterValue> effect_parameters;
   std::vector<std::pair<std::string, double>> noise_m;  ///< per recording, estimated
   std::vector<SurfaceParameters> baseline, improved;
+  std::vector<SurfaceParameters> refitted_on_all;  ///< the second null's coefficients (every trial), when it was needed
   FitQuality before, after;
   std::vector<PhaseReport> phases;
   std::vector<HypothesisReport> hypotheses;

@@ -5,6 +5,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "support/test_support.hpp"
@@ -57,6 +60,36 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --json", (dir / "rec").string(), clump()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(nlohmann::json::parse(run.out)["verdict"], "undecidable");
+}
+
+TEST(ConcealCli, BadOptionsAreRefusedAndNothingIsWritten) {
+  test::ScratchDir dir("conceal-bad");
+  const auto out = dir / "recordings";
+  const auto answer = dir / "answer.json";
+  auto conceal = [&](const std::string& clump_file, const std::string& options) {
+    return test::run_command(fmt::format("'{}' '{}' --small --out '{}' --answer '{}' {}", CLUMPFORGE_CONCEAL, clump_file, out.string(),
+                                         answer.string(), options));
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--effect air_drgg", "did you mean 'air_drag'"},
+      {"--effect air_drag --magnitude huge", "'huge' is not realistic, strong or numbers"},
+      {"--effect air_drag --magnitude -1", "drag_coefficient = -1 is outside"},
+      {"--effect air_drag --magnitude 0.4,2", "takes 1 parameter(s), not 2"},
+      {"--restitution 1.5", "restitution 1.5 is outside (0, 1]"},
+      {"--trials 0", "trials per recording must be 1 to 1000"},
+      {"--noise -1", "noise must be >= 0"},
+      {"--surface marble", "tuber - marble"},
+  };
+  for (const auto& [options, message] : cases) {
+    const auto run = conceal(clump(), options);
+    EXPECT_EQ(run.exit_code, 1) << options;
+    EXPECT_NE(run.err.find(message), std::string::npos) << options << ": " << run.err;
+  }
+  const auto missing = conceal((dir / "nope.h5").string(), "");
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("nope.h5"), std::string::npos) << missing.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_FALSE(std::filesystem::exists(answer));
 }
 
 TEST(DiagnoseCli, SummariesOnlySayWhatTheyCanDecide) {
