@@ -125,6 +125,33 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
   }
 }
 
+TEST(DiagnoseBlind, AnEffectOutsideTheCandidatesIsUnexplainedNotNamed) {
+  // Strong drag hidden, but only viscous rolling offered: no candidate may be named, and the
+  // generic smooth discrepancy must point at the drops' flights (cross-validated).
+  const Clump clump = diagnosis_clump();
+  const MaterialTable table = default_material_table();
+  DiagnoseOptions options;
+  options.effects = {Effect::ViscousRolling};
+  options.max_evaluations = 30;
+  ConcealOptions conceal;
+  conceal.trials = 4;
+  conceal.drop_heights = {1.0};
+  conceal.roll_starts = {};
+  conceal.tilt = false;
+  conceal.seed = 11;
+  conceal.effect = Effect::AirDrag;
+  conceal.values = {1.5};
+  auto made = make_concealed_recordings(clump, table, conceal);
+  ASSERT_TRUE(made) << made.error().message;
+  auto result = diagnose(clump, table, made->recordings, made->names, options);
+  ASSERT_TRUE(result) << result.error().message;
+  ASSERT_EQ(result->verdict, "unexplained") << result->statement;
+  EXPECT_TRUE(result->effect_parameters.empty());
+  bool flight = false;
+  for (const auto& u : result->unexplained) flight = flight || u.find("flight phases of drop-1m") != std::string::npos;
+  EXPECT_TRUE(flight) << result->statement;
+}
+
 TEST(DiagnoseBlind, TooShortOrTooNoisyIsUndecidable) {
   const Clump clump = diagnosis_clump();
   const MaterialTable table = default_material_table();
