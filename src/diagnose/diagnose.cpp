@@ -1189,22 +1189,6 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
                                                     : std::string("none"),
                                    report.heldout_delta_chi2);
   }
-  result.improved = improved.base;
-  const Groups improved_groups = phase_groups(c, c.all, improved_scores);
-  // Whole tracks (beyond the horizons) for the summaries and the plots.
-  c.ev.full_duration = true;
-  auto full_base = score(c, baseline, c.all, true);
-  if (!full_base) return std::unexpected(full_base.error());
-  auto full_improved = named ? score(c, improved, c.all, true) : full_base;
-  if (!full_improved) return std::unexpected(full_improved.error());
-  c.ev.full_duration = false;
-  result.before = quality(c, *full_base);
-  result.after = quality(c, *full_improved);
-  for (auto& p : result.phases) {
-    for (const auto& [key, g] : improved_groups) {
-      if (c.names[key.recording] == p.recording && phase_name(key.phase) == p.phase && g.values > 0) p.improved_chi2_per_value = g.chi2 / g.values;
-    }
-  }
   // A smooth discrepancy the named effect (or the baseline) leaves, phase by phase.
   auto smooth_misfits = [&](const Groups& groups) {
     std::vector<std::string> found;
@@ -1224,8 +1208,9 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
     }
     return found;
   };
-  result.unexplained = smooth_misfits(improved_groups);
-  Groups final_groups = improved_groups;
+  Groups final_groups = phase_groups(c, c.all, improved_scores);
+  bool recalibrated = false;  // nothing named, and the coefficients refitted on every trial shown as the improvement
+  result.unexplained = smooth_misfits(final_groups);
   if (!named && !result.unexplained.empty()) {
     // Without an effect, what the coefficients refitted on every trial still leave: a
     // miscalibration seen only on the held-out trials is not an unexplained mismatch.
@@ -1236,11 +1221,31 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
     result.unexplained = smooth_misfits(final_groups);
     if (result.unexplained.empty()) {
       result.notes.push_back("the baseline's misfit on the held-out trials goes once its coefficients are refitted on every trial: a miscalibration, "
-                             "not missing physics");
+                             "not missing physics; 'improved' and the fit after are those coefficients");
+      // The recalibrated coefficients are what the user should take away: shown as the improvement.
+      improved = null_all->model;
+      improved_scores = std::move(*s);
+      recalibrated = true;
     }
   }
   if (null_all) {
     result.refitted_on_all = null_all->model.base;
+  }
+  result.improved = improved.base;
+  const Groups improved_groups = phase_groups(c, c.all, improved_scores);
+  // Whole tracks (beyond the horizons) for the summaries and the plots.
+  c.ev.full_duration = true;
+  auto full_base = score(c, baseline, c.all, true);
+  if (!full_base) return std::unexpected(full_base.error());
+  auto full_improved = named || recalibrated ? score(c, improved, c.all, true) : full_base;
+  if (!full_improved) return std::unexpected(full_improved.error());
+  c.ev.full_duration = false;
+  result.before = quality(c, *full_base);
+  result.after = quality(c, *full_improved);
+  for (auto& p : result.phases) {
+    for (const auto& [key, g] : improved_groups) {
+      if (c.names[key.recording] == p.recording && phase_name(key.phase) == p.phase && g.values > 0) p.improved_chi2_per_value = g.chi2 / g.values;
+    }
   }
   if (!named && result.verdict.empty()) {
     if (!result.unexplained.empty()) {
