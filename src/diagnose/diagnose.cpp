@@ -1320,7 +1320,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
         slight.push_back(fmt::format("{} phases of {} (chi^2/value {:.2f})", phase_name(key.phase), c.names[key.recording], g.chi2 / g.values));
       }
       const std::string residual_state =
-          slight.empty() ? std::string("the residuals are consistent with the estimated noise level after the baseline fit")
+          slight.empty() ? std::string("the residuals are consistent with the estimated noise level once the coefficients are fitted")
                          : fmt::format("the residuals are at the noise level except for a small misfit, below three times the noise and with no "
                                        "shape the trials share, in {}",
                                        fmt::join(slight, ", "));
