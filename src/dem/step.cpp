@@ -260,7 +260,7 @@ void step(World& world, double dt) {
   }
 }
 
-TimeStepEstimate estimate_time_step(const World& world, double impact_speed) {
+TimeStepEstimate estimate_time_step(const World& world, double impact_speed, int steps_per_contact) {
   TimeStepEstimate estimate;
   estimate.rayleigh = std::numeric_limits<double>::infinity();
   estimate.hertz = std::numeric_limits<double>::infinity();
@@ -279,7 +279,7 @@ TimeStepEstimate estimate_time_step(const World& world, double impact_speed) {
   // EDEM's guidance: 20 % of the Rayleigh time for coordination numbers of 4 or more, 40 %
   // below; one body on walls (the lab tests) is the sparse case.
   estimate.rayleigh_fraction = world.bodies.size() <= 1 ? 0.4 : 0.2;
-  estimate.chosen = std::min(estimate.rayleigh_fraction * estimate.rayleigh, estimate.hertz / 50.0);
+  estimate.chosen = std::min(estimate.rayleigh_fraction * estimate.rayleigh, estimate.hertz / std::max(20, steps_per_contact));
   estimate.largest_allowed = std::min(0.4 * estimate.rayleigh, estimate.hertz / 20.0);
   return estimate;
 }

@@ -11,14 +11,15 @@ struct TimeStepEstimate {
   double rayleigh = 0.0;   ///< T_R = pi R sqrt(rho/G) / (0.1631 nu + 0.8766), smallest sphere [s]
   double hertz = 0.0;      ///< Hertz contact duration 2.87 (m*^2 / (R* E*^2 v))^(1/5) [s]
   double rayleigh_fraction = 0.2;  ///< 0.4 for a single body on walls (low coordination), else 0.2 (EDEM)
-  double chosen = 0.0;     ///< min(fraction T_R, t_H / 50): at least 50 steps per contact [s]
+  double chosen = 0.0;     ///< min(fraction T_R, t_H / n): at least n steps per contact (n = 50 by default) [s]
   double largest_allowed = 0.0;  ///< min(0.4 T_R, t_H / 20): an override above this is refused [s]
 };
 
 /// Estimates for the world's bodies against its walls and each other at impact speed
 /// `impact_speed` [m/s] (> 0). EDEM help "Selecting a time step"; LIGGGHTS
-/// fix check/timestep/gran.
-TimeStepEstimate estimate_time_step(const World& world, double impact_speed);
+/// fix check/timestep/gran. `steps_per_contact` (20 or more: below, the step is refused)
+/// sets `chosen`.
+TimeStepEstimate estimate_time_step(const World& world, double impact_speed, int steps_per_contact = 50);
 
 /// Fails when dt is not positive or exceeds the estimate's largest allowed step.
 Result<void> check_time_step(double dt, const TimeStepEstimate& estimate);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "calibrate/stats.hpp"
 #include "core/rng.hpp"
 #include "diagnose/model.hpp"
 #include "diagnose/tracks.hpp"
@@ -163,12 +164,6 @@ Result<Generated> run_setup(const Clump& clump, const MaterialTable& table, cons
   return g;
 }
 
-double mean(const std::vector<double>& v) {
-  double sum = 0.0;
-  for (double x : v) sum += x;
-  return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
-}
-
 std::pair<double, double> coefficient_bounds(LabTest test) {
   return test == LabTest::Drop ? std::pair{0.05, 1.0} : test == LabTest::Roll ? std::pair{0.0, 0.5} : std::pair{0.01, 2.0};
 }
@@ -231,45 +226,43 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
   for (std::size_t r : reference) {
     auto g = run_setup(clump, table, all[r].recording, with(result.baseline, false), orientations[r], false);
     if (!g) return std::unexpected(g.error());
-    target[r] = mean(g->summaries);
+    target[r] = sample_spread(g->summaries).mean;
   }
   result.truth = result.baseline;
   if (options.effect && options.conceal) {
-    // Secant steps on each test's own coefficient until its summary mean matches the baseline's.
-    for (int round = 0; round < 1; ++round) {
-      const auto& shown = effect_spec(library, *options.effect).tests;
-      for (std::size_t r : reference) {
-        const LabTest test = all[r].recording.test;
-        if (std::find(shown.begin(), shown.end(), test) == shown.end()) continue;  // the effect does not act there
-        auto [low, high] = coefficient_bounds(test);
-        auto mismatch = [&](double value) -> Result<double> {
-          Interaction trial = result.truth;
-          coefficient_of(trial, coefficient_for(test)) = value;
-          auto g = run_setup(clump, table, all[r].recording, with(trial, true), orientations[r], false);
-          if (!g) return std::unexpected(g.error());
-          return mean(g->summaries) - target[r];
-        };
-        // A coarse then a fine grid: irregular bodies make the mean rough in the coefficient
-        // (a roll's distance jumps when a tumble changes), so root finders stall.
-        double best = coefficient_of(result.truth, coefficient_for(test)), best_error = std::numeric_limits<double>::infinity();
-        double centre = best, half = test == LabTest::Roll ? std::max(0.5 * centre, 0.01) : 0.3 * centre;
-        for (int level = 0; level < 2; ++level) {
-          for (int k = -5; k <= 5; ++k) {
-            const double value = std::clamp(centre + half * k / 5.0, low, high);
-            auto f = mismatch(value);
-            if (!f) return std::unexpected(f.error());
-            if (std::abs(*f) < best_error) {
-              best_error = std::abs(*f);
-              best = value;
-            }
+    // Each test's own coefficient, retuned until its summary mean matches the baseline's.
+    const auto& shown = effect_spec(library, *options.effect).tests;
+    for (std::size_t r : reference) {
+      const LabTest test = all[r].recording.test;
+      if (std::find(shown.begin(), shown.end(), test) == shown.end()) continue;  // the effect does not act there
+      auto [low, high] = coefficient_bounds(test);
+      auto mismatch = [&](double value) -> Result<double> {
+        Interaction trial = result.truth;
+        coefficient_of(trial, coefficient_for(test)) = value;
+        auto g = run_setup(clump, table, all[r].recording, with(trial, true), orientations[r], false);
+        if (!g) return std::unexpected(g.error());
+        return sample_spread(g->summaries).mean - target[r];
+      };
+      // A coarse then a fine grid: irregular bodies make the mean rough in the coefficient
+      // (a roll's distance jumps when a tumble changes), so root finders stall.
+      double best = coefficient_of(result.truth, coefficient_for(test)), best_error = std::numeric_limits<double>::infinity();
+      double centre = best, half = test == LabTest::Roll ? std::max(0.5 * centre, 0.01) : 0.3 * centre;
+      for (int level = 0; level < 2; ++level) {
+        for (int k = -5; k <= 5; ++k) {
+          const double value = std::clamp(centre + half * k / 5.0, low, high);
+          auto f = mismatch(value);
+          if (!f) return std::unexpected(f.error());
+          if (std::abs(*f) < best_error) {
+            best_error = std::abs(*f);
+            best = value;
           }
-          centre = best;
-          half /= 6.0;
         }
-        coefficient_of(result.truth, coefficient_for(test)) = best;
+        centre = best;
+        half /= 6.0;
       }
-      context.report("concealing", 0.5 * (round + 1) / 2.0);
+      coefficient_of(result.truth, coefficient_for(test)) = best;
     }
+    context.report("concealing", 0.25);
   }
   for (std::size_t r = 0; r < all.size(); ++r) {
     auto g = run_setup(clump, table, all[r].recording, with(result.truth, true), orientations[r], true);
@@ -287,7 +280,7 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
       rec.trials.push_back(std::move(trial));
     }
     if (std::find(reference.begin(), reference.end(), r) != reference.end()) {
-      result.summaries.push_back({all[r].name, target[r], mean(g->summaries)});
+      result.summaries.push_back({all[r].name, target[r], sample_spread(g->summaries).mean});
     }
     result.recordings.push_back(std::move(rec));
     result.names.push_back(all[r].name);

@@ -532,7 +532,7 @@ Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::v
 /// The free parameters of a fit: the effect's (when `spec` is set) and the base coefficients
 /// of the tests in `which`, each within +-40 % of `model`'s value. With `fresh`, the effect
 /// starts from its usual value; otherwise from `model`'s.
-std::pair<Model, std::vector<FitParameter>> fit_parameters(const Context& c, const Model& model, const EffectSpec* spec, const std::vector<LabTest>& tests,
+std::pair<Model, std::vector<FitParameter>> fit_parameters(const Context& c, const Model& model, const EffectSpec* spec,
                                                            const std::vector<std::size_t>& which, bool fresh) {
   const auto& recs = *c.ev.recordings;
   Model start = model;
@@ -549,7 +549,7 @@ std::pair<Model, std::vector<FitParameter>> fit_parameters(const Context& c, con
     }
   }
   for (std::size_t s = 0; s < model.base.size(); ++s) {
-    for (LabTest test : tests) {
+    for (LabTest test : {LabTest::Drop, LabTest::Roll, LabTest::Tilt}) {
       const bool present = std::any_of(which.begin(), which.end(), [&](std::size_t i) {
         const Recording& r = recs[c.ev.trials[i].recording];
         return r.test == test && r.surface == model.base[s].surface;
@@ -578,7 +578,7 @@ std::vector<double> unit_point(const Model& start, const std::vector<FitParamete
 /// `model` (with its effect, if any) refitted on `which` by Levenberg-Marquardt from where it
 /// is: a fit already near its minimum, moved to other trials.
 Result<Fitted> refit(Context& c, const Model& model, const EffectSpec* spec, const std::vector<std::size_t>& which, int max_evaluations) {
-  auto [start, parameters] = fit_parameters(c, model, spec, {LabTest::Drop, LabTest::Roll, LabTest::Tilt}, which, false);
+  auto [start, parameters] = fit_parameters(c, model, spec, which, false);
   auto minimum = levenberg_marquardt(c, start, parameters, which, unit_point(start, parameters), std::max(2, max_evaluations / 5));
   if (!minimum) return std::unexpected(minimum.error());
   Fitted out;
@@ -591,11 +591,21 @@ Result<Fitted> refit(Context& c, const Model& model, const EffectSpec* spec, con
   return out;
 }
 
-/// With `spec` null, the baseline refitted the same way (its coefficients on the same tests):
-/// the fair null of the nested comparison.
-Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpec* spec, const std::vector<LabTest>& tests,
-                              const std::vector<std::size_t>& which, int max_evaluations) {
-  auto [start, parameters] = fit_parameters(c, baseline, spec, tests, which, true);
+/// The base coefficients fitted on `trials` the baseline's way: each on its own test over a
+/// wide grid, then a narrow one, then all together (each test's coefficient also acts in
+/// the others).
+Result<Fitted> fit_coefficients(Context& c, const Model& start, const std::vector<std::size_t>& trials, int max_evaluations) {
+  auto wide = fit_baseline(c, start, false, trials);
+  if (!wide) return std::unexpected(wide.error());
+  auto narrow = fit_baseline(c, *wide, true, trials);
+  if (!narrow) return std::unexpected(narrow.error());
+  return refit(c, *narrow, nullptr, trials, max_evaluations);
+}
+
+/// `spec`'s effect fitted with every base coefficient free on `which`, from the baseline (a
+/// nested model: its null is the baseline, refitted the same way by fit_coefficients).
+Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpec& spec, const std::vector<std::size_t>& which, int max_evaluations) {
+  auto [start, parameters] = fit_parameters(c, baseline, &spec, which, true);
   std::optional<Error> failure;
   Fitted out;
   auto chi2 = [&](const std::vector<double>& unit) {
@@ -611,7 +621,7 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
   // The effect's first parameter alone first (a grid over its range), then everything.
   double best_value = chi2(unit);
   std::vector<double> best_unit = unit;
-  for (double u : spec != nullptr ? std::vector<double>{0.0, 0.08, 0.2, 0.4, 0.7} : std::vector<double>{}) {
+  for (double u : {0.0, 0.08, 0.2, 0.4, 0.7}) {
     std::vector<double> trial = unit;
     trial[0] = u;
     const double f = chi2(trial);
@@ -621,7 +631,7 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
     }
   }
   if (failure) return std::unexpected(*failure);
-  if (spec != nullptr) {
+  {
     // Stage 1: the early window only (the first flight, the first impact), where an effect
     // and the coefficients are far from the narrow valleys later bounces make; then the
     // whole window from there.
@@ -644,7 +654,7 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
   auto minimum = levenberg_marquardt(c, start, parameters, which, best_unit, max_evaluations / 5);
   if (!minimum) return std::unexpected(minimum.error());
   out.evaluations += minimum->evaluations;
-  if (spec != nullptr && (best_unit[0] <= 0.0 || best_unit[0] >= 1.0)) {
+  if (best_unit[0] <= 0.0 || best_unit[0] >= 1.0) {
     // The grid's best sits on the null: also start from the effect's usual value, inside.
     auto inside = levenberg_marquardt(c, start, parameters, which, unit, max_evaluations / 5);
     if (!inside) return std::unexpected(inside.error());
@@ -655,7 +665,7 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
     best_value = minimum->value;
     best_unit = minimum->x;
   }
-  if (spec != nullptr) {
+  {
     // A line search along the effect's first parameter (the rest held), then Levenberg-
     // Marquardt again from there: Gauss-Newton can creep along the effect when the track
     // origins absorb part of its signal.
@@ -956,14 +966,8 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
   c.ev.shift.clear();
   if (auto ok = initialise_shifts(c.ev, baseline); !ok) return std::unexpected(ok.error());
   if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
-  fitted = fit_baseline(c, baseline, false, c.training);  // again wide: each coefficient now fitted with the others near their values
-  if (!fitted) return std::unexpected(fitted.error());
-  baseline = *fitted;
-  fitted = fit_baseline(c, baseline, true, c.training);
-  if (!fitted) return std::unexpected(fitted.error());
-  baseline = *fitted;
-  // All coefficients together on all training trials (each test's coefficient also acts in the others).
-  auto polished = fit_hypothesis(c, baseline, nullptr, {LabTest::Drop, LabTest::Roll, LabTest::Tilt}, c.training, options.max_evaluations);
+  // Again: each coefficient now fitted with the others near their values.
+  auto polished = fit_coefficients(c, baseline, c.training, options.max_evaluations);
   if (!polished) return std::unexpected(polished.error());
   baseline = polished->model;
   result.baseline = baseline.base;
@@ -1020,7 +1024,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
       continue;
     }
     // Every coefficient stays free: the fair null is the baseline itself, polished the same way.
-    auto fit = fit_hypothesis(c, baseline, &spec, {LabTest::Drop, LabTest::Roll, LabTest::Tilt}, train, options.max_evaluations);
+    auto fit = fit_hypothesis(c, baseline, spec, train, options.max_evaluations);
     if (!fit) return std::unexpected(fit.error());
     HypothesisReport report;
     report.name = spec.name;
@@ -1084,11 +1088,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
     // The baseline's own procedure on every trial (grids, so a coefficient stuck in the
     // wrong dip of an irregular body's chi^2 can leave it), and a local polish from the
     // baseline; the better is the null.
-    auto wide = fit_baseline(c, baseline, false, c.all);
-    if (!wide) return std::unexpected(wide.error());
-    auto narrow = fit_baseline(c, *wide, true, c.all);
-    if (!narrow) return std::unexpected(narrow.error());
-    auto global = refit(c, *narrow, nullptr, c.all, options.max_evaluations);
+    auto global = fit_coefficients(c, baseline, c.all, options.max_evaluations);
     if (!global) return std::unexpected(global.error());
     auto local = refit(c, baseline, nullptr, c.all, options.max_evaluations);
     if (!local) return std::unexpected(local.error());

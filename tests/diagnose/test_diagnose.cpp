@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
+#include <vector>
 
 #include "core/rng.hpp"
 #include "diagnose/conceal.hpp"
@@ -33,6 +35,19 @@ Track falling_track(double t0, double sigma, std::uint64_t seed) {
     track.z.push_back(0.5 - fall + rng.normal(0.0, sigma));
   }
   return track;
+}
+
+// Four trials of 1 m drops only (the fast blind subset), seed 11, `effect` hidden at `values`.
+ConcealOptions one_metre_drops(std::optional<Effect> effect = std::nullopt, std::vector<double> values = {}) {
+  ConcealOptions conceal;
+  conceal.trials = 4;
+  conceal.drop_heights = {1.0};
+  conceal.roll_starts = {};
+  conceal.tilt = false;
+  conceal.seed = 11;
+  conceal.effect = effect;
+  conceal.values = std::move(values);
+  return conceal;
 }
 
 }  // namespace
@@ -99,16 +114,7 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
   options.max_evaluations = 30;
   for (bool with_drag : {false, true}) {
     SCOPED_TRACE(with_drag);
-    ConcealOptions conceal;
-    conceal.trials = 4;
-    conceal.drop_heights = {1.0};
-    conceal.roll_starts = {};
-    conceal.tilt = false;
-    conceal.seed = 11;
-    if (with_drag) {
-      conceal.effect = Effect::AirDrag;
-      conceal.values = {1.5};
-    }
+    const ConcealOptions conceal = with_drag ? one_metre_drops(Effect::AirDrag, {1.5}) : one_metre_drops();
     auto made = make_concealed_recordings(clump, table, conceal);
     ASSERT_TRUE(made) << made.error().message;
     auto result = diagnose(clump, table, made->recordings, made->names, options);
@@ -133,15 +139,7 @@ TEST(DiagnoseBlind, AnEffectOutsideTheCandidatesIsUnexplainedNotNamed) {
   DiagnoseOptions options;
   options.effects = {Effect::ViscousRolling};
   options.max_evaluations = 30;
-  ConcealOptions conceal;
-  conceal.trials = 4;
-  conceal.drop_heights = {1.0};
-  conceal.roll_starts = {};
-  conceal.tilt = false;
-  conceal.seed = 11;
-  conceal.effect = Effect::AirDrag;
-  conceal.values = {1.5};
-  auto made = make_concealed_recordings(clump, table, conceal);
+  auto made = make_concealed_recordings(clump, table, one_metre_drops(Effect::AirDrag, {1.5}));
   ASSERT_TRUE(made) << made.error().message;
   auto result = diagnose(clump, table, made->recordings, made->names, options);
   ASSERT_TRUE(result) << result.error().message;
