@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <iterator>
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -854,6 +855,33 @@ std::string experiment_for(const std::string& a, const std::string& b) {
 
 }  // namespace
 
+Decision decide(const std::vector<HypothesisReport>& hypotheses, double min_delta_bic) {
+  Decision decision;
+  std::vector<std::size_t> order(hypotheses.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return hypotheses[a].delta_bic > hypotheses[b].delta_bic; });
+  // The data favour a rejected explanation: nothing is named.
+  if (order.empty() || !hypotheses[order[0]].passes) return decision;
+  // The passing candidates compete on every trial, each refitted there against the same
+  // second null: a training fit can stop in a local minimum.
+  std::vector<std::size_t> passing;
+  std::copy_if(order.begin(), order.end(), std::back_inserter(passing), [&](std::size_t k) { return hypotheses[k].passes; });
+  std::stable_sort(passing.begin(), passing.end(),
+                   [&](std::size_t a, std::size_t b) { return hypotheses[a].all_trials_delta_bic > hypotheses[b].all_trials_delta_bic; });
+  decision.best = passing[0];
+  if (passing.size() > 1) decision.runner_up = passing[1];
+  const HypothesisReport& best = hypotheses[passing[0]];
+  for (std::size_t k : order) {
+    if (k == passing[0]) continue;
+    if (!decision.training_next) decision.training_next = k;
+    const HypothesisReport& other = hypotheses[k];
+    const bool near = other.passes ? best.all_trials_delta_bic - other.all_trials_delta_bic < min_delta_bic
+                                   : other.delta_bic >= min_delta_bic && hypotheses[order[0]].delta_bic - other.delta_bic < min_delta_bic;
+    if (near) decision.close.push_back(k);
+  }
+  return decision;
+}
+
 Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, const std::vector<Recording>& recordings,
                                 const std::vector<std::string>& names, const DiagnoseOptions& options, const RunContext& run) {
   const auto started = std::chrono::steady_clock::now();
@@ -1120,28 +1148,23 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
   }
 
   // Decide.
-  std::vector<std::size_t> order(result.hypotheses.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return result.hypotheses[a].delta_bic > result.hypotheses[b].delta_bic; });
+  const Decision decision = decide(result.hypotheses, options.min_delta_bic);
   std::optional<std::size_t> named;
-  if (!order.empty() && result.hypotheses[order[0]].passes) {
-    const auto& best = result.hypotheses[order[0]];
-    std::vector<std::string> close;
-    for (std::size_t k = 1; k < order.size(); ++k) {
-      const auto& other = result.hypotheses[order[k]];
-      if (other.delta_bic >= options.min_delta_bic && best.delta_bic - other.delta_bic < options.min_delta_bic) close.push_back(other.name);
-    }
-    if (close.empty()) {
-      named = order[0];
-    } else {
-      result.verdict = "ambiguous";
-      result.candidates.push_back(best.name);
-      for (auto& n : close) result.candidates.push_back(n);
-      result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
-      result.statement = fmt::format("The recordings disagree with the baseline, and {} explain it about equally well (delta-BIC {:.1f} vs {:.1f}); "
-                                     "no single effect can be named. To separate them: {}.",
-                                     fmt::join(result.candidates, " and "), best.delta_bic, result.hypotheses[order[1]].delta_bic, result.experiment);
-    }
+  if (decision.named()) {
+    named = decision.best;
+  } else if (decision.best) {
+    const auto& best = result.hypotheses[*decision.best];
+    const auto& other = result.hypotheses[decision.close.front()];
+    result.verdict = "ambiguous";
+    result.candidates.push_back(best.name);
+    for (std::size_t k : decision.close) result.candidates.push_back(result.hypotheses[k].name);
+    result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
+    result.statement = fmt::format("The recordings disagree with the baseline, and {} explain it about equally well ({}); "
+                                   "no single effect can be named. To separate them: {}.",
+                                   fmt::join(result.candidates, " and "),
+                                   other.passes ? fmt::format("delta-BIC refitted on every trial {:.1f} vs {:.1f}", best.all_trials_delta_bic, other.all_trials_delta_bic)
+                                                : fmt::format("training delta-BIC {:.1f} vs {:.1f}", best.delta_bic, other.delta_bic),
+                                   result.experiment);
   }
 
   Model improved = baseline;
@@ -1177,17 +1200,25 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
     auto s = score(c, improved, c.all, true);
     if (!s) return std::unexpected(s.error());
     improved_scores = std::move(*s);
-    result.statement = fmt::format("Missing physics found: {} ({}), {}; it improves the training fit by delta-chi^2 {:.0f} (delta-BIC {:.1f}, next best "
-                                   "{}) and the held-out trials by delta-chi^2 {:.0f}.",
+    // The runner-up: the next candidate on every trial when another passed, else the next by
+    // training delta-BIC.
+    std::string next = "none";
+    if (decision.runner_up) {
+      const auto& r = result.hypotheses[*decision.runner_up];
+      next = fmt::format("{}, {:.1f} behind when both are refitted on every trial (training delta-BIC {:.1f})", r.name,
+                         report.all_trials_delta_bic - r.all_trials_delta_bic, r.delta_bic);
+    } else if (decision.training_next) {
+      next = fmt::format("{} at training delta-BIC {:.1f}", result.hypotheses[*decision.training_next].name,
+                         result.hypotheses[*decision.training_next].delta_bic);
+    }
+    result.statement = fmt::format("Missing physics found: {} ({}), {}; it improves the training fit by delta-chi^2 {:.0f} (delta-BIC {:.1f}) "
+                                   "and the held-out trials by delta-chi^2 {:.0f}; next best: {}.",
                                    report.name, spec.description,
                                    fmt::join(report.values | std::views::transform([](const ParameterValue& p) {
                                                return fmt::format("{} = {:.4g} [{:.4g}, {:.4g}]", p.name, p.value, p.low, p.high);
                                              }),
                                              ", "),
-                                   report.delta_chi2, report.delta_bic,
-                                   order.size() > 1 ? fmt::format("{} at {:.1f}", result.hypotheses[order[1]].name, result.hypotheses[order[1]].delta_bic)
-                                                    : std::string("none"),
-                                   report.heldout_delta_chi2);
+                                   report.delta_chi2, report.delta_bic, report.heldout_delta_chi2, next);
   }
   // A smooth discrepancy the named effect (or the baseline) leaves, phase by phase.
   auto smooth_misfits = [&](const Groups& groups) {

@@ -108,6 +108,20 @@ struct DiagnoseResult {
   double seconds = 0.0;
 };
 
+/// Which candidate the hypotheses name (indices into them). Nothing is named when the
+/// candidate with the best training delta-BIC fails a check. Otherwise the passing ones are
+/// ranked by `all_trials_delta_bic`; the best is named when every other passing one trails it
+/// by `min_delta_bic` or more there and no failed one (with delta-BIC >= `min_delta_bic`)
+/// comes within `min_delta_bic` of the best training delta-BIC; else those are `close`
+/// (ambiguous, best first in `best`).
+struct Decision {
+  std::optional<std::size_t> best, runner_up;  ///< best passing candidate; the next passing one
+  std::vector<std::size_t> close;              ///< alternatives within the margin (ambiguous when not empty)
+  std::optional<std::size_t> training_next;    ///< the next by training delta-BIC after the best
+  bool named() const { return best && close.empty(); }
+};
+Decision decide(const std::vector<HypothesisReport>& hypotheses, double min_delta_bic);
+
 /// Diagnoses `recordings` (names parallel to them) for `clump`. Recordings without tracks
 /// give the summaries-only statement (see diagnose_summaries).
 Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, const std::vector<Recording>& recordings,
