@@ -110,6 +110,7 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
                                {"all_trials_delta_bic", std::isfinite(h.all_trials_delta_bic) ? nlohmann::json(h.all_trials_delta_bic) : nlohmann::json()},
                                {"beats_refitted_null", h.beats_refitted_null},
                                {"flagged_excess_before", h.flagged_excess_before}, {"flagged_excess_after", h.flagged_excess_after},
+                               {"worsened_phases", h.worsened_phases},
                                {"passes", h.passes}, {"evaluations", h.evaluations},
                                {"smallest_detectable", std::isfinite(h.smallest_detectable) ? nlohmann::json(h.smallest_detectable) : nlohmann::json()}});
   }

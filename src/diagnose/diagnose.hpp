@@ -68,6 +68,7 @@ struct HypothesisReport {
   double all_trials_delta_bic = NAN;   ///< every trial: against the coefficients refitted on every trial (set for candidates passing the rest)
   bool plausible = false, improves_heldout = false, clears_signature = false, beats_refitted_null = false, passes = false;
   double flagged_excess_before = 0.0, flagged_excess_after = 0.0;  ///< chi^2 - values in the baseline's flagged phases
+  std::vector<std::string> worsened_phases;  ///< flagged phases it makes worse (training trials), with chi^2 per value before -> after
   int evaluations = 0;
   double smallest_detectable = 0.0;    ///< of its first parameter (reported with verdict "none")
 };
