@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <iterator>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -312,6 +312,11 @@ TrialSpread trial_spread(const Group& g) {
   }
   out.rest = values > 0 ? chi2 / values : 0.0;
   return out;
+}
+
+/// A misfit of three times the noise or more that one trial alone carries, the others below it.
+bool outlier_trial(const Group& g, const TrialSpread& spread) {
+  return g.values > 0 && g.chi2 / g.values >= kLargeMisfit && spread.trials >= 2 && spread.rest < kLargeMisfit;
 }
 
 // ---- The diagnosis ------------------------------------------------------------------------
@@ -1283,7 +1288,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
       const std::string where = fmt::format("{} phases of {}", phase_name(key.phase), recording_label(recordings[key.recording], c.names[key.recording]));
       if (d.parameters > 0 && d.gain - d.parameters * std::log(g.values) >= options.min_delta_bic && d.heldout_gain > 0.0) {
         found.push_back(where);
-      } else if (g.chi2 / g.values >= kLargeMisfit && (trial_spread(g).trials < 2 || trial_spread(g).rest >= kLargeMisfit)) {
+      } else if (g.chi2 / g.values >= kLargeMisfit && !outlier_trial(g, trial_spread(g))) {
         found.push_back(fmt::format("{} (chi^2/value {:.0f}, not one shape shared by the trials)", where, g.chi2 / g.values));
       }
     }
@@ -1398,7 +1403,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
       std::vector<std::string> slight, outliers;
       for (const auto& [key, g] : final_groups) {
         if (key.phase == Phase::Hold || key.phase == Phase::LaterBounces || g.values < 20 || !beyond_noise(g.chi2, g.values, final_groups.size())) continue;
-        if (const TrialSpread spread = trial_spread(g); g.chi2 / g.values >= kLargeMisfit && spread.trials >= 2) {
+        if (const TrialSpread spread = trial_spread(g); outlier_trial(g, spread)) {
           outliers.push_back(fmt::format("{} phases of {} (one trial at chi^2/value {:.0f}, the other {} at {:.2f})", phase_name(key.phase),
                                          c.names[key.recording], spread.worst, spread.trials - 1, spread.rest));
         } else {
