@@ -24,8 +24,8 @@ namespace {
 struct DiagnoseArgs {
   std::vector<std::string> recordings, effects;
   std::string mesh, clump, clump_name, out, materials, units = "mm";
-  double density = 1085.0;
-  int spheres = 32, max_evaluations = 45;
+  double density = 1085.0, orientation_prior_deg = 15.0;
+  int spheres = 32, max_evaluations = 45, release_orientations = 12;
   std::uint64_t seed = 1;
   bool json = false;
 };
@@ -218,6 +218,8 @@ int run_diagnose(const DiagnoseArgs& args) {
   DiagnoseOptions options;
   options.seed = args.seed;
   options.max_evaluations = args.max_evaluations;
+  options.orientation_prior_deg = args.orientation_prior_deg;
+  options.release_orientations = args.release_orientations;
   for (const auto& name : args.effects) {
     auto e = parse_effect(name);
     if (!e) return report_error(kCommand, e.error());
@@ -247,15 +249,14 @@ int run_diagnose(const DiagnoseArgs& args) {
     clump = std::move(filled->clump);
     clump.name = fmt::format("adaptive-{}", clump.spheres.size());
   }
-  if (!args.out.empty()) {
-    std::error_code ec;
-    fs::create_directories(args.out, ec);
-    if (ec || !fs::is_directory(args.out)) return report_error(kCommand, {ErrorCode::IoError, fmt::format("cannot create '{}'", args.out)});
-  }
   auto result = diagnose(clump, *loaded_table, recordings, names, options, context);
   if (!result) return report_error(kCommand, result.error());
   const nlohmann::json report = report_json(*result, clump.name);
   if (!args.out.empty()) {
+    // Created only once there is something to write: a refusal leaves nothing behind.
+    std::error_code ec;
+    fs::create_directories(args.out, ec);
+    if (ec || !fs::is_directory(args.out)) return report_error(kCommand, {ErrorCode::IoError, fmt::format("cannot create '{}'", args.out)});
     auto files = plots(*result, args.out);
     files.emplace_back(fs::path(args.out) / "report.json", report.dump(2) + "\n");
     if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
@@ -280,7 +281,11 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_option("--effects", args->effects, "Candidate effects to test (default: the whole library)");
   sub->add_option("--materials", args->materials, "Materials file (JSON) overriding the built-in table");
   sub->add_option("--max-evaluations", args->max_evaluations, "Fit budget per candidate (Levenberg-Marquardt iterations: a fifth of it)");
-  sub->add_option("--seed", args->seed, "Seed (orientation candidates when a trial has none recorded)");
+  sub->add_option("--seed", args->seed, "Seed (the release orientations drawn from each prior)");
+  sub->add_option("--orientation-prior", args->orientation_prior_deg,
+                  "Uncertainty of a recorded release orientation (orientation_wxyz) [deg]; never taken as exact");
+  sub->add_option("--release-orientations", args->release_orientations,
+                  "Release orientations drawn from each prior to find how long each trial stays predictable");
   sub->add_option("--out", args->out, "Write report.json and SVG plots here");
   sub->add_flag("--json", args->json, "Print the report as JSON");
   return {sub, [args] { return run_diagnose(*args); }};

@@ -1,5 +1,6 @@
 // clumpforge: from a particle scan to a calibrated multi-sphere DEM clump.
 #include <CLI/CLI.hpp>
+#include <iostream>
 #include <vector>
 
 #include "cli_common.hpp"
@@ -18,8 +19,15 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;
   }
-  for (const auto& command : commands) {
-    if (command.app->parsed()) return command.run();
+  // A dependency's exception (CGAL, JSON, HDF5) that no module edge caught still ends in a
+  // clean message and exit 1, never an abort.
+  try {
+    for (const auto& command : commands) {
+      if (command.app->parsed()) return command.run();
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "clumpforge: internal error: " << e.what() << "\n";
+    return kExitFailure;
   }
   return kExitUsage;
 }

@@ -1,6 +1,7 @@
 #pragma once
 /// A laboratory (or simulated) recording of one calibration test on one surface, as
 /// ../shared/spec/recording-format.md defines it (format "recording/1").
+#include <Eigen/Geometry>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -28,7 +29,23 @@ struct Trial {
   std::optional<double> summary;    ///< the test's summary value (SI, degrees for tilt)
   std::string track_file;           ///< relative to the recording's directory; empty = none
   std::optional<Track> track;
+  /// The release orientation the lab wrote down (trial key `orientation_wxyz`, body to lab,
+  /// unit quaternion). A prior, never exact: a hand or a clamp gives it to tens of degrees.
+  std::optional<Eigen::Quaterniond> release_orientation;
   std::string extra_json = "{}";    ///< other keys of the trial, kept when rewriting
+};
+
+/// Limits no experiment exceeds: a value beyond them is refused as a broken recording.
+struct RecordingLimits {
+  static constexpr double max_coordinate = 100.0;      ///< [m] |x|, |z| of a track
+  static constexpr double max_release_height = 100.0;  ///< [m] drop: (0, this]
+  static constexpr double max_start_distance = 100.0;  ///< [m] roll: (0, this]
+  static constexpr double max_frame_rate = 1e6;        ///< [Hz] (0, this]
+  static constexpr double max_time = 1e9;              ///< [s] |t| of a frame
+  static constexpr double min_density = 1.0;           ///< [kg/m^3]
+  static constexpr double max_density = 25000.0;       ///< [kg/m^3]
+  static constexpr double max_noise = 0.1;             ///< [m] stated camera noise: (0, this]
+  static constexpr double max_tilt_rate = 1000.0;      ///< [deg/s] (0, this]
 };
 
 struct Recording {

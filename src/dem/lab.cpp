@@ -382,12 +382,13 @@ Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, c
     outcomes[i].trial.id = fmt::format("{:02d}", i + 1);
     const Eigen::Quaterniond& q = outcomes[i].orientation;
     const ImpactDiagnostics& d = outcomes[i].impact;
+    outcomes[i].trial.release_orientation = q;  // a simulation knows its release exactly
     outcomes[i].trial.extra_json =
         setup.test == LabTest::Drop
-            ? fmt::format("{{\"orientation_wxyz\": [{:.9f}, {:.9f}, {:.9f}, {:.9f}], \"apparent_restitution\": {:.6f}, "
-                          "\"rotation_share_after_impact\": {:.6f}, \"impact_energy_to_rotation\": {:.6f}, \"contacts_at_impact\": {}}}",
-                          q.w(), q.x(), q.y(), q.z(), d.apparent_restitution, d.rotation_share, d.rotation_of_impact, d.first_contacts)
-            : fmt::format("{{\"orientation_wxyz\": [{:.9f}, {:.9f}, {:.9f}, {:.9f}]}}", q.w(), q.x(), q.y(), q.z());
+            ? fmt::format("{{\"apparent_restitution\": {:.6f}, \"rotation_share_after_impact\": {:.6f}, \"impact_energy_to_rotation\": {:.6f}, "
+                          "\"contacts_at_impact\": {}}}",
+                          d.apparent_restitution, d.rotation_share, d.rotation_of_impact, d.first_contacts)
+            : std::string("{}");
     result.impacts.push_back(d);
     result.orientations.push_back(q);
     result.steps += outcomes[i].steps;

@@ -276,7 +276,7 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
       trial.summary = g->summaries[static_cast<std::size_t>(i)];
       trial.track = film(g->replays[static_cast<std::size_t>(i)], rec.test, options, rng);
       const Eigen::Quaterniond& q = orientations[r][static_cast<std::size_t>(i)];
-      trial.extra_json = fmt::format("{{\"orientation_wxyz\": [{:.12f}, {:.12f}, {:.12f}, {:.12f}]}}", q.w(), q.x(), q.y(), q.z());
+      trial.release_orientation = q;
       rec.trials.push_back(std::move(trial));
     }
     if (std::find(reference.begin(), reference.end(), r) != reference.end()) {

@@ -10,6 +10,7 @@
 #include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <numeric>
 #include <ranges>
 
@@ -17,6 +18,7 @@
 #include "diagnose/model.hpp"
 #include "diagnose/optimize.hpp"
 #include "diagnose/phases.hpp"
+#include "diagnose/release.hpp"
 
 namespace clumpforge {
 namespace {
@@ -27,19 +29,6 @@ constexpr double kNever = std::numeric_limits<double>::infinity();
 /// predictability horizon never match to a small fraction of the noise, and a statistically
 /// significant 0.02 mm is not a physics question.
 constexpr double kPracticalExcess = 1.5;
-
-std::optional<Eigen::Quaterniond> recorded_orientation(const std::string& extra_json) {
-  const auto extra = nlohmann::json::parse(extra_json, nullptr, false);
-  if (!extra.is_object() || !extra.contains("orientation_wxyz")) return std::nullopt;
-  const auto& q = extra["orientation_wxyz"];
-  if (!q.is_array() || q.size() != 4) return std::nullopt;
-  for (const auto& v : q) {
-    if (!v.is_number()) return std::nullopt;
-  }
-  Eigen::Quaterniond out(q[0].get<double>(), q[1].get<double>(), q[2].get<double>(), q[3].get<double>());
-  if (!(out.norm() > 0.5)) return std::nullopt;
-  return out.normalized();
-}
 
 /// Upper tail of chi^2 with n degrees of freedom (Wilson-Hilferty).
 double chi2_tail(double chi2, double n) {
@@ -375,7 +364,7 @@ Result<void> set_horizons(Context& c, const Model& model, double perturbation) {
     replay.record_from = tt.record_from;
     const auto nominal = replay_trial(*worlds[0][r], rec, tt.orientation, options[0][r], replay);
     const double limit = 0.5 * c.ev.sigma[r];
-    double horizon = kNever;
+    double horizon = tt.release_horizon;
     for (const auto& axis : std::array<Eigen::Vector3d, 2>{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()}) {
       const Eigen::Quaterniond q = Eigen::Quaterniond(Eigen::AngleAxisd(perturbation, axis)) * tt.orientation;
       const auto other = replay_trial(*worlds[0][r], rec, q, options[0][r], replay);
@@ -747,35 +736,63 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
   return out;
 }
 
-/// Fixes each trial's release orientation: the recorded one, or the best of a seeded set.
-Result<void> choose_orientations(Context& c, const Model& model, const std::vector<std::size_t>& unknown, int candidates, std::uint64_t seed) {
+/// The release state, a nuisance: every trial replays an orientation its prior allows (the
+/// recorded one when the lab wrote one down, else a draw from the uniform prior) and is
+/// fitted frame by frame only up to its release horizon, where replays from every
+/// orientation the prior allows still agree to half the noise level (their tracked points'
+/// displacements; the origins are fitted). Beyond it no single replay can stand for the
+/// trial. Returns a note per recording.
+Result<std::vector<std::string>> settle_release_state(Context& c, const Model& model, const DiagnoseOptions& options) {
   const auto& recs = *c.ev.recordings;
-  for (std::size_t i : unknown) {
-    TrackedTrial& tt = c.ev.trials[i];
-    Rng rng(seed, 5000 + i);
-    double best = kNever;
-    Eigen::Quaterniond chosen = Eigen::Quaterniond::Identity();
-    for (int k = 0; k < candidates; ++k) {
-      Eigen::Quaterniond q;
-      if (recs[tt.recording].test == LabTest::Tilt) {
-        q = Eigen::Quaterniond(Eigen::AngleAxisd(2.0 * 3.141592653589793 * k / candidates, Eigen::Vector3d::UnitZ()));
+  std::vector<std::string> notes;
+  for (std::size_t r = 0; r < recs.size(); ++r) {
+    const Recording& rec = recs[r];
+    // One prior shared by the trials without a recorded orientation, one per trial with one.
+    std::vector<std::pair<OrientationPrior, std::vector<std::size_t>>> groups;
+    for (std::size_t i = 0; i < c.ev.trials.size(); ++i) {
+      TrackedTrial& tt = c.ev.trials[i];
+      if (tt.recording != r) continue;
+      tt.origins = OriginFit{true, rec.test != LabTest::Tilt};
+      OrientationPrior prior;
+      prior.spread = options.orientation_prior_deg * std::numbers::pi / 180.0;
+      prior.recorded = rec.trials[tt.trial].release_orientation;
+      if (!prior.recorded && !groups.empty() && !groups.front().first.recorded) {
+        groups.front().second.push_back(i);
+      } else if (!prior.recorded) {
+        groups.insert(groups.begin(), {prior, {i}});
       } else {
-        q = Eigen::Quaterniond(rng.normal(), rng.normal(), rng.normal(), rng.normal()).normalized();
-      }
-      tt.orientation = q;
-      Evaluator probe = c.ev;
-      probe.shift.clear();
-      c.evaluations += 1;
-      auto scores = evaluate(probe, model, {i}, false);
-      if (!scores) return std::unexpected(scores.error());
-      if ((*scores)[0].alignment.chi_squared < best) {
-        best = (*scores)[0].alignment.chi_squared;
-        chosen = q;
+        groups.push_back({prior, {i}});
       }
     }
-    tt.orientation = chosen;
+    if (groups.empty()) continue;
+    const LabOptions lab = lab_options_for(c.ev, model, rec);
+    auto world = make_lab_world(*c.ev.clump, *c.ev.table, rec, lab);
+    if (!world) return std::unexpected(world.error());
+    std::vector<double> horizons;
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const auto& [prior, members] = groups[g];
+      const auto candidates = draw_release_orientations(rec.test, prior, options.release_orientations, options.seed, 7000 + 1000 * r + g);
+      ReplayOptions replay;
+      replay.sample_interval = c.ev.sample_interval;
+      for (std::size_t i : members) replay.duration = std::max(replay.duration, c.ev.trials[i].duration);
+      std::vector<std::vector<ReplaySample>> replays(candidates.size());
+      tbb::parallel_for(std::size_t{0}, candidates.size(),
+                        [&](std::size_t k) { replays[k] = replay_trial(*world, rec, candidates[k], lab, replay); });
+      c.evaluations += static_cast<int>(candidates.size());
+      const double horizon = release_horizon(replays, 0.5 * c.ev.sigma[r]);
+      for (std::size_t i : members) {
+        c.ev.trials[i].orientation = candidates.front();
+        c.ev.trials[i].release_horizon = horizon;
+      }
+      horizons.push_back(horizon);
+    }
+    const bool recorded = std::any_of(groups.begin(), groups.end(), [](const auto& g) { return g.first.recorded.has_value(); });
+    notes.push_back(fmt::format("{}: release orientation {}; replays from {} orientations it allows agree up to {} s after release",
+                                c.names[r], recorded ? fmt::format("recorded (a prior of +-{:g} deg)", options.orientation_prior_deg) : std::string("unknown (uniform prior)"),
+                                options.release_orientations,
+                                fmt::join(horizons | std::views::transform([](double h) { return std::isfinite(h) ? fmt::format("{:.3f}", h) : std::string("the end"); }), ", ")));
   }
-  return {};
+  return notes;
 }
 
 double rms_mm(const Context& c, const std::vector<std::size_t>& which, const std::vector<TrialScore>& scores) {
@@ -937,6 +954,12 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
   const auto started = std::chrono::steady_clock::now();
   if (recordings.empty()) return fail(ErrorCode::InvalidArgument, "no recordings to diagnose");
   if (names.size() != recordings.size()) return fail(ErrorCode::InvalidArgument, "one name per recording is needed");
+  if (options.release_orientations < 2 || options.release_orientations > 1000) {
+    return fail(ErrorCode::InvalidArgument, fmt::format("release orientations drawn per prior must be 2 to 1000, not {}", options.release_orientations));
+  }
+  if (!(options.orientation_prior_deg > 0.0 && options.orientation_prior_deg <= 180.0)) {
+    return fail(ErrorCode::InvalidArgument, fmt::format("the recorded orientation's uncertainty must lie in (0, 180] deg, not {}", options.orientation_prior_deg));
+  }
   bool any_track = false;
   for (const auto& r : recordings) {
     for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
@@ -967,7 +990,6 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
     if (!tracks.empty()) result.noise_m.emplace_back(names[r], sigma);
   }
   // The trials that can be used.
-  std::vector<std::size_t> unknown_orientation;
   std::vector<std::string> too_short;
   for (std::size_t r = 0; r < recordings.size(); ++r) {
     const Recording& rec = recordings[r];
@@ -990,8 +1012,6 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
       const double last = track->t.back() - tt.shift_guess;
       tt.duration = std::clamp(last + 0.05, 0.05, rec.test == LabTest::Tilt ? 89.0 / rate : 6.0);
       if (rec.test == LabTest::Tilt) tt.record_from = std::max(0.0, track->t.front() - tt.shift_guess - 0.05);
-      if (auto q = recorded_orientation(rec.trials[i].extra_json)) tt.orientation = *q;
-      else unknown_orientation.push_back(c.ev.trials.size());
       (tt.training ? c.training : c.heldout).push_back(c.ev.trials.size());
       c.all.push_back(c.ev.trials.size());
       c.ev.trials.push_back(tt);
@@ -1029,12 +1049,10 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
     if (!pair) return std::unexpected(pair.error());
     baseline.base.push_back({rec.surface, *pair});
   }
-  run.report("aligning", 0.02);
-  if (!unknown_orientation.empty()) {
-    if (auto ok = choose_orientations(c, baseline, unknown_orientation, options.orientation_candidates, options.seed); !ok) return std::unexpected(ok.error());
-    result.notes.push_back(fmt::format("{} trial(s) had no recorded release orientation; the best of {} seeded candidates was used for each",
-                                       unknown_orientation.size(), options.orientation_candidates));
-  }
+  run.report("release state", 0.02);
+  auto release_notes = settle_release_state(c, baseline, options);
+  if (!release_notes) return std::unexpected(release_notes.error());
+  result.notes.insert(result.notes.end(), release_notes->begin(), release_notes->end());
   if (auto ok = initialise_shifts(c.ev, baseline); !ok) return std::unexpected(ok.error());
   if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
   run.report("baseline", 0.05);
@@ -1439,7 +1457,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
       for (std::size_t f = 0; f < track.size(); ++f) {
         cmp.t.push_back(track.t[f] - a.shift);
         cmp.x.push_back(track.x[f] - a.x_offset);
-        cmp.z.push_back(track.z[f]);
+        cmp.z.push_back(track.z[f] - a.z_offset);
       }
       const double end = cmp.t.back();
       auto sampled = [&](const std::vector<ReplaySample>& replay, std::vector<double>& t, std::vector<double>& x, std::vector<double>& z) {
@@ -1453,8 +1471,9 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, 
       sampled((*full_base)[k].replay, cmp.baseline_t, cmp.baseline_x, cmp.baseline_z);
       sampled((*full_improved)[k].replay, cmp.improved_t, cmp.improved_x, cmp.improved_z);
       // The improved model's own x origin differs slightly: shift its curve onto the recording's frame.
-      const double dx = (*full_improved)[k].alignment.x_offset - a.x_offset;
+      const double dx = (*full_improved)[k].alignment.x_offset - a.x_offset, dz = (*full_improved)[k].alignment.z_offset - a.z_offset;
       for (double& x : cmp.improved_x) x += dx;
+      for (double& z : cmp.improved_z) z += dz;
       result.tracks.push_back(std::move(cmp));
       break;
     }

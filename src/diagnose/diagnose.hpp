@@ -32,8 +32,9 @@ struct DiagnoseOptions {
   std::vector<Effect> effects;     ///< candidates (empty: the whole library)
   double min_delta_bic = 10.0;     ///< margin over the baseline and over the next best
   int max_evaluations = 45;        ///< fit budget per candidate: Levenberg-Marquardt iterations are a fifth of it
-  double horizon_perturbation = 1e-4;  ///< [rad] release-orientation uncertainty for the predictability horizon
-  int orientation_candidates = 16; ///< tried per trial whose release orientation was not recorded
+  double horizon_perturbation = 1e-4;  ///< [rad] release-orientation perturbation for the predictability horizon
+  int release_orientations = 12;   ///< drawn from each release prior to find how long the trials stay predictable, >= 2
+  double orientation_prior_deg = 15.0;  ///< uncertainty of a recorded release orientation [deg], (0, 180]
   std::uint64_t seed = 1;
 };
 

@@ -79,7 +79,6 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
     replay.record_from = tt.record_from;
     auto samples = replay_trial(*worlds[tt.recording], recording, tt.orientation, options[tt.recording], replay);
     const Track& track = *recording.trials[tt.trial].track;
-    const bool x_offset = recording.test != LabTest::Roll;
     const double sigma = ev.sigma[tt.recording];
     TrialScore& score = scores[k];
     // The time origin is chosen on the first phase (free fall, the incline), where the
@@ -89,10 +88,10 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
       // Wide enough for a model that falls or rolls milliseconds later than the first one
       // (strong drag); the first phase's chi^2 is a single bowl in the shift.
       const double window = recording.test == LabTest::Tilt ? ev.shift_window : 5.0 * ev.shift_window;
-      score.alignment = align(track, samples, sigma, x_offset, ev.shift[which[k]], window, window, tt.cutoff,
+      score.alignment = align(track, samples, sigma, tt.origins, ev.shift[which[k]], window, window, tt.cutoff,
                               ev.shift[which[k]] + first_phase_end);
     } else {
-      score.alignment = align(track, samples, sigma, x_offset, tt.shift_guess, ev.shift_range[which[k]], 5e-4, tt.cutoff,
+      score.alignment = align(track, samples, sigma, tt.origins, tt.shift_guess, ev.shift_range[which[k]], 5e-4, tt.cutoff,
                               tt.shift_guess + first_phase_end + (recording.test == LabTest::Drop ? 0.0 : ev.shift_range[which[k]]));
     }
     score.summary = replay_summary(samples, recording.test);
@@ -121,15 +120,18 @@ int total_values(const std::vector<TrialScore>& scores) {
   return sum;
 }
 
+void set_shift_ranges(Evaluator& ev) {
+  if (ev.shift_range.size() == ev.trials.size()) return;
+  ev.shift_range.assign(ev.trials.size(), 0.0);
+  for (std::size_t i = 0; i < ev.trials.size(); ++i) {
+    const LabTest test = (*ev.recordings)[ev.trials[i].recording].test;
+    ev.shift_range[i] = test == LabTest::Drop ? 0.02 : test == LabTest::Tilt ? 0.02 : 0.3;
+  }
+}
+
 Result<void> initialise_shifts(Evaluator& ev, const Model& model) {
   ev.shift.clear();
-  if (ev.shift_range.size() != ev.trials.size()) {
-    ev.shift_range.assign(ev.trials.size(), 0.0);
-    for (std::size_t i = 0; i < ev.trials.size(); ++i) {
-      const LabTest test = (*ev.recordings)[ev.trials[i].recording].test;
-      ev.shift_range[i] = test == LabTest::Drop ? 0.02 : test == LabTest::Tilt ? 0.02 : 0.3;
-    }
-  }
+  set_shift_ranges(ev);
   std::vector<std::size_t> all(ev.trials.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
   auto scores = evaluate(ev, model, all, false);

@@ -16,7 +16,8 @@ namespace clumpforge {
 
 struct TrackedTrial {
   std::size_t recording = 0, trial = 0;  ///< indices into the recordings
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< release orientation
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< release orientation replayed (one the prior allows)
+  OriginFit origins;                     ///< camera-frame origins fitted besides the time origin
   bool training = true;                  ///< false: held out of every fit
   double shift_guess = 0.0;              ///< [s] from the data alone
   double duration = 0.0;                 ///< [s] replayed after release
@@ -26,6 +27,9 @@ struct TrackedTrial {
   /// body's later bounces and tumbles depend on its release state beyond what any lab
   /// knows, so frames after it are not fitted (they are still shown).
   double horizon = std::numeric_limits<double>::infinity();
+  /// [s] replay time up to which replays from every release orientation the prior allows
+  /// agree (see release_horizon); the horizon is never later.
+  double release_horizon = std::numeric_limits<double>::infinity();
   double cutoff = std::numeric_limits<double>::infinity();  ///< the horizon in the track's own time [s]
   double early_cutoff = std::numeric_limits<double>::infinity();  ///< the end of the first phase (+ the impact), track time [s]
 };
@@ -69,6 +73,9 @@ LabOptions lab_options_for(const Evaluator& evaluator, const Model& model, const
 /// Sum of the chi^2 of `scores`.
 double total_chi_squared(const std::vector<TrialScore>& scores);
 int total_values(const std::vector<TrialScore>& scores);
+
+/// The half range of every trial's first alignment (evaluator.shift_range), when not set.
+void set_shift_ranges(Evaluator& evaluator);
 
 /// First alignment of every trial under `model` over a wide window; fixes evaluator.shift.
 Result<void> initialise_shifts(Evaluator& evaluator, const Model& model);

@@ -50,10 +50,12 @@ ReplayPoint interpolate(const std::vector<ReplaySample>& replay, double t) {
   return {replay[i].x + f * (replay[i + 1].x - replay[i].x), replay[i].z + f * (replay[i + 1].z - replay[i].z), i};
 }
 
-Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset, double cutoff) {
+Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset, double z_offset,
+                   double cutoff) {
   Alignment a;
   a.shift = shift;
   a.x_offset = x_offset;
+  a.z_offset = z_offset;
   for (std::size_t i = 0; i < track.size(); ++i) {
     if (track.t[i] > cutoff) break;
     const ReplayPoint p = interpolate(replay, track.t[i] - shift);
@@ -63,7 +65,7 @@ Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, 
       ++a.values;
     }
     if (std::isfinite(track.z[i])) {
-      const double r = (track.z[i] - p.z) / sigma;
+      const double r = (track.z[i] - p.z - z_offset) / sigma;
       a.chi_squared += r * r;
       ++a.values;
     }
@@ -71,54 +73,60 @@ Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, 
   return a;
 }
 
-Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, bool fit_x_offset, double cutoff) {
-  double x_offset = 0.0;
-  if (fit_x_offset) {
-    double sum = 0.0;
-    int count = 0;
+Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, OriginFit origins, double cutoff) {
+  // Each fitted origin is the mean residual of its axis (least squares).
+  double sum_x = 0.0, sum_z = 0.0;
+  int count_x = 0, count_z = 0;
+  if (origins.x || origins.z) {
     for (std::size_t i = 0; i < track.size(); ++i) {
-      if (!std::isfinite(track.x[i]) || track.t[i] > cutoff) continue;
-      sum += track.x[i] - interpolate(replay, track.t[i] - shift).x;
-      ++count;
+      if (track.t[i] > cutoff) break;
+      const ReplayPoint p = interpolate(replay, track.t[i] - shift);
+      if (origins.x && std::isfinite(track.x[i])) {
+        sum_x += track.x[i] - p.x;
+        ++count_x;
+      }
+      if (origins.z && std::isfinite(track.z[i])) {
+        sum_z += track.z[i] - p.z;
+        ++count_z;
+      }
     }
-    x_offset = count > 0 ? sum / count : 0.0;
   }
-  return score_at(track, replay, sigma, shift, x_offset, cutoff);
+  return score_at(track, replay, sigma, shift, count_x > 0 ? sum_x / count_x : 0.0, count_z > 0 ? sum_z / count_z : 0.0, cutoff);
 }
 
-Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, bool fit_x_offset, double guess,
+Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, OriginFit origins, double guess,
                 double half_range, double step, double cutoff, double align_cutoff) {
   const double fit_cutoff = std::min(cutoff, align_cutoff);
-  Alignment best = score(track, replay, sigma, guess, fit_x_offset, fit_cutoff);
+  Alignment best = score(track, replay, sigma, guess, origins, fit_cutoff);
   for (double s = guess - half_range; s <= guess + half_range + 1e-12; s += step) {
-    Alignment a = score(track, replay, sigma, s, fit_x_offset, fit_cutoff);
+    Alignment a = score(track, replay, sigma, s, origins, fit_cutoff);
     if (a.chi_squared < best.chi_squared) best = a;
   }
   // Golden section on [best - step, best + step].
   constexpr double kGolden = 0.6180339887498949;
   double lo = best.shift - step, hi = best.shift + step;
   double c = hi - kGolden * (hi - lo), d = lo + kGolden * (hi - lo);
-  Alignment fc = score(track, replay, sigma, c, fit_x_offset, fit_cutoff), fd = score(track, replay, sigma, d, fit_x_offset, fit_cutoff);
+  Alignment fc = score(track, replay, sigma, c, origins, fit_cutoff), fd = score(track, replay, sigma, d, origins, fit_cutoff);
   while (hi - lo > 1e-6) {
     if (fc.chi_squared < fd.chi_squared) {
       hi = d;
       d = c;
       fd = fc;
       c = hi - kGolden * (hi - lo);
-      fc = score(track, replay, sigma, c, fit_x_offset, fit_cutoff);
+      fc = score(track, replay, sigma, c, origins, fit_cutoff);
     } else {
       lo = c;
       c = d;
       fc = fd;
       d = lo + kGolden * (hi - lo);
-      fd = score(track, replay, sigma, d, fit_x_offset, fit_cutoff);
+      fd = score(track, replay, sigma, d, origins, fit_cutoff);
     }
   }
   for (const Alignment& a : {fc, fd}) {
     if (a.chi_squared < best.chi_squared) best = a;
   }
   if (fit_cutoff >= cutoff) return best;
-  return score_at(track, replay, sigma, best.shift, best.x_offset, cutoff);
+  return score_at(track, replay, sigma, best.shift, best.x_offset, best.z_offset, cutoff);
 }
 
 double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s) {
@@ -154,7 +162,7 @@ std::vector<FrameResidual> residuals(const Track& track, const std::vector<Repla
     r.t = t;
     r.sample = p.index;
     r.rx = std::isfinite(track.x[i]) ? (track.x[i] - p.x - a.x_offset) / sigma : std::numeric_limits<double>::quiet_NaN();
-    r.rz = std::isfinite(track.z[i]) ? (track.z[i] - p.z) / sigma : std::numeric_limits<double>::quiet_NaN();
+    r.rz = std::isfinite(track.z[i]) ? (track.z[i] - p.z - a.z_offset) / sigma : std::numeric_limits<double>::quiet_NaN();
     out.push_back(r);
   }
   return out;

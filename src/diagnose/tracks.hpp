@@ -27,29 +27,38 @@ struct ReplayPoint {
 };
 ReplayPoint interpolate(const std::vector<ReplaySample>& replay, double t);
 
+/// Which origins of the camera frame are fitted besides the time origin. A drop's release
+/// height of the tracked point depends on the unknown release orientation (the lowest point
+/// is at the set height), so its vertical origin is a nuisance too.
+struct OriginFit {
+  bool x = true;   ///< horizontal origin (drop, tilt)
+  bool z = false;  ///< vertical origin (drop with an unknown release orientation)
+};
+
 struct Alignment {
   double shift = 0.0;     ///< t_replay = t_recorded - shift [s]
   double x_offset = 0.0;  ///< x_recorded = x_replay + x_offset [m]
+  double z_offset = 0.0;  ///< z_recorded = z_replay + z_offset [m]
   double chi_squared = 0.0;
   int values = 0;         ///< recorded cells used
 };
 
-/// chi^2 of `track` against `replay` for a given shift (x offset fitted when asked), over
+/// chi^2 of `track` against `replay` for a given shift (the origins in `origins` fitted), over
 /// the frames recorded up to `cutoff` (recorded time; beyond it the release state cannot
 /// predict the trajectory, see TrackedTrial::horizon). The cutoff does not move with the
 /// shift, so every shift is scored on the same frames.
-Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, bool fit_x_offset,
+Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, OriginFit origins,
                 double cutoff = std::numeric_limits<double>::infinity());
 
-/// chi^2 at a given shift and horizontal offset, frames recorded up to `cutoff`.
-Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset,
+/// chi^2 at a given shift and origin offsets, frames recorded up to `cutoff`.
+Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset, double z_offset,
                    double cutoff = std::numeric_limits<double>::infinity());
 
 /// Best shift in [guess - half_range, guess + half_range]: a grid of `step`, then a golden
 /// section to 1 microsecond around the best grid point. The shift (and x offset) is chosen
 /// on the frames up to `align_cutoff` (recorded time: the first phase, where the release
 /// alone decides the motion); the returned chi^2 covers the frames up to `cutoff`.
-Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, bool fit_x_offset, double guess,
+Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, OriginFit origins, double guess,
                 double half_range, double step, double cutoff = std::numeric_limits<double>::infinity(),
                 double align_cutoff = std::numeric_limits<double>::infinity());
 

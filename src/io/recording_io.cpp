@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <fstream>
 #include <limits>
@@ -36,11 +38,20 @@ class ManifestReader {
     throw ManifestError{fmt::format("{}:{}: {}", file_, line_of(text_, key, from), what)};
   }
   double positive(const json& object, const char* key, const std::string& where) const {
+    return bounded(object, key, where, 0.0, std::numeric_limits<double>::max(), "");
+  }
+  /// A number in (low, high] (or [low, high] with `closed_low`); `unit` names the limit's unit.
+  double bounded(const json& object, const char* key, const std::string& where, double low, double high, std::string_view unit,
+                 bool closed_low = false) const {
     if (!object.contains(key)) error(where, fmt::format("'{}' is missing its '{}'", where, key));
     const auto& value = object.at(key);
     if (!value.is_number()) error(key, fmt::format("'{}' must be a number", key));
     const double v = value.get<double>();
-    if (!(v > 0.0) || !std::isfinite(v)) error(key, fmt::format("'{}' must be positive, not {}", key, v));
+    if (!std::isfinite(v) || !(closed_low ? v >= low : v > low)) {
+      if (low == 0.0 && !closed_low) error(key, fmt::format("'{}' must be positive, not {}", key, v));
+      error(key, fmt::format("'{}' is {}: it must lie in {}{}, {}] {}", key, v, closed_low ? "[" : "(", low, high, unit));
+    }
+    if (v > high) error(key, fmt::format("'{}' is {}: it must lie in {}{}, {}] {} (no experiment exceeds that)", key, v, closed_low ? "[" : "(", low, high, unit));
     return v;
   }
   std::string string(const json& object, const char* key) const {
@@ -64,6 +75,57 @@ std::string extras(const json& object, std::initializer_list<const char*> known)
     if (!is_known) rest[key] = value;
   }
   return rest.dump();
+}
+
+/// The largest magnitude a track column can hold in any experiment.
+double column_limit(const std::string& column) {
+  if (column == "t_s") return RecordingLimits::max_time;
+  if (column == "x_m" || column == "z_m") return RecordingLimits::max_coordinate;
+  if (column == "tilt_deg") return 180.0;
+  return 1e6;  // angle_rad: a marked axis may turn many times
+}
+
+std::string_view column_unit(const std::string& column) {
+  if (column == "t_s") return "s";
+  if (column == "x_m" || column == "z_m") return "m";
+  if (column == "tilt_deg") return "deg";
+  return "rad";
+}
+
+/// The track file a trial names, resolved inside the recording's folder: an absolute path, a
+/// `..` component or a link that leads out of the folder is refused, and nothing is opened.
+Result<fs::path> track_path(const fs::path& dir, const std::string& name) {
+  const fs::path relative(name);
+  if (name.empty()) return fail(ErrorCode::InvalidArgument, "the track path is empty");
+  if (relative.is_absolute() || relative.has_root_name() || relative.has_root_directory()) {
+    return fail(ErrorCode::InvalidArgument, fmt::format("the track path '{}' is absolute; it must name a file inside the recording's folder", name));
+  }
+  for (const auto& part : relative) {
+    if (part == "..") return fail(ErrorCode::InvalidArgument, fmt::format("the track path '{}' leaves the recording's folder ('..')", name));
+  }
+  std::error_code ec;
+  const fs::path folder = fs::weakly_canonical(fs::absolute(dir, ec), ec);
+  const fs::path resolved = fs::weakly_canonical(fs::absolute(dir / relative, ec), ec);
+  if (ec) return fail(ErrorCode::InvalidArgument, fmt::format("the track path '{}' cannot be resolved: {}", name, ec.message()));
+  auto [end, at] = std::mismatch(folder.begin(), folder.end(), resolved.begin(), resolved.end());
+  if (end != folder.end()) {
+    return fail(ErrorCode::InvalidArgument, fmt::format("the track path '{}' leads out of the recording's folder (through a link)", name));
+  }
+  return dir / relative;
+}
+
+/// `orientation_wxyz`: four finite numbers, a unit quaternion to 1 %.
+std::optional<Eigen::Quaterniond> parse_orientation(const json& value) {
+  if (!value.is_array() || value.size() != 4) return std::nullopt;
+  std::array<double, 4> q{};
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (!value[k].is_number()) return std::nullopt;
+    q[k] = value[k].get<double>();
+    if (!std::isfinite(q[k])) return std::nullopt;
+  }
+  const Eigen::Quaterniond out(q[0], q[1], q[2], q[3]);
+  if (std::abs(out.norm() - 1.0) > 0.01) return std::nullopt;
+  return out.normalized();
 }
 
 Result<Track> read_track(const fs::path& path) {
@@ -123,6 +185,10 @@ Result<Track> read_track(const fs::path& path) {
       } else if (columns[k] == "t_s") {
         return fail(ErrorCode::ParseError, fmt::format("{}:{}: the time cell is empty", path.string(), number));
       }
+      if (const double limit = column_limit(columns[k]); std::abs(value) > limit) {
+        return fail(ErrorCode::ParseError, fmt::format("{}:{}: {:g} in column {} is beyond the limit of +-{:g} {}", path.string(), number,
+                                                       value, columns[k], limit, column_unit(columns[k])));
+      }
       targets[k]->push_back(value);
     }
     const auto& t = track.t;
@@ -149,14 +215,15 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
   r.surface = reader.string(manifest, "surface");
   if (!manifest.contains("setup") || !manifest["setup"].is_object()) reader.error("setup", "the manifest has no 'setup' object");
   const json& setup = manifest["setup"];
-  if (r.test == LabTest::Drop) r.release_height = reader.positive(setup, "release_height_m", "setup");
+  using L = RecordingLimits;
+  if (r.test == LabTest::Drop) r.release_height = reader.bounded(setup, "release_height_m", "setup", 0.0, L::max_release_height, "m");
   if (r.test == LabTest::Roll) {
     r.incline_deg = reader.positive(setup, "incline_deg", "setup");
     if (r.incline_deg >= 90.0) reader.error("incline_deg", "'incline_deg' must be below 90");
-    r.start_distance = reader.positive(setup, "start_distance_m", "setup");
+    r.start_distance = reader.bounded(setup, "start_distance_m", "setup", 0.0, L::max_start_distance, "m");
   }
   if (r.test == LabTest::Tilt) {
-    if (setup.contains("tilt_rate_deg_per_s")) r.tilt_rate_deg_per_s = reader.positive(setup, "tilt_rate_deg_per_s", "setup");
+    if (setup.contains("tilt_rate_deg_per_s")) r.tilt_rate_deg_per_s = reader.bounded(setup, "tilt_rate_deg_per_s", "setup", 0.0, L::max_tilt_rate, "deg/s");
     if (setup.contains("composite")) {
       const std::string composite = setup["composite"].is_string() ? setup["composite"].get<std::string>() : "";
       if (composite == "single") r.composite = Composite::Single;
@@ -164,16 +231,19 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
       else reader.error("composite", fmt::format("composite '{}' is not \"single\" or \"four-square\"", composite));
     }
   }
+  for (const char* key : {"particle", "camera"}) {
+    if (manifest.contains(key) && !manifest[key].is_object()) reader.error(key, fmt::format("'{}' must be an object", key));
+  }
   if (manifest.contains("particle")) {
     const json& p = manifest["particle"];
     if (p.contains("mesh")) r.particle_mesh = reader.string(p, "mesh");
     if (p.contains("mesh_units")) r.particle_mesh_units = reader.string(p, "mesh_units");
-    if (p.contains("density_kg_m3")) r.particle_density = reader.positive(p, "density_kg_m3", "particle");
+    if (p.contains("density_kg_m3")) r.particle_density = reader.bounded(p, "density_kg_m3", "particle", L::min_density, L::max_density, "kg/m^3", true);
   }
   if (manifest.contains("camera")) {
     const json& c = manifest["camera"];
-    if (c.contains("frame_rate_hz")) r.frame_rate_hz = reader.positive(c, "frame_rate_hz", "camera");
-    if (c.contains("position_noise_m")) r.position_noise_m = reader.positive(c, "position_noise_m", "camera");
+    if (c.contains("frame_rate_hz")) r.frame_rate_hz = reader.bounded(c, "frame_rate_hz", "camera", 0.0, L::max_frame_rate, "Hz");
+    if (c.contains("position_noise_m")) r.position_noise_m = reader.bounded(c, "position_noise_m", "camera", 0.0, L::max_noise, "m");
   }
   if (!manifest.contains("trials") || !manifest["trials"].is_array() || manifest["trials"].empty()) {
     reader.error("trials", "the manifest needs a non-empty 'trials' list");
@@ -199,12 +269,21 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
     if (entry.contains("track")) {
       if (!entry["track"].is_string()) reader.error("track", fmt::format("trial '{}': 'track' must be a file name", trial.id), search_from);
       trial.track_file = entry["track"].get<std::string>();
-      auto track = read_track(dir / trial.track_file);
+      auto path = track_path(dir, trial.track_file);
+      if (!path) reader.error("track", fmt::format("trial '{}': {}", trial.id, path.error().message), search_from);
+      auto track = read_track(*path);
       if (!track) throw ManifestError{track.error().message};
       trial.track = std::move(*track);
     }
+    if (entry.contains("orientation_wxyz")) {
+      trial.release_orientation = parse_orientation(entry["orientation_wxyz"]);
+      if (!trial.release_orientation) {
+        reader.error("orientation_wxyz", fmt::format("trial '{}': 'orientation_wxyz' must be a unit quaternion [w, x, y, z] of four numbers", trial.id),
+                     search_from);
+      }
+    }
     if (!trial.summary && !trial.track) reader.error("id", fmt::format("trial '{}' has neither a summary nor a track", trial.id), search_from);
-    trial.extra_json = extras(entry, {"id", "summary", "track"});
+    trial.extra_json = extras(entry, {"id", "summary", "track", "orientation_wxyz"});
     r.trials.push_back(std::move(trial));
   }
   r.extra_json = extras(manifest, {"format", "test", "surface", "setup", "particle", "camera", "trials"});
@@ -288,6 +367,10 @@ Result<void> write_recording(const fs::path& dir, const Recording& r) {
   for (const auto& trial : r.trials) {
     json entry = json::parse(trial.extra_json);
     entry["id"] = trial.id;
+    if (trial.release_orientation) {
+      const auto& q = *trial.release_orientation;
+      entry["orientation_wxyz"] = {q.w(), q.x(), q.y(), q.z()};
+    }
     if (trial.summary) entry["summary"] = {{std::string(summary_key(r.test)), *trial.summary}};
     if (trial.track) {
       const std::string name = trial.track_file.empty() ? fmt::format("trial-{}.csv", trial.id) : trial.track_file;

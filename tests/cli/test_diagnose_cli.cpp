@@ -62,6 +62,43 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   EXPECT_EQ(nlohmann::json::parse(run.out)["verdict"], "undecidable");
 }
 
+// Hostile recordings (issue 12, item 5) through the command: a clean message naming the
+// file, exit 1, nothing written, and nothing outside the recording opened.
+TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
+  test::ScratchDir dir("diagnose-hostile");
+  write(dir / "outside.csv", "t_s,x_m,z_m\nSECRET-LINE,0,0\n");
+  const std::string drop = R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": %H%},
+  "trials": [{"id": "01", "track": "%T%"}]})";
+  auto manifest = [&](const std::string& height, const std::string& track) {
+    std::string m = drop;
+    m.replace(m.find("%H%"), 3, height);
+    m.replace(m.find("%T%"), 3, track);
+    return m;
+  };
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases{
+      {manifest("0.2", "../outside.csv"), "t_s,x_m,z_m\n0,0,0.2\n", "leaves the recording's folder"},
+      {manifest("0.2", "/etc/passwd"), "t_s,x_m,z_m\n0,0,0.2\n", "is absolute"},
+      {manifest("1e9", "trial-01.csv"), "t_s,x_m,z_m\n0,0,0.2\n", "must lie in (0, 100] m"},
+      {manifest("0.2", "trial-01.csv"), "t_s,x_m,z_m\n0,0,0.2\n0.001,1e308,0.2\n", "beyond the limit of +-100 m"},
+      {"{\"format\": \"recording/1\", \"test\": [", "", "not valid JSON"},
+  };
+  for (const auto& [m, track, expected] : cases) {
+    SCOPED_TRACE(expected);
+    std::filesystem::remove_all(dir / "rec");
+    write(dir / "rec" / "recording.json", m);
+    if (!track.empty()) write(dir / "rec" / "trial-01.csv", track);
+    const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --out '{}' --json", (dir / "rec").string(), clump(),
+                                                      (dir / "out").string()));
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_NE(run.err.find((dir / "rec").string()), std::string::npos) << run.err;  // names the file
+    EXPECT_NE(run.err.find(expected), std::string::npos) << run.err;
+    EXPECT_EQ(run.err.find("SECRET-LINE"), std::string::npos) << run.err;
+    EXPECT_EQ(run.err.find("root:"), std::string::npos) << run.err;
+    EXPECT_TRUE(run.out.empty()) << run.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  }
+}
+
 TEST(ConcealCli, BadOptionsAreRefusedAndNothingIsWritten) {
   test::ScratchDir dir("conceal-bad");
   const auto out = dir / "recordings";

@@ -74,7 +74,7 @@ TEST(DiagnoseMeasurement, AlignmentFindsTheTimeOriginAndHorizontalOrigin) {
   const Track track = falling_track(10.0731, 1e-4, 5);
   const double guess = guess_shift(track, LabTest::Drop, 5.0);
   EXPECT_NEAR(guess, 10.0731, 0.003);
-  const Alignment a = align(track, replay, 1e-4, true, guess, 0.02, 5e-4);
+  const Alignment a = align(track, replay, 1e-4, OriginFit{}, guess, 0.02, 5e-4);
   EXPECT_NEAR(a.shift, 10.0731, 2e-5);
   EXPECT_NEAR(a.x_offset, 0.002, 2e-5);
   EXPECT_NEAR(a.chi_squared / a.values, 1.0, 0.15);
@@ -101,7 +101,7 @@ TEST(ConcealedRecordings, HideTheEffectInTheSummariesAndReadBack) {
   ASSERT_TRUE(back) << back.error().message;
   ASSERT_EQ(back->trials.size(), 4u);
   ASSERT_TRUE(back->trials[0].track);
-  EXPECT_NE(back->trials[0].extra_json.find("orientation_wxyz"), std::string::npos);
+  EXPECT_TRUE(back->trials[0].release_orientation.has_value());
   EXPECT_NE(answer_json(options, *made).find("\"effect\": \"air_drag\""), std::string::npos);
 }
 
@@ -222,6 +222,9 @@ TEST(DiagnoseBlind, OneTrialsMisfitIsAnOutlierNotAMismatch) {
   DiagnoseOptions options;
   options.effects = {Effect::AirDrag, Effect::ViscoelasticRestitution};
   options.max_evaluations = 30;
+  // A lab that knows its release orientation to 0.001 deg: the rebound flight is then within
+  // the release horizon and fitted frame by frame (at +-15 deg only the fall would be).
+  options.orientation_prior_deg = 0.001;
   auto result = diagnose(clump, table, made->recordings, made->names, options);
   ASSERT_TRUE(result) << result.error().message;
   EXPECT_EQ(result->verdict, "none") << result->statement;

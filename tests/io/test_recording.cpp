@@ -94,4 +94,155 @@ TEST(Recording, BadInputNamesFileAndLine) {
   }
 }
 
+// Recordings that cannot hurt the tool (issue 12, item 5): a track outside the recording's
+// folder is refused without being opened, and values no experiment produces are refused
+// with the file, the line and the limit broken.
+namespace {
+const char* kDrop = R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2},
+ "trials": [{"id": "1", "track": "%TRACK%"}]})";
+
+std::string with_track(const std::string& name) {
+  std::string m = kDrop;
+  m.replace(m.find("%TRACK%"), 7, name);
+  return m;
+}
+
+std::string refusal(const fs::path& dir, const std::string& manifest, const std::string& track = "t_s,x_m,z_m\n0,0,0.2\n0.001,0,0.2\n") {
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  test::write_text(dir / "recording.json", manifest);
+  test::write_text(dir / "t.csv", track);
+  const auto r = read_recording(dir);
+  return r ? std::string("(accepted)") : r.error().message;
+}
+}  // namespace
+
+TEST(RecordingLimits, TrackPathWithDotDotIsRefusedUnread) {
+  test::ScratchDir dir("rec-limits");
+  test::write_text(dir / "secret.csv", "first line of a file outside the recording\n");
+  const std::string m = refusal(dir / "r", with_track("../secret.csv"));
+  EXPECT_NE(m.find("recording.json:2"), std::string::npos) << m;
+  EXPECT_NE(m.find("leaves the recording's folder"), std::string::npos) << m;
+  EXPECT_EQ(m.find("first line"), std::string::npos) << m;
+  EXPECT_NE(refusal(dir / "r", with_track("sub/../../secret.csv")).find("leaves the recording's folder"), std::string::npos);
+}
+
+TEST(RecordingLimits, AbsoluteTrackPathIsRefused) {
+  test::ScratchDir dir("rec-limits");
+  const std::string m = refusal(dir / "r", with_track("/etc/passwd"));
+  EXPECT_NE(m.find("is absolute"), std::string::npos) << m;
+  EXPECT_EQ(m.find("root:"), std::string::npos) << m;
+}
+
+TEST(RecordingLimits, SymlinkLeavingTheFolderIsRefused) {
+  test::ScratchDir dir("rec-limits");
+  test::write_text(dir / "outside.csv", "t_s,x_m,z_m\n0,0,0.2\n0.001,0,0.2\n");
+  fs::create_directories(dir / "r");
+  const std::string manifest = with_track("link.csv");
+  fs::remove_all(dir / "r");
+  fs::create_directories(dir / "r");
+  test::write_text(dir / "r" / "recording.json", manifest);
+  fs::create_symlink(dir / "outside.csv", dir / "r" / "link.csv");
+  const auto r = read_recording(dir / "r");
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("leads out of the recording's folder"), std::string::npos) << r.error().message;
+  // A link that stays inside is a file of the recording like any other.
+  fs::create_directories(dir / "r" / "tracks");
+  test::write_text(dir / "r" / "tracks" / "t.csv", "t_s,x_m,z_m\n0,0,0.2\n0.001,0,0.2\n");
+  fs::remove(dir / "r" / "link.csv");
+  fs::create_symlink(dir / "r" / "tracks" / "t.csv", dir / "r" / "link.csv");
+  EXPECT_TRUE(read_recording(dir / "r"));
+}
+
+TEST(RecordingLimits, CoordinateBeyond100MetresIsRefused) {
+  test::ScratchDir dir("rec-limits");
+  const std::string m = refusal(dir / "r", with_track("t.csv"), "t_s,x_m,z_m\n0,0,0.2\n0.001,0,1e308\n");
+  EXPECT_NE(m.find("t.csv:3"), std::string::npos) << m;
+  EXPECT_NE(m.find("beyond the limit of +-100 m"), std::string::npos) << m;
+  EXPECT_NE(refusal(dir / "r", with_track("t.csv"), "t_s,x_m,z_m\n0,-150,0.2\n").find("t.csv:2"), std::string::npos);
+}
+
+TEST(RecordingLimits, TimeBeyond1e9SecondsIsRefused) {
+  test::ScratchDir dir("rec-limits");
+  const std::string m = refusal(dir / "r", with_track("t.csv"), "t_s,x_m,z_m\n0,0,0.2\n2e9,0,0.2\n");
+  EXPECT_NE(m.find("t.csv:3"), std::string::npos) << m;
+  EXPECT_NE(m.find("+-1e+09 s"), std::string::npos) << m;
+}
+
+TEST(RecordingLimits, ReleaseHeightOutside0To100MetresIsRefused) {
+  test::ScratchDir dir("rec-limits");
+  std::string m = with_track("t.csv");
+  m.replace(m.find("0.2}"), 3, "1e9");
+  const std::string message = refusal(dir / "r", m);
+  EXPECT_NE(message.find("recording.json:1"), std::string::npos) << message;
+  EXPECT_NE(message.find("must lie in (0, 100] m"), std::string::npos) << message;
+  m = with_track("t.csv");
+  m.replace(m.find("0.2}"), 3, "0");
+  EXPECT_NE(refusal(dir / "r", m).find("must be positive"), std::string::npos);
+}
+
+TEST(RecordingLimits, FrameRateOutside0To1MHzIsRefused) {
+  test::ScratchDir dir("rec-limits");
+  const std::string m = R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2},
+ "camera": {"frame_rate_hz": 5e6}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  const std::string message = refusal(dir / "r", m);
+  EXPECT_NE(message.find("recording.json:2"), std::string::npos) << message;
+  EXPECT_NE(message.find("'frame_rate_hz' is 5000000: it must lie in (0, 1000000] Hz"), std::string::npos) << message;
+}
+
+TEST(RecordingLimits, DensityOutside1To25000IsRefused) {
+  test::ScratchDir dir("rec-limits");
+  for (const char* density : {"0.5", "30000"}) {
+    const std::string m = fmt::format(R"({{"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {{"release_height_m": 0.2}},
+ "particle": {{"density_kg_m3": {}}}, "trials": [{{"id": "1", "track": "t.csv"}}]}})",
+                                      density);
+    const std::string message = refusal(dir / "r", m);
+    EXPECT_NE(message.find("recording.json:2"), std::string::npos) << message;
+    EXPECT_NE(message.find("must lie in [1, 25000] kg/m^3"), std::string::npos) << message;
+  }
+}
+
+TEST(RecordingLimits, MalformedJsonAnywhereIsAParseError) {
+  test::ScratchDir dir("rec-limits");
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"{\"format\": \"recording/1\", \"test\": \"drop\",", "not valid JSON"},
+      {"[1, 2, 3]", "the manifest must be a JSON object"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": "high"}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "'release_height_m' must be a number"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": 5}]})",
+       "'track' must be a file name"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv", "orientation_wxyz": [1, "a", 0, 0]}]})",
+       "'orientation_wxyz' must be a unit quaternion"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv", "orientation_wxyz": [3, 0, 0, 0]}]})",
+       "'orientation_wxyz' must be a unit quaternion"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "particle": 7, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "recording.json:1: 'particle' must be an object"},
+      {R"({"format": 1, "test": "drop"})", "'format' must be a string"},
+  };
+  for (const auto& [manifest, expected] : cases) {
+    SCOPED_TRACE(manifest);
+    const std::string m = refusal(dir / "r", manifest);
+    EXPECT_NE(m.find(expected), std::string::npos) << m;
+  }
+}
+
+TEST(RecordingLimits, RecordedOrientationIsATypedPrior) {
+  test::ScratchDir dir("rec-limits");
+  fs::create_directories(dir / "r");
+  test::write_text(dir / "r" / "recording.json", R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2},
+ "trials": [{"id": "1", "track": "t.csv", "orientation_wxyz": [0, 1, 0, 0]}, {"id": "2", "summary": {"rebound_height_m": 0.01}}]})");
+  test::write_text(dir / "r" / "t.csv", "t_s,x_m,z_m\n0,0,0.2\n0.001,0,0.2\n");
+  const auto r = read_recording(dir / "r");
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_TRUE(r->trials[0].release_orientation);
+  EXPECT_DOUBLE_EQ(r->trials[0].release_orientation->x(), 1.0);
+  EXPECT_FALSE(r->trials[1].release_orientation);
+  EXPECT_EQ(r->trials[0].extra_json.find("orientation"), std::string::npos);
+  ASSERT_TRUE(write_recording(dir / "copy", *r));
+  const auto back = read_recording(dir / "copy");
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_TRUE(back->trials[0].release_orientation);
+  EXPECT_DOUBLE_EQ(back->trials[0].release_orientation->x(), 1.0);
+}
+
 }  // namespace clumpforge

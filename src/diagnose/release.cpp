@@ -1,0 +1,60 @@
+#include "diagnose/release.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/rng.hpp"
+
+namespace clumpforge {
+
+std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count, std::uint64_t seed,
+                                                          std::uint64_t stream) {
+  Rng rng(seed, stream);
+  std::vector<Eigen::Quaterniond> out;
+  out.reserve(static_cast<std::size_t>(std::max(0, count)));
+  for (int k = 0; k < count; ++k) {
+    if (prior.recorded) {
+      if (k == 0) {
+        out.push_back(prior.recorded->normalized());
+        continue;
+      }
+      // Uniform in the ball of rotation vectors of radius `spread`: a random axis, an angle
+      // with density proportional to its square.
+      Eigen::Vector3d axis(rng.normal(), rng.normal(), rng.normal());
+      if (axis.norm() < 1e-12) axis = Eigen::Vector3d::UnitX();
+      const double angle = prior.spread * std::cbrt(rng.uniform());
+      out.push_back((Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())) * *prior.recorded).normalized());
+    } else if (test == LabTest::Tilt) {
+      out.emplace_back(Eigen::AngleAxisd(rng.uniform(0.0, 2.0 * std::numbers::pi), Eigen::Vector3d::UnitZ()));
+    } else {
+      // Uniform over all rotations: a normalised 4D Gaussian.
+      out.push_back(Eigen::Quaterniond(rng.normal(), rng.normal(), rng.normal(), rng.normal()).normalized());
+    }
+  }
+  return out;
+}
+
+double release_horizon(const std::vector<std::vector<ReplaySample>>& replays, double tolerance) {
+  if (replays.size() < 2) return std::numeric_limits<double>::infinity();
+  std::size_t samples = replays.front().size();
+  for (const auto& r : replays) samples = std::min(samples, r.size());
+  const double n = static_cast<double>(replays.size());
+  for (std::size_t k = 0; k < samples; ++k) {
+    double mean_x = 0.0, mean_z = 0.0;
+    for (const auto& r : replays) {
+      mean_x += (r[k].x - r[0].x) / n;
+      mean_z += (r[k].z - r[0].z) / n;
+    }
+    double spread = 0.0;
+    for (const auto& r : replays) {
+      const double dx = r[k].x - r[0].x - mean_x, dz = r[k].z - r[0].z - mean_z;
+      spread += (dx * dx + dz * dz) / n;
+    }
+    if (std::sqrt(spread) > tolerance) return replays.front()[k].t;
+  }
+  // Replays that end early (a body at rest) agree from there on.
+  return std::numeric_limits<double>::infinity();
+}
+
+}  // namespace clumpforge

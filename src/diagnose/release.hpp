@@ -1,0 +1,40 @@
+#pragma once
+/// The release state a lab does not know. A camera shows the tracked centroid, not the
+/// orientation, and nobody writes the orientation down to better than tens of degrees; an
+/// irregular body's path after its first contact depends on it chaotically. The diagnosis
+/// therefore treats the release orientation as a nuisance with a prior: uniform when the
+/// recording has none, within a stated spread of the recorded one otherwise (never exact).
+/// Replays from orientations the prior allows show how long a trial stays predictable:
+/// only that part of a track is fitted frame by frame.
+#include <cstdint>
+#include <numbers>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/recording.hpp"
+#include "dem/lab.hpp"
+
+namespace clumpforge {
+
+/// What is known of one trial's release orientation.
+struct OrientationPrior {
+  std::optional<Eigen::Quaterniond> recorded;  ///< the lab's, when written down (a prior centre)
+  double spread = 15.0 * std::numbers::pi / 180.0;  ///< [rad] how far from `recorded` the release may be, (0, pi]
+};
+
+/// `count` release orientations the prior allows, reproducibly from (`seed`, `stream`):
+/// uniform over all rotations (drop, roll) or over headings about the vertical (tilt: the
+/// particle lies as the test places it) when nothing was recorded; uniform within a ball of
+/// rotation angle `spread` about the recorded one otherwise, the recorded one first.
+std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count, std::uint64_t seed,
+                                                          std::uint64_t stream);
+
+/// The release horizon of replays from orientations the prior allows [s since release]:
+/// the first sample time at which the tracked points' displacements from their own first
+/// sample spread (RMS about their mean, x and z together) by more than `tolerance` [m].
+/// Infinity when they never do (a sphere; a body whose orientation does not matter).
+double release_horizon(const std::vector<std::vector<ReplaySample>>& replays, double tolerance);
+
+}  // namespace clumpforge
