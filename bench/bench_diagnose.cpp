@@ -41,11 +41,136 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
+/// The verdicts that name a recording set's effect right: its answer file's vocabulary
+/// mapped onto the candidate library's (a speed-dependent restitution is right under
+/// either law the library has; the set's law is e ~ v^-1/4, the elastic-plastic one).
+std::vector<std::string> right_verdicts(const std::string& effect) {
+  if (effect == "none") return {"none"};
+  if (effect == "drag") return {"air_drag"};
+  if (effect == "speed_restitution") return {"elastic_plastic_restitution", "viscoelastic_restitution"};
+  if (effect == "plastic_soil") return {"plastic_substrate"};
+  return {effect};
+}
+
+/// The particle a case's recordings name: the first manifest's mesh (relative to it) and density.
+std::optional<std::pair<fs::path, double>> case_particle(const fs::path& case_dir) {
+  std::vector<fs::path> manifests;
+  for (const auto& entry : fs::directory_iterator(case_dir)) {
+    if (fs::is_regular_file(entry.path() / "recording.json")) manifests.push_back(entry.path() / "recording.json");
+  }
+  std::sort(manifests.begin(), manifests.end());
+  if (manifests.empty()) return std::nullopt;
+  std::ifstream in(manifests.front());
+  const auto j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.contains("particle") || !j["particle"].contains("mesh")) return std::nullopt;
+  return std::pair{manifests.front().parent_path() / j["particle"]["mesh"].get<std::string>(),
+                   j["particle"].value("density_kg_m3", 1085.0)};
+}
+
+/// Diagnoses every case of a recording set made elsewhere (case-NN/ with recordings, the
+/// particle named in their manifests) through the real command line, blind, then scores the
+/// verdicts against the set's ANSWERS.json, read only here.
+int run_recordings_set(const fs::path& set, const fs::path& out, const std::string& cli, const std::string& extra,
+                       bool existing_only) {
+  std::ifstream answers_in(set / "ANSWERS.json");
+  const auto answers = nlohmann::json::parse(answers_in, nullptr, false);
+  if (answers.is_discarded() || !answers.contains("cases")) {
+    std::cerr << (set / "ANSWERS.json").string() << ": no readable answers\n";
+    return 1;
+  }
+  fs::create_directories(out);
+  std::string table =
+      "| case | particle | truth | verdict | right | held-out RMS before -> after [mm] | improvement | time [s] "
+      "|\n|---|---|---|---|---|---|---:|---:|\n";
+  int effects = 0, effects_right = 0, controls = 0, controls_none = 0, controls_named = 0;
+  std::vector<double> seconds, improvements;
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& [id, answer] : answers["cases"].items()) {
+    const fs::path case_dir = set / id, report = out / id / "report.json";
+    if (!fs::is_directory(case_dir)) continue;
+    if (!fs::exists(report)) {
+      if (existing_only) continue;
+      const auto particle = case_particle(case_dir);
+      if (!particle) {
+        std::cerr << id << ": no particle mesh named in its manifests\n";
+        return 1;
+      }
+      fs::create_directories(out / id);
+      const std::string command =
+          fmt::format("'{}' diagnose --recordings '{}' --mesh '{}' --density {} {} --json > '{}.tmp' 2> '{}'", cli,
+                      case_dir.string(), particle->first.string(), particle->second, extra, report.string(),
+                      (out / id / "stderr.txt").string());
+      if (std::system(command.c_str()) != 0) {
+        std::cerr << id << ": diagnose failed, see " << (out / id / "stderr.txt").string() << "\n";
+        return 1;
+      }
+      fs::rename(report.string() + ".tmp", report);
+    }
+    std::ifstream in(report);
+    const auto j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded()) {
+      std::cerr << id << ": unreadable report\n";
+      return 1;
+    }
+    const std::string effect = answer.value("effect", "none"), verdict = j.value("verdict", "?");
+    const auto right = right_verdicts(effect);
+    const bool is_right = std::find(right.begin(), right.end(), verdict) != right.end();
+    const bool named_effect =
+        verdict != "none" && verdict != "ambiguous" && verdict != "unexplained" && verdict != "undecidable";
+    const double before = j["fit"]["before"].value("heldout_rms_mm", NAN),
+                 after = j["fit"]["after"].value("heldout_rms_mm", NAN);
+    const double gain = before > 0.0 ? (before - after) / before : NAN;
+    if (effect == "none") {
+      ++controls;
+      controls_none += verdict == "none";
+      controls_named += named_effect;
+    } else {
+      ++effects;
+      effects_right += is_right;
+      if (is_right) improvements.push_back(gain);
+    }
+    seconds.push_back(j.value("seconds", NAN));
+    table += fmt::format("| {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} |\n", id,
+                         answer.value("particle", "?"), answer.value("label", effect), verdict, is_right ? "yes" : "no",
+                         before, after, 100.0 * gain, j.value("seconds", NAN));
+    rows.push_back({{"case", id},
+                    {"truth", effect},
+                    {"verdict", verdict},
+                    {"right", is_right},
+                    {"heldout_rms_before_mm", before},
+                    {"heldout_rms_after_mm", after},
+                    {"seconds", j.value("seconds", NAN)}});
+    std::cout << fmt::format("{}  truth {:18s} verdict {:28s} {}  {:.0f} s\n", id, effect, verdict,
+                             is_right ? "right" : "WRONG", j.value("seconds", NAN))
+              << std::flush;
+  }
+  table += fmt::format("\neffects named right: {}/{}; controls 'none': {}/{}; controls named as an effect: {}\n",
+                       effects_right, effects, controls_none, controls, controls_named);
+  table += fmt::format("median held-out improvement of the cases named right: {:.1f} % of the held-out RMS\n",
+                       100.0 * median(improvements));
+  table += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
+  std::cout << "\n" << table;
+  nlohmann::json summary{{"set", set.string()},
+                         {"effects", effects},
+                         {"effects_right", effects_right},
+                         {"controls", controls},
+                         {"controls_none", controls_none},
+                         {"controls_named", controls_named},
+                         {"median_seconds", median(seconds)},
+                         {"median_heldout_improvement", median(improvements)},
+                         {"cases", rows},
+                         {"table_markdown", table}};
+  std::ofstream(out / "summary.md") << table;
+  std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Blind benchmark of clumpforge diagnose on concealed-effect recordings"};
-  std::string clump_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default-diagnosis.h5", clump_name, cli = CLUMPFORGE_CLI, out = "bench-out/diagnose";
+  std::string clump_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default-diagnosis.h5", clump_name,
+              cli = CLUMPFORGE_CLI, out = "bench-out/diagnose";
   int controls = 50, trials = 4;
   std::uint64_t seed = 1;
   std::vector<std::string> only;
@@ -58,9 +183,29 @@ int main(int argc, char** argv) {
   app.add_option("--trials", trials, "Trials per recording");
   app.add_option("--seed", seed, "Seed of the whole benchmark");
   app.add_option("--effects", only, "Only these effects (default: the library)");
-  app.add_flag("--full-set", full_set, "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
-  app.add_flag("--existing-only", existing_only, "Score only the cases already diagnosed in --out (a partial run's figures), run none");
+  app.add_flag("--full-set", full_set,
+               "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
+  app.add_flag("--existing-only", existing_only,
+               "Score only the cases already diagnosed in --out (a partial run's figures), run none");
+  std::string recordings_set, diagnose_options, orientation = "none", generator_file, generator_name;
+  double fps = 1000.0, noise = 1e-4;
+  bool no_pre_roll = false;
+  app.add_option("--orientation", orientation,
+                 "What each generated trial records of its release orientation: none (default), noisy:DEG, exact");
+  app.add_option("--fps", fps, "Camera frame rate of the generated tracks [Hz] (labs: 1000, 240)");
+  app.add_option("--noise", noise, "Camera noise of the generated tracks [m] (1e-4 at 1000 fps, 5e-4 at 240 fps)");
+  app.add_flag("--no-pre-roll", no_pre_roll, "Generated tracks begin after the release");
+  app.add_option("--generator-clump", generator_file,
+                 "Clump library the recordings are made with (default: --clump's file); a finer clump of the same mesh "
+                 "than the diagnosed one");
+  app.add_option("--generator-clump-name", generator_name, "Which clump of the generator's library");
+  app.add_option("--recordings-set", recordings_set,
+                 "Score a recording set made elsewhere (case-NN/ folders and ANSWERS.json, e.g. "
+                 "../shared/data/lab-like) instead of generating one");
+  app.add_option("--diagnose-options", diagnose_options,
+                 "Extra options passed to every diagnose run of --recordings-set (e.g. \"--spheres 64\")");
   CLI11_PARSE(app, argc, argv);
+  if (!recordings_set.empty()) return run_recordings_set(recordings_set, out, cli, diagnose_options, existing_only);
 
   auto clumps = read_clump_library(clump_file);
   if (!clumps) {
@@ -72,11 +217,37 @@ int main(int argc, char** argv) {
     std::cerr << clump.error().message << "\n";
     return 1;
   }
+  // The recordings come from a finer (or other) clump than the one diagnosed, as real data
+  // never comes from the diagnoser's own model.
+  Clump generator = *clump;
+  if (!generator_file.empty()) {
+    auto library_g = read_clump_library(generator_file);
+    auto chosen = library_g ? select_clump(std::move(*library_g), generator_name, generator_file)
+                            : Result<Clump>(std::unexpected(library_g.error()));
+    if (!chosen) {
+      std::cerr << chosen.error().message << "\n";
+      return 1;
+    }
+    generator = std::move(*chosen);
+  }
   const MaterialTable table = default_material_table();
   const auto library = effect_library();
   std::vector<Case> cases;
+  ConcealOptions camera;
+  camera.frame_rate_hz = fps;
+  camera.noise_m = noise;
+  camera.pre_roll = !no_pre_roll;
+  if (orientation == "exact")
+    camera.orientation = OrientationRecord::Exact;
+  else if (orientation.starts_with("noisy:")) {
+    camera.orientation = OrientationRecord::Noisy;
+    camera.orientation_noise_deg = std::atof(orientation.c_str() + 6);
+  } else if (orientation != "none") {
+    std::cerr << "--orientation '" << orientation << "' is not none, noisy:DEG or exact\n";
+    return 1;
+  }
   auto base_options = [&](const std::string& surface, std::uint64_t case_seed) {
-    ConcealOptions o;
+    ConcealOptions o = camera;
     o.surface = surface;
     o.trials = trials;
     o.seed = case_seed;
@@ -96,7 +267,8 @@ int main(int argc, char** argv) {
       c.magnitude = magnitude;
       c.options = base_options(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", seed * 1000 + ++k);
       c.options.effect = spec.effect;
-      for (const auto& p : spec.parameters) c.options.values.push_back(magnitude == "realistic" ? p.realistic : p.strong);
+      for (const auto& p : spec.parameters)
+        c.options.values.push_back(magnitude == "realistic" ? p.realistic : p.strong);
       cases.push_back(std::move(c));
     }
   }
@@ -120,7 +292,8 @@ int main(int argc, char** argv) {
     std::vector<Case> effects_first(cases.begin(), cases.end());
     std::vector<Case> interleaved;
     std::size_t e = 0, c = 0;
-    const auto first_control = std::find_if(effects_first.begin(), effects_first.end(), [](const Case& x) { return !x.effect; });
+    const auto first_control =
+        std::find_if(effects_first.begin(), effects_first.end(), [](const Case& x) { return !x.effect; });
     const std::size_t n_effects = static_cast<std::size_t>(first_control - effects_first.begin());
     while (e < n_effects || c < effects_first.size() - n_effects) {
       if (e < n_effects) interleaved.push_back(effects_first[e++]);
@@ -141,7 +314,7 @@ int main(int argc, char** argv) {
     const std::string truth = c.effect ? effect_spec(library, *c.effect).name : "none";
     if (!fs::exists(report) && existing_only) continue;
     if (!fs::exists(report)) {
-      auto made = make_concealed_recordings(*clump, table, c.options);
+      auto made = make_concealed_recordings(generator, table, c.options);
       if (!made) {
         std::cerr << c.id << ": " << made.error().message << "\n";
         return 1;
@@ -155,9 +328,10 @@ int main(int argc, char** argv) {
       }
       std::ofstream(dir / "answer.json") << answer_json(c.options, *made);
       // Blind: the diagnosis sees the recordings directory and the clump, nothing else.
-      const std::string command = fmt::format("'{}' diagnose --recordings '{}' --clump '{}' {} --json > '{}.tmp' 2> '{}'", cli,
-                                              (dir / "recordings").string(), clump_file, clump_name.empty() ? "" : "--clump-name '" + clump_name + "'",
-                                              report.string(), (dir / "stderr.txt").string());
+      const std::string command = fmt::format(
+          "'{}' diagnose --recordings '{}' --clump '{}' {} --json > '{}.tmp' 2> '{}'", cli,
+          (dir / "recordings").string(), clump_file, clump_name.empty() ? "" : "--clump-name '" + clump_name + "'",
+          report.string(), (dir / "stderr.txt").string());
       if (std::system(command.c_str()) != 0) {
         std::cerr << c.id << ": diagnose failed, see " << (dir / "stderr.txt").string() << "\n";
         return 1;
@@ -178,8 +352,8 @@ int main(int argc, char** argv) {
     o.heldout_before = j["fit"]["before"].value("heldout_rms_mm", NAN);
     o.heldout_after = j["fit"]["after"].value("heldout_rms_mm", NAN);
     o.seconds = j.value("seconds", NAN);
-    std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id, truth, o.verdict,
-                             o.heldout_before, o.heldout_after, o.seconds)
+    std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id,
+                             truth, o.verdict, o.heldout_before, o.heldout_after, o.seconds)
               << std::flush;
     outcomes.push_back(o);
   }
@@ -202,7 +376,8 @@ int main(int argc, char** argv) {
   md += "\n";
   for (const auto& row : rows) {
     md += fmt::format("| {} |", row);
-    for (const auto& col : columns) md += fmt::format(" {} |", matrix[row][col] ? std::to_string(matrix[row][col]) : std::string("."));
+    for (const auto& col : columns)
+      md += fmt::format(" {} |", matrix[row][col] ? std::to_string(matrix[row][col]) : std::string("."));
     md += "\n";
   }
   int control_count = 0, false_positives = 0;
@@ -234,8 +409,10 @@ int main(int argc, char** argv) {
     md += fmt::format("| {} |{}\n", spec.name, cells);
   }
   const double fpr = control_count ? static_cast<double>(false_positives) / control_count : NAN;
-  md += fmt::format("\nfalse-positive rate on {} controls: {}/{} = {:.1f} %\n", control_count, false_positives, control_count, 100.0 * fpr);
-  md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n", 100.0 * median(improvements));
+  md += fmt::format("\nfalse-positive rate on {} controls: {}/{} = {:.1f} %\n", control_count, false_positives,
+                    control_count, 100.0 * fpr);
+  md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
+                    100.0 * median(improvements));
   md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
   std::cout << "\n" << md;
   summary["false_positive_rate"] = fpr;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <ranges>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
@@ -21,11 +22,13 @@ namespace fs = std::filesystem;
 namespace clumpforge::cli {
 namespace {
 
+constexpr int kMaxAutoSpheres = 256;
+
 struct DiagnoseArgs {
   std::vector<std::string> recordings, effects;
   std::string mesh, clump, clump_name, out, materials, units = "mm";
-  double density = 1085.0, orientation_prior_deg = 15.0;
-  int spheres = 32, max_evaluations = 45, release_orientations = 12;
+  double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3;
+  int spheres = 0, max_evaluations = 45, release_orientations = 12;
   std::uint64_t seed = 1;
   bool json = false;
 };
@@ -34,7 +37,8 @@ struct DiagnoseArgs {
 Result<void> collect(const std::string& path, std::vector<Recording>& recordings, std::vector<std::string>& names) {
   const fs::path p(path);
   std::error_code ec;
-  if (fs::is_regular_file(p / "recording.json", ec) || (fs::is_regular_file(p, ec) && p.filename() == "recording.json")) {
+  if (fs::is_regular_file(p / "recording.json", ec) ||
+      (fs::is_regular_file(p, ec) && p.filename() == "recording.json")) {
     auto r = read_recording(p);
     if (!r) return std::unexpected(r.error());
     recordings.push_back(std::move(*r));
@@ -47,7 +51,9 @@ Result<void> collect(const std::string& path, std::vector<Recording>& recordings
   for (const auto& entry : fs::directory_iterator(p, ec)) {
     if (entry.is_directory() && fs::is_regular_file(entry.path() / "recording.json")) children.push_back(entry.path());
   }
-  if (children.empty()) return fail(ErrorCode::NotFound, fmt::format("{}: neither a recording (recording.json) nor a directory of recordings", path));
+  if (children.empty())
+    return fail(ErrorCode::NotFound,
+                fmt::format("{}: neither a recording (recording.json) nor a directory of recordings", path));
   std::sort(children.begin(), children.end());
   for (const auto& child : children) {
     auto r = read_recording(child);
@@ -61,7 +67,8 @@ Result<void> collect(const std::string& path, std::vector<Recording>& recordings
 nlohmann::json coefficients_json(const std::vector<SurfaceParameters>& base) {
   nlohmann::json out = nlohmann::json::object();
   for (const auto& b : base) {
-    out[b.surface] = {{"restitution", b.interaction.restitution}, {"static_friction", b.interaction.static_friction},
+    out[b.surface] = {{"restitution", b.interaction.restitution},
+                      {"static_friction", b.interaction.static_friction},
                       {"rolling_friction", b.interaction.rolling_friction}};
   }
   return out;
@@ -70,8 +77,11 @@ nlohmann::json coefficients_json(const std::vector<SurfaceParameters>& base) {
 nlohmann::json quality_json(const FitQuality& q) {
   nlohmann::json summary = nlohmann::json::object();
   for (const auto& [name, v] : q.summary_error) summary[name] = v;
-  return {{"train_rms_mm", q.train_rms_mm}, {"heldout_rms_mm", q.heldout_rms_mm}, {"train_chi2_per_value", q.train_chi2_per_value},
-          {"heldout_chi2_per_value", q.heldout_chi2_per_value}, {"summary_error_mm_or_deg", summary}};
+  return {{"train_rms_mm", q.train_rms_mm},
+          {"heldout_rms_mm", q.heldout_rms_mm},
+          {"train_chi2_per_value", q.train_chi2_per_value},
+          {"heldout_chi2_per_value", q.heldout_chi2_per_value},
+          {"summary_error_mm_or_deg", summary}};
 }
 
 nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_name) {
@@ -83,7 +93,8 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
   j["candidates"] = r.candidates;
   j["experiment"] = r.experiment;
   j["effect_parameters"] = nlohmann::json::object();
-  for (const auto& p : r.effect_parameters) j["effect_parameters"][p.name] = {{"value", p.value}, {"low", p.low}, {"high", p.high}};
+  for (const auto& p : r.effect_parameters)
+    j["effect_parameters"][p.name] = {{"value", p.value}, {"low", p.low}, {"high", p.high}};
   j["summaries_only"] = r.summaries_only;
   j["decidable"] = r.decidable;
   j["undecidable"] = r.undecidable;
@@ -95,24 +106,46 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
   j["phases"] = nlohmann::json::array();
   for (const auto& p : r.phases) {
-    j["phases"].push_back({{"recording", p.recording}, {"phase", p.phase}, {"values", p.values}, {"chi2_per_value", p.chi2_per_value},
-                           {"p_value", p.p_value}, {"significant", p.significant}, {"bias_x_mm", p.bias_x_mm}, {"bias_z_mm", p.bias_z_mm},
-                           {"axis", p.axis}, {"growth_power", p.growth_power}, {"end_residual_mm", p.end_residual_mm},
-                           {"improved_chi2_per_value", p.improved_chi2_per_value}, {"statement", p.statement}});
+    j["phases"].push_back({{"recording", p.recording},
+                           {"phase", p.phase},
+                           {"values", p.values},
+                           {"chi2_per_value", p.chi2_per_value},
+                           {"p_value", p.p_value},
+                           {"significant", p.significant},
+                           {"bias_x_mm", p.bias_x_mm},
+                           {"bias_z_mm", p.bias_z_mm},
+                           {"axis", p.axis},
+                           {"growth_power", p.growth_power},
+                           {"end_residual_mm", p.end_residual_mm},
+                           {"improved_chi2_per_value", p.improved_chi2_per_value},
+                           {"statement", p.statement}});
   }
   j["hypotheses"] = nlohmann::json::array();
   for (const auto& h : r.hypotheses) {
     nlohmann::json values = nlohmann::json::object();
     for (const auto& v : h.values) values[v.name] = v.value;
-    j["hypotheses"].push_back({{"name", h.name}, {"values", values}, {"coefficients", coefficients_json(h.base)}, {"values_used", h.values_used},
-                               {"delta_chi2", h.delta_chi2}, {"delta_bic", h.delta_bic}, {"heldout_delta_chi2", h.heldout_delta_chi2},
-                               {"plausible", h.plausible}, {"improves_heldout", h.improves_heldout}, {"clears_signature", h.clears_signature},
-                               {"all_trials_delta_bic", std::isfinite(h.all_trials_delta_bic) ? nlohmann::json(h.all_trials_delta_bic) : nlohmann::json()},
-                               {"beats_refitted_null", h.beats_refitted_null},
-                               {"flagged_excess_before", h.flagged_excess_before}, {"flagged_excess_after", h.flagged_excess_after},
-                               {"worsened_phases", h.worsened_phases},
-                               {"passes", h.passes}, {"evaluations", h.evaluations},
-                               {"smallest_detectable", std::isfinite(h.smallest_detectable) ? nlohmann::json(h.smallest_detectable) : nlohmann::json()}});
+    j["hypotheses"].push_back(
+        {{"name", h.name},
+         {"values", values},
+         {"coefficients", coefficients_json(h.base)},
+         {"values_used", h.values_used},
+         {"delta_chi2", h.delta_chi2},
+         {"delta_bic", h.delta_bic},
+         {"heldout_delta_chi2", h.heldout_delta_chi2},
+         {"plausible", h.plausible},
+         {"improves_heldout", h.improves_heldout},
+         {"clears_signature", h.clears_signature},
+         {"clears_large_misfit", h.clears_large_misfit},
+         {"all_trials_delta_bic",
+          std::isfinite(h.all_trials_delta_bic) ? nlohmann::json(h.all_trials_delta_bic) : nlohmann::json()},
+         {"beats_refitted_null", h.beats_refitted_null},
+         {"flagged_excess_before", h.flagged_excess_before},
+         {"flagged_excess_after", h.flagged_excess_after},
+         {"worsened_phases", h.worsened_phases},
+         {"passes", h.passes},
+         {"evaluations", h.evaluations},
+         {"smallest_detectable",
+          std::isfinite(h.smallest_detectable) ? nlohmann::json(h.smallest_detectable) : nlohmann::json()}});
   }
   j["unexplained"] = r.unexplained;
   j["notes"] = r.notes;
@@ -128,7 +161,8 @@ std::vector<std::pair<fs::path, std::string>> plots(const DiagnoseResult& r, con
   for (const auto& t : r.tracks) {
     for (int axis = 0; axis < 2; ++axis) {
       Plot plot;
-      plot.title = fmt::format("{}: recorded vs baseline vs improved ({}; fitted up to {:.3f} s)", t.recording, r.verdict, std::min(t.horizon, 99.0));
+      plot.title = fmt::format("{}: recorded vs baseline vs improved ({}; fitted up to {:.3f} s)", t.recording,
+                               r.verdict, std::min(t.horizon, 99.0));
       plot.x_label = "time since release [s]";
       plot.y_label = axis == 0 ? "height z [mm]" : "horizontal x [mm]";
       auto mm = [](const std::vector<double>& v) {
@@ -138,8 +172,10 @@ std::vector<std::pair<fs::path, std::string>> plots(const DiagnoseResult& r, con
       };
       const auto& rec_y = axis == 0 ? t.z : t.x;
       PlotSeries recorded{"recorded", t.t, mm(rec_y), "#444444", false, true};
-      PlotSeries baseline{"baseline", t.baseline_t, mm(axis == 0 ? t.baseline_z : t.baseline_x), "#d62728", true, false};
-      PlotSeries improved{"improved", t.improved_t, mm(axis == 0 ? t.improved_z : t.improved_x), "#2ca02c", true, false};
+      PlotSeries baseline{"baseline", t.baseline_t, mm(axis == 0 ? t.baseline_z : t.baseline_x),
+                          "#d62728",  true,         false};
+      PlotSeries improved{"improved", t.improved_t, mm(axis == 0 ? t.improved_z : t.improved_x),
+                          "#2ca02c",  true,         false};
       plot.series = {recorded, baseline, improved};
       files.emplace_back(dir / fmt::format("track-{}-{}.svg", t.recording, axis == 0 ? "z" : "x"), render_svg(plot));
     }
@@ -165,7 +201,9 @@ std::vector<std::pair<fs::path, std::string>> plots(const DiagnoseResult& r, con
 
 void print_text(const DiagnoseResult& r) {
   if (r.summaries_only) {
-    std::cout << fmt::format("verdict: {} (summaries only: no tracks, so no effect can be named)\n\nwhat these summaries decide:\n", r.verdict);
+    std::cout << fmt::format(
+        "verdict: {} (summaries only: no tracks, so no effect can be named)\n\nwhat these summaries decide:\n",
+        r.verdict);
     for (const auto& d : r.decidable) std::cout << "  - " << d << "\n";
     std::cout << "\nwhat they cannot decide:\n";
     for (const auto& d : r.undecidable) std::cout << "  - " << d << "\n";
@@ -187,38 +225,49 @@ void print_text(const DiagnoseResult& r) {
   for (const auto& h : r.hypotheses) {
     std::string values;
     for (const auto& v : h.values) values += fmt::format(" {}={:.3g}", v.name, v.value);
-    const std::string refitted =
-        std::isfinite(h.all_trials_delta_bic) && !h.beats_refitted_null ? fmt::format(" refitted-coefficients-do-as-well({:.1f})", h.all_trials_delta_bic) : "";
-    std::cout << fmt::format("  {:28s} {:9.1f} {:9.1f} {:9.1f}  {}{}{}{}{}{}\n", h.name, h.delta_chi2, h.delta_bic, h.heldout_delta_chi2,
-                             h.passes ? "PASS" : "fail", h.plausible ? "" : " implausible", h.improves_heldout ? "" : " no-held-out-gain",
-                             h.clears_signature ? "" : " signature-left", refitted, values);
+    const std::string refitted = std::isfinite(h.all_trials_delta_bic) && !h.beats_refitted_null
+                                     ? fmt::format(" refitted-coefficients-do-as-well({:.1f})", h.all_trials_delta_bic)
+                                     : "";
+    std::cout << fmt::format("  {:28s} {:9.1f} {:9.1f} {:9.1f}  {}{}{}{}{}{}\n", h.name, h.delta_chi2, h.delta_bic,
+                             h.heldout_delta_chi2, h.passes ? "PASS" : "fail", h.plausible ? "" : " implausible",
+                             h.improves_heldout ? "" : " no-held-out-gain", h.clears_signature ? "" : " signature-left",
+                             refitted + (h.clears_large_misfit ? "" : " no-large-misfit-cleared"), values);
   }
-  std::cout << fmt::format("\nfit before -> after: training RMS {:.3f} -> {:.3f} mm, held-out RMS {:.3f} -> {:.3f} mm\n", r.before.train_rms_mm,
-                           r.after.train_rms_mm, r.before.heldout_rms_mm, r.after.heldout_rms_mm);
+  std::cout << fmt::format(
+      "\nfit before -> after: training RMS {:.3f} -> {:.3f} mm, held-out RMS {:.3f} -> {:.3f} mm\n",
+      r.before.train_rms_mm, r.after.train_rms_mm, r.before.heldout_rms_mm, r.after.heldout_rms_mm);
   for (std::size_t k = 0; k < r.before.summary_error.size() && k < r.after.summary_error.size(); ++k) {
-    std::cout << fmt::format("  summary error {}: {:+.3g} -> {:+.3g}\n", r.before.summary_error[k].first, r.before.summary_error[k].second,
-                             r.after.summary_error[k].second);
+    std::cout << fmt::format("  summary error {}: {:+.3g} -> {:+.3g}\n", r.before.summary_error[k].first,
+                             r.before.summary_error[k].second, r.after.summary_error[k].second);
   }
   for (const auto& note : r.notes) std::cout << "note: " << note << "\n";
-  std::cout << fmt::format("{} tracked trials ({} for fitting), {} trial replays, {:.1f} s\n", r.tracked_trials, r.training_trials, r.evaluations, r.seconds);
+  std::cout << fmt::format("{} tracked trials ({} for fitting), {} trial replays, {:.1f} s\n", r.tracked_trials,
+                           r.training_trials, r.evaluations, r.seconds);
 }
 
 int run_diagnose(const DiagnoseArgs& args) {
   constexpr std::string_view kCommand = "diagnose";
-  if (args.mesh.empty() == args.clump.empty()) return report_error(kCommand, {ErrorCode::InvalidArgument, "give exactly one of --mesh and --clump"});
-  if (args.spheres < 4 || args.spheres > 5000) return report_error(kCommand, {ErrorCode::InvalidArgument, "--spheres must be between 4 and 5000"});
-  if (args.max_evaluations < 5 || args.max_evaluations > 10000) return report_error(kCommand, {ErrorCode::InvalidArgument, "--max-evaluations must be between 5 and 10000"});
+  if (args.mesh.empty() == args.clump.empty())
+    return report_error(kCommand, {ErrorCode::InvalidArgument, "give exactly one of --mesh and --clump"});
+  if (args.spheres != 0 && (args.spheres < 1 || args.spheres > 5000)) {
+    return report_error(
+        kCommand, {ErrorCode::InvalidArgument, "--spheres must be 0 (chosen by convergence) or between 1 and 5000"});
+  }
+  if (args.max_evaluations < 5 || args.max_evaluations > 10000)
+    return report_error(kCommand, {ErrorCode::InvalidArgument, "--max-evaluations must be between 5 and 10000"});
   std::vector<Recording> recordings;
   std::vector<std::string> names;
   for (const auto& path : args.recordings) {
     if (auto ok = collect(path, recordings, names); !ok) return report_error(kCommand, ok.error());
   }
-  auto loaded_table = args.materials.empty() ? Result<MaterialTable>(default_material_table()) : read_materials(args.materials);
+  auto loaded_table =
+      args.materials.empty() ? Result<MaterialTable>(default_material_table()) : read_materials(args.materials);
   if (!loaded_table) return report_error(kCommand, loaded_table.error());
   DiagnoseOptions options;
   options.seed = args.seed;
   options.max_evaluations = args.max_evaluations;
   options.orientation_prior_deg = args.orientation_prior_deg;
+  options.model_accuracy_m = args.model_accuracy_mm * 1e-3;
   options.release_orientations = args.release_orientations;
   for (const auto& name : args.effects) {
     auto e = parse_effect(name);
@@ -230,6 +279,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   }
   const RunContext context = progress_context(args.json);
   Clump clump;
+  std::vector<std::pair<int, double>> ladder;  // spheres, surface RMS [m] of each resolution tried
   if (!args.clump.empty()) {
     auto clumps = read_clump_library(args.clump);
     if (!clumps) return report_error(kCommand, clumps.error());
@@ -244,25 +294,45 @@ int run_diagnose(const DiagnoseArgs& args) {
     FillOptions fill;
     fill.method = FillMethod::Adaptive;
     fill.max_spheres = args.spheres;
-    auto filled = fill_body(body->body, fill, context);
-    if (!filled) return report_error(kCommand, Error{filled.error().code, fmt::format("'{}': {}", args.mesh, filled.error().message)});
+    // --spheres 0: the resolution by convergence to the scan (surface RMS within a third of
+    // the model accuracy), not a fixed budget.
+    auto filled = args.spheres > 0 ? fill_body(body->body, fill, context)
+                                   : fill_to_surface_accuracy(body->body, fill, args.model_accuracy_mm * 1e-3 / 3.0,
+                                                              kMaxAutoSpheres, &ladder, context);
+    if (!filled)
+      return report_error(kCommand,
+                          Error{filled.error().code, fmt::format("'{}': {}", args.mesh, filled.error().message)});
     clump = std::move(filled->clump);
     clump.name = fmt::format("adaptive-{}", clump.spheres.size());
   }
   auto result = diagnose(clump, *loaded_table, recordings, names, options, context);
   if (!result) return report_error(kCommand, result.error());
+  if (!ladder.empty()) {
+    result->notes.insert(result->notes.begin(), fmt::format("particle model: adaptive clump of {} spheres, the first "
+                                                            "of {} whose surface lies within {:.3g} mm RMS of the mesh",
+                                                            clump.spheres.size(),
+                                                            fmt::join(ladder | std::views::transform([](const auto& l) {
+                                                                        return fmt::format("{} ({:.3f} mm)", l.first,
+                                                                                           l.second * 1e3);
+                                                                      }),
+                                                                      ", "),
+                                                            args.model_accuracy_mm / 3.0));
+  }
   const nlohmann::json report = report_json(*result, clump.name);
   if (!args.out.empty()) {
     // Created only once there is something to write: a refusal leaves nothing behind.
     std::error_code ec;
     fs::create_directories(args.out, ec);
-    if (ec || !fs::is_directory(args.out)) return report_error(kCommand, {ErrorCode::IoError, fmt::format("cannot create '{}'", args.out)});
+    if (ec || !fs::is_directory(args.out))
+      return report_error(kCommand, {ErrorCode::IoError, fmt::format("cannot create '{}'", args.out)});
     auto files = plots(*result, args.out);
     files.emplace_back(fs::path(args.out) / "report.json", report.dump(2) + "\n");
     if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
   }
-  if (args.json) std::cout << report.dump(2) << "\n";
-  else print_text(*result);
+  if (args.json)
+    std::cout << report.dump(2) << "\n";
+  else
+    print_text(*result);
   return kExitOk;
 }
 
@@ -270,20 +340,29 @@ int run_diagnose(const DiagnoseArgs& args) {
 
 Command add_diagnose_command(CLI::App& app) {
   auto args = std::make_shared<DiagnoseArgs>();
-  auto* sub = app.add_subcommand("diagnose", "Locate where the DEM and recorded tracks disagree, name the missing physics, show the fit improve");
-  sub->add_option("--recordings", args->recordings, "Recording directories, or directories of them")->required()->expected(1, -1);
+  auto* sub = app.add_subcommand(
+      "diagnose", "Locate where the DEM and recorded tracks disagree, name the missing physics, show the fit improve");
+  sub->add_option("--recordings", args->recordings, "Recording directories, or directories of them")
+      ->required()
+      ->expected(1, -1);
   sub->add_option("--mesh", args->mesh, "The particle's closed mesh (filled adaptively with --spheres spheres)");
   sub->add_option("--clump", args->clump, "The particle as a clump library (.h5)");
   sub->add_option("--clump-name", args->clump_name, "Which clump of the library (needed when it holds several)");
-  sub->add_option("--spheres", args->spheres, "With --mesh: spheres of the adaptive clump (the DEM replays every trial many times)");
+  sub->add_option("--spheres", args->spheres,
+                  "With --mesh: spheres of the adaptive clump; 0 (default) chooses them by convergence to the scan "
+                  "(surface RMS within a third of --model-accuracy)");
   sub->add_option("--units", args->units, "With --mesh: its length unit (mm, cm, m)");
   sub->add_option("--density", args->density, "With --mesh: bulk density [kg/m^3]");
   sub->add_option("--effects", args->effects, "Candidate effects to test (default: the whole library)");
   sub->add_option("--materials", args->materials, "Materials file (JSON) overriding the built-in table");
-  sub->add_option("--max-evaluations", args->max_evaluations, "Fit budget per candidate (Levenberg-Marquardt iterations: a fifth of it)");
+  sub->add_option("--max-evaluations", args->max_evaluations,
+                  "Fit budget per candidate (Levenberg-Marquardt iterations: a fifth of it)");
   sub->add_option("--seed", args->seed, "Seed (the release orientations drawn from each prior)");
   sub->add_option("--orientation-prior", args->orientation_prior_deg,
                   "Uncertainty of a recorded release orientation (orientation_wxyz) [deg]; never taken as exact");
+  sub->add_option("--model-accuracy", args->model_accuracy_mm,
+                  "How closely the particle model can follow a real particle [mm]; residuals are weighed against it "
+                  "and the camera noise together");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   sub->add_option("--out", args->out, "Write report.json and SVG plots here");

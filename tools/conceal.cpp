@@ -1,7 +1,10 @@
 // clumpforge-conceal: writes recordings with one physics effect hidden in them (or none), for
 // proving `clumpforge diagnose` blind. The answer goes to a separate file, for the scorer.
-//   clumpforge-conceal CLUMP.h5 --effect air_drag|...|none [--magnitude realistic|strong|V[,V]]
-//                      [--surface Q235] [--trials 8] [--seed 1] --out DIR [--answer FILE]
+//   clumpforge-conceal CLUMP.h5 [--clump NAME] --effect air_drag|...|none [--magnitude realistic|strong|V[,V]]
+//                      [--surface Q235] [--trials 8] [--seed 1] [--orientation none|noisy:DEG|exact]
+//                      [--fps 1000] [--noise 1e-4] [--no-pre-roll] --out DIR [--answer FILE]
+#include "diagnose/conceal.hpp"
+
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -13,7 +16,6 @@
 
 #include "cli_common.hpp"
 #include "core/atomic_file.hpp"
-#include "diagnose/conceal.hpp"
 #include "io/clump_library.hpp"
 #include "io/recording_io.hpp"
 
@@ -37,10 +39,33 @@ Result<std::vector<double>> parse_values(const std::string& text, const EffectSp
       values.push_back(std::stod(cell, &used));
       if (used != cell.size()) throw std::invalid_argument(cell);
     } catch (const std::exception&) {
-      return fail(ErrorCode::InvalidArgument, fmt::format("--magnitude '{}' is not realistic, strong or numbers", text));
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("--magnitude '{}' is not realistic, strong or numbers", text));
     }
   }
   return values;
+}
+/// --orientation none | noisy:DEG | exact
+Result<void> parse_orientation(const std::string& text, ConcealOptions& options) {
+  if (text == "none")
+    options.orientation = OrientationRecord::None;
+  else if (text == "exact")
+    options.orientation = OrientationRecord::Exact;
+  else if (text.starts_with("noisy:")) {
+    options.orientation = OrientationRecord::Noisy;
+    try {
+      std::size_t used = 0;
+      const std::string number = text.substr(6);
+      options.orientation_noise_deg = std::stod(number, &used);
+      if (used != number.size()) throw std::invalid_argument(number);
+    } catch (const std::exception&) {
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("--orientation '{}': noisy takes an angle in degrees (noisy:15)", text));
+    }
+  } else {
+    return fail(ErrorCode::InvalidArgument, fmt::format("--orientation '{}' is not none, noisy:DEG or exact", text));
+  }
+  return {};
 }
 }  // namespace
 
@@ -49,17 +74,27 @@ int main(int argc, char** argv) {
   std::string input, clump_name, effect_name = "none", magnitude = "realistic", surface = "Q235", out, answer;
   int trials = 8;
   std::uint64_t seed = 1;
-  double noise = 1e-4;
-  bool no_conceal = false, small = false;
+  double noise = 1e-4, fps = 1000.0;
+  int steps_per_contact = generator_lab_options().steps_per_contact;
+  std::string orientation = "none";
+  bool no_conceal = false, small = false, no_pre_roll = false;
   std::optional<double> restitution, static_friction, rolling_friction;
   app.add_option("clump_file", input, "Clump library (.h5)")->required();
   app.add_option("--clump", clump_name, "Which clump of the file (needed when it holds several)");
-  app.add_option("--effect", effect_name, "Effect to hide: air_drag, viscoelastic_restitution, elastic_plastic_restitution, plastic_substrate, viscous_rolling, epsd_rolling, adhesion, com_offset, static_kinetic_friction, or none");
+  app.add_option("--effect", effect_name,
+                 "Effect to hide: air_drag, viscoelastic_restitution, elastic_plastic_restitution, plastic_substrate, "
+                 "viscous_rolling, epsd_rolling, adhesion, com_offset, static_kinetic_friction, or none");
   app.add_option("--magnitude", magnitude, "realistic, strong, or the parameter values (comma-separated, SI)");
   app.add_option("--surface", surface, "Plate material");
   app.add_option("--trials", trials, "Trials per recording");
   app.add_option("--seed", seed, "Seed of orientations, noise and time origins");
-  app.add_option("--noise", noise, "Camera noise per coordinate [m]");
+  app.add_option("--noise", noise, "Camera noise per coordinate [m] (labs: 1e-4 at 1000 fps, 5e-4 at 240 fps)");
+  app.add_option("--fps", fps, "Camera frame rate [Hz]");
+  app.add_flag("--no-pre-roll", no_pre_roll, "Tracks begin 2-20 ms after the release (default: 5-30 ms before it)");
+  app.add_option("--orientation", orientation,
+                 "Release orientation written into each trial: none (default, as labs), noisy:DEG, or exact");
+  app.add_option("--steps-per-contact", steps_per_contact,
+                 "Time steps per Hertz contact of the generating DEM (finer than the diagnosis's)");
   app.add_option("--restitution", restitution, "Baseline e (default: the table's)");
   app.add_option("--static-friction", static_friction, "Baseline mu_s");
   app.add_option("--rolling-friction", rolling_friction, "Baseline mu_r");
@@ -74,6 +109,14 @@ int main(int argc, char** argv) {
   options.trials = trials;
   options.seed = seed;
   options.noise_m = noise;
+  options.frame_rate_hz = fps;
+  options.pre_roll = !no_pre_roll;
+  if (steps_per_contact < 20 || steps_per_contact > 10000) {
+    return cli::report_error(kCommand,
+                             {ErrorCode::InvalidArgument, "--steps-per-contact must be between 20 and 10000"});
+  }
+  options.lab.steps_per_contact = steps_per_contact;
+  if (auto ok = parse_orientation(orientation, options); !ok) return cli::report_error(kCommand, ok.error());
   options.conceal = !no_conceal;
   if (small) {
     options.drop_heights = {0.2, 1.0};
@@ -105,13 +148,17 @@ int main(int argc, char** argv) {
 
   // Everything into a temporary directory, renamed into place when complete.
   const fs::path target(out);
-  const fs::path temporary = target.parent_path() / fs::path(target.filename().string() + fmt::format(".tmp-{}", ::getpid()));
+  const fs::path temporary =
+      target.parent_path() / fs::path(target.filename().string() + fmt::format(".tmp-{}", ::getpid()));
   std::error_code ec;
   fs::remove_all(temporary, ec);
   for (std::size_t r = 0; r < result->recordings.size(); ++r) {
     Recording& rec = result->recordings[r];
     rec.particle_density = clump->density;
-    rec.extra_json = fmt::format("{{\"notes\": \"synthetic recording from clumpforge-conceal (seed {}); the effect, if any, is in the answer file\"}}", seed);
+    rec.extra_json = fmt::format(
+        "{{\"notes\": \"synthetic recording from clumpforge-conceal (seed {}); the effect, if any, is in the answer "
+        "file\"}}",
+        seed);
     if (auto ok = write_recording(temporary / result->names[r], rec); !ok) {
       fs::remove_all(temporary, ec);
       return cli::report_error(kCommand, ok.error());
@@ -125,16 +172,18 @@ int main(int argc, char** argv) {
   }
   const std::string answer_text = answer_json(options, *result);
   if (!answer.empty()) {
-    if (auto ok = write_file_atomically(answer, [&](std::ostream& o) -> Result<void> {
-          o << answer_text;
-          return {};
-        });
+    if (auto ok = write_file_atomically(answer,
+                                        [&](std::ostream& o) -> Result<void> {
+                                          o << answer_text;
+                                          return {};
+                                        });
         !ok) {
       return cli::report_error(kCommand, ok.error());
     }
   }
   for (const auto& s : result->summaries) {
-    std::cerr << fmt::format("{:12s} summary mean: baseline {:.5g}, with the effect {:.5g}\n", s.recording, s.baseline_mean, s.effect_mean);
+    std::cerr << fmt::format("{:12s} summary mean: baseline {:.5g}, with the effect {:.5g}\n", s.recording,
+                             s.baseline_mean, s.effect_mean);
   }
   std::cerr << fmt::format("wrote {} recordings to {}\n", result->recordings.size(), out);
   return cli::kExitOk;

@@ -26,13 +26,13 @@ struct Track {
 
 struct Trial {
   std::string id;
-  std::optional<double> summary;    ///< the test's summary value (SI, degrees for tilt)
-  std::string track_file;           ///< relative to the recording's directory; empty = none
+  std::optional<double> summary;  ///< the test's summary value (SI, degrees for tilt)
+  std::string track_file;         ///< relative to the recording's directory; empty = none
   std::optional<Track> track;
   /// The release orientation the lab wrote down (trial key `orientation_wxyz`, body to lab,
   /// unit quaternion). A prior, never exact: a hand or a clamp gives it to tens of degrees.
   std::optional<Eigen::Quaterniond> release_orientation;
-  std::string extra_json = "{}";    ///< other keys of the trial, kept when rewriting
+  std::string extra_json = "{}";  ///< other keys of the trial, kept when rewriting
 };
 
 /// Limits no experiment exceeds: a value beyond them is refused as a broken recording.
@@ -51,14 +51,14 @@ struct RecordingLimits {
 struct Recording {
   LabTest test = LabTest::Drop;
   std::string surface;
-  double release_height = 0.2;              ///< drop [m]
-  double incline_deg = 30.0;                ///< roll
-  double start_distance = 0.035;            ///< roll [m], along the slope from the foot
+  double release_height = 0.2;                ///< drop [m]
+  double incline_deg = 30.0;                  ///< roll
+  double start_distance = 0.035;              ///< roll [m], along the slope from the foot
   std::optional<double> tilt_rate_deg_per_s;  ///< tilt; absent when not recorded
-  Composite composite = Composite::Single;  ///< tilt
-  std::optional<std::string> particle_mesh;      ///< relative to the manifest
+  Composite composite = Composite::Single;    ///< tilt
+  std::optional<std::string> particle_mesh;   ///< relative to the manifest
   std::optional<std::string> particle_mesh_units;
-  std::optional<double> particle_density;   ///< [kg/m^3]
+  std::optional<double> particle_density;  ///< [kg/m^3]
   std::optional<double> frame_rate_hz;
   std::optional<double> position_noise_m;
   std::vector<Trial> trials;

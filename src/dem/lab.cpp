@@ -24,7 +24,9 @@ double lowest_offset(const RigidBody& body, const Eigen::Quaterniond& q, const E
   return lowest;
 }
 
-double lowest_height(const RigidBody& body) { return lowest_offset(body, body.orientation, Eigen::Vector3d::UnitZ()) + body.position.z(); }
+double lowest_height(const RigidBody& body) {
+  return lowest_offset(body, body.orientation, Eigen::Vector3d::UnitZ()) + body.position.z();
+}
 
 struct TrialOutcome {
   Trial trial;
@@ -33,11 +35,14 @@ struct TrialOutcome {
   ImpactDiagnostics impact;
 };
 
-double rotational_energy(const RigidBody& b) { return 0.5 * b.angular_momentum.dot(b.angular_velocity()); }
+double rotational_energy(const RigidBody& b) {
+  return 0.5 * b.angular_momentum.dot(b.angular_velocity());
+}
 
 class TrackSampler {
  public:
-  TrackSampler(double frame_rate, const Eigen::Vector3d& tracked_point) : interval_(1.0 / frame_rate), point_(tracked_point) {}
+  TrackSampler(double frame_rate, const Eigen::Vector3d& tracked_point)
+      : interval_(1.0 / frame_rate), point_(tracked_point) {}
   void sample(const World& world, double tilt_deg = std::numeric_limits<double>::quiet_NaN()) {
     if (world.time + 1e-12 < next_) return;
     next_ += interval_;
@@ -59,7 +64,9 @@ class TrackSampler {
   Track track_;
 };
 
-bool any_wall_contact(const World& world) { return active_contacts(world) > 0; }
+bool any_wall_contact(const World& world) {
+  return active_contacts(world) > 0;
+}
 
 // Drop: lowest point `H` above the plate, at rest.
 void place_drop(RigidBody& body, const Recording& setup, const Eigen::Quaterniond& q) {
@@ -95,8 +102,8 @@ void place_tilt(RigidBody& body, const Eigen::Quaterniond& q) {
 
 // Drop: released from rest with its lowest point `H` above the plate; the summary is the
 // apex of the first rebound, measured as the rise of the lowest point above the plate.
-TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked, double dt,
-                        Rng& rng) {
+TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked,
+                        double dt, Rng& rng) {
   RigidBody& body = world.bodies[0];
   place_drop(body, setup, random_orientation(rng));
   TrackSampler sampler(options.frame_rate_hz, tracked);
@@ -139,8 +146,8 @@ TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& o
 
 // Roll: released from rest on the incline with its contact point `L` up the slope from the
 // foot; the summary is the horizontal distance on the flat from the foot where it stops.
-TrialOutcome roll_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked, double dt,
-                        Rng& rng) {
+TrialOutcome roll_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked,
+                        double dt, Rng& rng) {
   RigidBody& body = world.bodies[0];
   place_roll(body, setup, random_orientation(rng));
   TrackSampler sampler(options.frame_rate_hz, tracked);
@@ -167,15 +174,16 @@ TrialOutcome roll_trial(World world, const Recording& setup, const LabOptions& o
 
 // Tilt: resting flat on a plate tilted at a steady rate about y; the summary is the plate
 // angle at which sliding starts (1 mm of motion along the plate); 90 when it never slid by 89.
-TrialOutcome tilt_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked, double dt,
-                        Rng& rng) {
+TrialOutcome tilt_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked,
+                        double dt, Rng& rng) {
   RigidBody& body = world.bodies[0];
   const double yaw = rng.uniform(0.0, 2.0 * kPi);
   place_tilt(body, Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
   TrialOutcome out;
   out.orientation = body.orientation;
   TrackSampler sampler(options.frame_rate_hz, tracked);
-  const double rate = (setup.tilt_rate_deg_per_s ? *setup.tilt_rate_deg_per_s : options.tilt_rate_deg_per_s) * kPi / 180.0;
+  const double rate =
+      (setup.tilt_rate_deg_per_s ? *setup.tilt_rate_deg_per_s : options.tilt_rate_deg_per_s) * kPi / 180.0;
   Wall& plate = world.walls[0];
   // Settle, then tilt.
   while (world.time < 0.05) step(world, dt);
@@ -227,8 +235,10 @@ RigidBody four_square_body(const Clump& clump, int material) {
   return body;
 }
 
-Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, const Recording& setup, const LabOptions& options) {
-  if (clump.spheres.empty() || !(clump.mass > 0.0)) return fail(ErrorCode::InvalidArgument, "the clump has no spheres or no mass");
+Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, const Recording& setup,
+                                const LabOptions& options) {
+  if (clump.spheres.empty() || !(clump.mass > 0.0))
+    return fail(ErrorCode::InvalidArgument, "the clump has no spheres or no mass");
   auto particle = table.find(options.particle_material);
   if (!particle) return std::unexpected(particle.error());
   auto surface = table.find(setup.surface);
@@ -241,7 +251,8 @@ Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, 
     if (!pair) return std::unexpected(pair.error());
     interaction = *pair;
   }
-  if (auto ok = validate_interaction(interaction, fmt::format("{} on {}", options.particle_material, setup.surface)); !ok) {
+  if (auto ok = validate_interaction(interaction, fmt::format("{} on {}", options.particle_material, setup.surface));
+      !ok) {
     return std::unexpected(ok.error());
   }
   LabWorld lab;
@@ -249,11 +260,13 @@ Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, 
   const int p = add_material(world, **particle);
   const int s = add_material(world, **surface);
   set_interaction(world, p, s, interaction);
-  set_interaction(world, p, p, table.interaction(options.particle_material, options.particle_material).value_or(interaction));
+  set_interaction(world, p, p,
+                  table.interaction(options.particle_material, options.particle_material).value_or(interaction));
   set_interaction(world, s, s, interaction);
   world.contact = options.contact;
   world.terms = options.terms;
-  RigidBody body = setup.test == LabTest::Tilt && setup.composite == Composite::FourSquare ? four_square_body(clump, p) : make_body(clump, p);
+  RigidBody body = setup.test == LabTest::Tilt && setup.composite == Composite::FourSquare ? four_square_body(clump, p)
+                                                                                           : make_body(clump, p);
   if (!options.com_offset.isZero()) {
     for (auto& sphere : body.spheres) sphere.centre -= options.com_offset;
     update_bounding_radius(body);
@@ -277,10 +290,11 @@ Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, 
   } else {
     world.walls = {floor};
   }
-  const double impact_speed = setup.test == LabTest::Drop ? std::sqrt(2 * 9.81 * setup.release_height)
-                              : setup.test == LabTest::Roll
-                                  ? std::sqrt(2 * 9.81 * setup.start_distance * std::sin(setup.incline_deg * kPi / 180.0)) + 0.2
-                                  : 0.1;
+  const double impact_speed =
+      setup.test == LabTest::Drop ? std::sqrt(2 * 9.81 * setup.release_height)
+      : setup.test == LabTest::Roll
+          ? std::sqrt(2 * 9.81 * setup.start_distance * std::sin(setup.incline_deg * kPi / 180.0)) + 0.2
+          : 0.1;
   lab.estimate = estimate_time_step(world, impact_speed, options.steps_per_contact);
   lab.time_step = options.time_step.value_or(lab.estimate.chosen);
   if (auto ok = check_time_step(lab.time_step, lab.estimate); !ok) return std::unexpected(ok.error());
@@ -288,15 +302,22 @@ Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, 
   return lab;
 }
 
-std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& setup, const Eigen::Quaterniond& orientation,
-                                       const LabOptions& options, const ReplayOptions& replay) {
+std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& setup,
+                                       const Eigen::Quaterniond& orientation, const LabOptions& options,
+                                       const ReplayOptions& replay) {
   World world = lab.world;
   RigidBody& body = world.bodies[0];
   const double dt = lab.time_step;
   switch (setup.test) {
-    case LabTest::Drop: place_drop(body, setup, orientation); break;
-    case LabTest::Roll: place_roll(body, setup, orientation); break;
-    case LabTest::Tilt: place_tilt(body, orientation); break;
+    case LabTest::Drop:
+      place_drop(body, setup, orientation);
+      break;
+    case LabTest::Roll:
+      place_roll(body, setup, orientation);
+      break;
+    case LabTest::Tilt:
+      place_tilt(body, orientation);
+      break;
   }
   double origin = 0.0, rate = 0.0;
   if (setup.test == LabTest::Tilt) {
@@ -325,7 +346,8 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
       sample.along_plate = (b.position - world.walls[0].pivot).dot(world.walls[0].u_axis);
       sample.contacts = active_contacts(world);
       for (const auto& entry : world.history) {
-        if ((entry.first >> 63) == 0 && entry.second.last_step == world.steps) sample.wall = std::max(sample.wall, static_cast<int>(entry.first & 0xFFF));  // wall contacts
+        if ((entry.first >> 63) == 0 && entry.second.last_step == world.steps)
+          sample.wall = std::max(sample.wall, static_cast<int>(entry.first & 0xFFF));  // wall contacts
       }
       samples.push_back(sample);
       next += replay.sample_interval;
@@ -336,8 +358,10 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
     if (replay.stop_after_rest >= 0.0 && world.time - origin > 0.05) {
       const RigidBody& b = world.bodies[0];
       const bool still = b.velocity.norm() < 2e-3 && b.angular_velocity().norm() * b.bounding_radius < 2e-3;
-      if (!still) rest_since = -1.0;
-      else if (rest_since < 0.0) rest_since = world.time;
+      if (!still)
+        rest_since = -1.0;
+      else if (rest_since < 0.0)
+        rest_since = world.time;
       if (rest_since >= 0.0 && world.time - rest_since > replay.stop_after_rest) break;
     }
     if (replay.stop_after_slip >= 0.0 && !samples.empty()) {
@@ -368,16 +392,23 @@ Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, c
   tbb::parallel_for(0, options.trials, [&](int i) {
     Rng rng(options.seed, static_cast<std::uint64_t>(i));
     switch (setup.test) {
-      case LabTest::Drop: outcomes[i] = drop_trial(world, setup, options, tracked, result.time_step, rng); break;
-      case LabTest::Roll: outcomes[i] = roll_trial(world, setup, options, tracked, result.time_step, rng); break;
-      case LabTest::Tilt: outcomes[i] = tilt_trial(world, setup, options, tracked, result.time_step, rng); break;
+      case LabTest::Drop:
+        outcomes[i] = drop_trial(world, setup, options, tracked, result.time_step, rng);
+        break;
+      case LabTest::Roll:
+        outcomes[i] = roll_trial(world, setup, options, tracked, result.time_step, rng);
+        break;
+      case LabTest::Tilt:
+        outcomes[i] = tilt_trial(world, setup, options, tracked, result.time_step, rng);
+        break;
     }
     context.report(fmt::format("{} trials", to_string(setup.test)), static_cast<double>(++done) / options.trials);
   });
   result.recording = setup;
   result.recording.trials.clear();
   result.recording.frame_rate_hz = options.frame_rate_hz;
-  if (setup.test == LabTest::Tilt && !setup.tilt_rate_deg_per_s) result.recording.tilt_rate_deg_per_s = options.tilt_rate_deg_per_s;
+  if (setup.test == LabTest::Tilt && !setup.tilt_rate_deg_per_s)
+    result.recording.tilt_rate_deg_per_s = options.tilt_rate_deg_per_s;
   for (int i = 0; i < options.trials; ++i) {
     outcomes[i].trial.id = fmt::format("{:02d}", i + 1);
     const Eigen::Quaterniond& q = outcomes[i].orientation;
@@ -385,9 +416,11 @@ Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, c
     outcomes[i].trial.release_orientation = q;  // a simulation knows its release exactly
     outcomes[i].trial.extra_json =
         setup.test == LabTest::Drop
-            ? fmt::format("{{\"apparent_restitution\": {:.6f}, \"rotation_share_after_impact\": {:.6f}, \"impact_energy_to_rotation\": {:.6f}, "
-                          "\"contacts_at_impact\": {}}}",
-                          d.apparent_restitution, d.rotation_share, d.rotation_of_impact, d.first_contacts)
+            ? fmt::format(
+                  "{{\"apparent_restitution\": {:.6f}, \"rotation_share_after_impact\": {:.6f}, "
+                  "\"impact_energy_to_rotation\": {:.6f}, "
+                  "\"contacts_at_impact\": {}}}",
+                  d.apparent_restitution, d.rotation_share, d.rotation_of_impact, d.first_contacts)
             : std::string("{}");
     result.impacts.push_back(d);
     result.orientations.push_back(q);

@@ -49,7 +49,8 @@ std::vector<Setup> setups(const ConcealOptions& o) {
 }
 
 Eigen::Quaterniond trial_orientation(LabTest test, Rng& rng) {
-  if (test == LabTest::Tilt) return Eigen::Quaterniond(Eigen::AngleAxisd(rng.uniform(0.0, 2.0 * std::numbers::pi), Eigen::Vector3d::UnitZ()));
+  if (test == LabTest::Tilt)
+    return Eigen::Quaterniond(Eigen::AngleAxisd(rng.uniform(0.0, 2.0 * std::numbers::pi), Eigen::Vector3d::UnitZ()));
   Eigen::Quaterniond q(rng.normal(), rng.normal(), rng.normal(), rng.normal());
   return q.normalized();
 }
@@ -59,7 +60,9 @@ ReplayOptions replay_options(const Recording& r) {
   ReplayOptions o;
   o.sample_interval = 1e-4;
   switch (r.test) {
-    case LabTest::Drop: o.duration = std::sqrt(2.0 * r.release_height / 9.81) * 2.8 + 0.1; break;
+    case LabTest::Drop:
+      o.duration = std::sqrt(2.0 * r.release_height / 9.81) * 2.8 + 0.1;
+      break;
     case LabTest::Roll:
       o.duration = 3.0;
       o.stop_after_rest = 0.15;
@@ -73,16 +76,21 @@ ReplayOptions replay_options(const Recording& r) {
 }
 
 // The camera's window [start, end] in replay time.
-std::pair<double, double> camera_window(const std::vector<ReplaySample>& replay, LabTest test, Rng& rng) {
-  const double pre = rng.uniform(0.005, 0.03);
+std::pair<double, double> camera_window(const std::vector<ReplaySample>& replay, LabTest test, bool pre_roll,
+                                        Rng& rng) {
+  // With pre-roll the camera runs before the release; without, it starts after it.
+  const double pre = pre_roll ? rng.uniform(0.005, 0.03) : -rng.uniform(0.002, 0.02);
   switch (test) {
     case LabTest::Drop: {
       // Until 40 ms after the second landing.
       int phase = 0;
       for (const auto& s : replay) {
-        if (phase == 0 && s.contacts > 0) phase = 1;
-        else if (phase == 1 && s.contacts == 0) phase = 2;
-        else if (phase == 2 && s.contacts > 0) return {-pre, std::min(replay.back().t, s.t + 0.04)};
+        if (phase == 0 && s.contacts > 0)
+          phase = 1;
+        else if (phase == 1 && s.contacts == 0)
+          phase = 2;
+        else if (phase == 2 && s.contacts > 0)
+          return {-pre, std::min(replay.back().t, s.t + 0.04)};
       }
       return {-pre, replay.back().t};
     }
@@ -116,7 +124,7 @@ std::pair<double, double> camera_window(const std::vector<ReplaySample>& replay,
 }
 
 Track film(const std::vector<ReplaySample>& replay, LabTest test, const ConcealOptions& o, Rng& rng) {
-  const auto [start, end] = camera_window(replay, test, rng);
+  const auto [start, end] = camera_window(replay, test, o.pre_roll, rng);
   const double origin = rng.uniform(0.0, 100.0);
   const double x_origin = test == LabTest::Roll ? 0.0 : rng.uniform(-0.01, 0.01);
   const double interval = 1.0 / o.frame_rate_hz;
@@ -142,14 +150,30 @@ Track film(const std::vector<ReplaySample>& replay, LabTest test, const ConcealO
   return track;
 }
 
+// What the lab writes down of a release orientation `q`.
+std::optional<Eigen::Quaterniond> recorded_orientation(const Eigen::Quaterniond& q, const ConcealOptions& o, Rng& rng) {
+  switch (o.orientation) {
+    case OrientationRecord::None:
+      return std::nullopt;
+    case OrientationRecord::Exact:
+      return q;
+    case OrientationRecord::Noisy: {
+      // A rotation about a random axis by a Gaussian angle of the given rms.
+      Eigen::Vector3d axis(rng.normal(), rng.normal(), rng.normal());
+      const double angle = rng.normal(0.0, o.orientation_noise_deg * std::numbers::pi / 180.0);
+      return (Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())) * q).normalized();
+    }
+  }
+  return std::nullopt;
+}
 
 struct Generated {
   std::vector<std::vector<ReplaySample>> replays;  // per trial
   std::vector<double> summaries;
 };
 
-Result<Generated> run_setup(const Clump& clump, const MaterialTable& table, const Recording& setup, const LabOptions& options,
-                            const std::vector<Eigen::Quaterniond>& orientations, bool keep) {
+Result<Generated> run_setup(const Clump& clump, const MaterialTable& table, const Recording& setup,
+                            const LabOptions& options, const std::vector<Eigen::Quaterniond>& orientations, bool keep) {
   auto lab = make_lab_world(clump, table, setup, options);
   if (!lab) return std::unexpected(lab.error());
   Generated g;
@@ -165,15 +189,25 @@ Result<Generated> run_setup(const Clump& clump, const MaterialTable& table, cons
 }
 
 std::pair<double, double> coefficient_bounds(LabTest test) {
-  return test == LabTest::Drop ? std::pair{0.05, 1.0} : test == LabTest::Roll ? std::pair{0.0, 0.5} : std::pair{0.01, 2.0};
+  return test == LabTest::Drop   ? std::pair{0.05, 1.0}
+         : test == LabTest::Roll ? std::pair{0.0, 0.5}
+                                 : std::pair{0.01, 2.0};
 }
 
 }  // namespace
 
-Result<ConcealResult> make_concealed_recordings(const Clump& clump, const MaterialTable& table, const ConcealOptions& options,
-                                                const RunContext& context) {
-  if (options.trials < 1 || options.trials > 1000) return fail(ErrorCode::InvalidArgument, "trials per recording must be 1 to 1000");
-  if (!(options.noise_m >= 0.0) || !(options.frame_rate_hz > 0.0)) return fail(ErrorCode::InvalidArgument, "noise must be >= 0 and the frame rate positive");
+Result<ConcealResult> make_concealed_recordings(const Clump& clump, const MaterialTable& table,
+                                                const ConcealOptions& options, const RunContext& context) {
+  if (options.trials < 1 || options.trials > 1000)
+    return fail(ErrorCode::InvalidArgument, "trials per recording must be 1 to 1000");
+  if (!(options.noise_m >= 0.0 && options.noise_m <= 0.01) ||
+      !(options.frame_rate_hz > 0.0 && options.frame_rate_hz <= 1e5)) {
+    return fail(ErrorCode::InvalidArgument, "camera noise must lie in [0, 10] mm and the frame rate in (0, 100000] Hz");
+  }
+  if (options.orientation == OrientationRecord::Noisy &&
+      !(options.orientation_noise_deg > 0.0 && options.orientation_noise_deg <= 180.0)) {
+    return fail(ErrorCode::InvalidArgument, "the recorded orientation's noise must lie in (0, 180] deg");
+  }
   const auto library = effect_library();
   ConcealResult result;
   if (options.effect) {
@@ -183,12 +217,14 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
       for (const auto& p : spec.parameters) result.values.push_back(p.realistic);
     }
     if (result.values.size() != spec.parameters.size()) {
-      return fail(ErrorCode::InvalidArgument, fmt::format("{} takes {} parameter(s), not {}", spec.name, spec.parameters.size(), result.values.size()));
+      return fail(ErrorCode::InvalidArgument, fmt::format("{} takes {} parameter(s), not {}", spec.name,
+                                                          spec.parameters.size(), result.values.size()));
     }
     for (std::size_t k = 0; k < result.values.size(); ++k) {
       const auto& p = spec.parameters[k];
       if (!(result.values[k] >= p.lower && result.values[k] <= p.upper)) {
-        return fail(ErrorCode::InvalidArgument, fmt::format("{} = {} is outside [{}, {}]", p.name, result.values[k], p.lower, p.upper));
+        return fail(ErrorCode::InvalidArgument,
+                    fmt::format("{} = {} is outside [{}, {}]", p.name, result.values[k], p.lower, p.upper));
       }
     }
   }
@@ -245,7 +281,8 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
       };
       // A coarse then a fine grid: irregular bodies make the mean rough in the coefficient
       // (a roll's distance jumps when a tumble changes), so root finders stall.
-      double best = coefficient_of(result.truth, coefficient_for(test)), best_error = std::numeric_limits<double>::infinity();
+      double best = coefficient_of(result.truth, coefficient_for(test)),
+             best_error = std::numeric_limits<double>::infinity();
       double centre = best, half = test == LabTest::Roll ? std::max(0.5 * centre, 0.01) : 0.3 * centre;
       for (int level = 0; level < 2; ++level) {
         for (int k = -5; k <= 5; ++k) {
@@ -275,8 +312,7 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
       trial.id = fmt::format("{:02d}", i + 1);
       trial.summary = g->summaries[static_cast<std::size_t>(i)];
       trial.track = film(g->replays[static_cast<std::size_t>(i)], rec.test, options, rng);
-      const Eigen::Quaterniond& q = orientations[r][static_cast<std::size_t>(i)];
-      trial.release_orientation = q;
+      trial.release_orientation = recorded_orientation(orientations[r][static_cast<std::size_t>(i)], options, rng);
       rec.trials.push_back(std::move(trial));
     }
     if (std::find(reference.begin(), reference.end(), r) != reference.end()) {
@@ -300,20 +336,22 @@ std::string answer_json(const ConcealOptions& options, const ConcealResult& resu
   }
   values += "}";
   auto coefficients = [](const Interaction& i) {
-    return fmt::format("{{\"restitution\": {:.9g}, \"static_friction\": {:.9g}, \"rolling_friction\": {:.9g}}}", i.restitution,
-                       i.static_friction, i.rolling_friction);
+    return fmt::format("{{\"restitution\": {:.9g}, \"static_friction\": {:.9g}, \"rolling_friction\": {:.9g}}}",
+                       i.restitution, i.static_friction, i.rolling_friction);
   };
   std::string summaries = "[";
   for (std::size_t k = 0; k < result.summaries.size(); ++k) {
     const auto& s = result.summaries[k];
-    summaries += fmt::format("{}{{\"recording\": \"{}\", \"baseline_mean\": {:.9g}, \"effect_mean\": {:.9g}}}", k ? ", " : "", s.recording,
-                             s.baseline_mean, s.effect_mean);
+    summaries += fmt::format("{}{{\"recording\": \"{}\", \"baseline_mean\": {:.9g}, \"effect_mean\": {:.9g}}}",
+                             k ? ", " : "", s.recording, s.baseline_mean, s.effect_mean);
   }
   summaries += "]";
-  return fmt::format("{{\n  \"format\": \"clumpforge-concealed-answer/1\",\n  \"effect\": \"{}\",\n  \"effect_parameters\": {},\n  \"surface\": \"{}\",\n"
-                     "  \"seed\": {},\n  \"baseline\": {},\n  \"truth\": {},\n  \"summary_means\": {}\n}}\n",
-                     options.effect ? effect_spec(library, *options.effect).name : std::string("none"), values, options.surface, options.seed,
-                     coefficients(result.baseline), coefficients(result.truth), summaries);
+  return fmt::format(
+      "{{\n  \"format\": \"clumpforge-concealed-answer/1\",\n  \"effect\": \"{}\",\n  \"effect_parameters\": {},\n  "
+      "\"surface\": \"{}\",\n"
+      "  \"seed\": {},\n  \"baseline\": {},\n  \"truth\": {},\n  \"summary_means\": {}\n}}\n",
+      options.effect ? effect_spec(library, *options.effect).name : std::string("none"), values, options.surface,
+      options.seed, coefficients(result.baseline), coefficients(result.truth), summaries);
 }
 
 }  // namespace clumpforge

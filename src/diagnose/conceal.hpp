@@ -12,47 +12,64 @@
 #include "core/clump.hpp"
 #include "core/recording.hpp"
 #include "core/run_context.hpp"
-#include "diagnose/effects.hpp"
 #include "dem/lab.hpp"
+#include "diagnose/effects.hpp"
 
 namespace clumpforge {
 
+/// The generator's DEM: 100 steps per Hertz contact, finer than the diagnosis's.
+inline LabOptions generator_lab_options() {
+  LabOptions lab = diagnosis_lab_options();
+  lab.steps_per_contact = 100;
+  return lab;
+}
+
+/// What the recordings say about each trial's release orientation: nothing (what labs
+/// write down), the true one with Gaussian noise of a given angle (a lab that notes it by
+/// eye), or the exact one (only a simulation knows it).
+enum class OrientationRecord { None, Noisy, Exact };
+
 struct ConcealOptions {
-  std::optional<Effect> effect;        ///< none: an effect-free control
-  std::vector<double> values;          ///< the effect's parameters (empty: its realistic magnitude)
+  std::optional<Effect> effect;  ///< none: an effect-free control
+  std::vector<double> values;    ///< the effect's parameters (empty: its realistic magnitude)
   std::string surface = "Q235";
-  std::optional<Interaction> base;     ///< the baseline coefficients (default: the table's)
-  int trials = 8;                      ///< per recording
-  std::vector<double> drop_heights{0.2, 0.5, 1.0};   ///< [m]; the first is the study's
-  std::vector<double> roll_starts{0.035, 0.10};      ///< [m]; the first is the study's
+  std::optional<Interaction> base;                  ///< the baseline coefficients (default: the table's)
+  int trials = 8;                                   ///< per recording
+  std::vector<double> drop_heights{0.2, 0.5, 1.0};  ///< [m]; the first is the study's
+  std::vector<double> roll_starts{0.035, 0.10};     ///< [m]; the first is the study's
   bool tilt = true;
   double incline_deg = 30.0, tilt_rate_deg_per_s = 5.0;
-  double noise_m = 1e-4;               ///< camera noise, per coordinate
-  double frame_rate_hz = 1000.0;
+  double noise_m = 1e-4;          ///< camera noise, per coordinate
+  double frame_rate_hz = 1000.0;  ///< (0, 1e5]; labs use 240 to 5000
+  OrientationRecord orientation = OrientationRecord::None;
+  double orientation_noise_deg = 15.0;    ///< Noisy: the recorded orientation's error (rms angle)
+  bool pre_roll = true;                   ///< the camera starts 5-30 ms before the release (false: 2-20 ms after it)
   double drop_frame_probability = 0.01;   ///< single frames lost
   double gap_probability = 0.3;           ///< a run of 3-15 lost frames, per track
   double empty_cell_probability = 0.005;  ///< a lost x or z cell
-  bool conceal = true;                 ///< retune the base coefficients to hide the effect in the summaries
+  bool conceal = true;                    ///< retune the base coefficients to hide the effect in the summaries
   std::uint64_t seed = 1;
-  LabOptions lab = diagnosis_lab_options();  ///< contact settings, particle material, steps per contact
+  /// Contact settings, particle material, steps per contact: finer than the diagnosis's
+  /// (100 against its 25, 50 in drops), so that no recording shares the diagnoser's time step.
+  LabOptions lab = generator_lab_options();
 };
 
 struct SummaryMatch {
-  std::string recording;               ///< e.g. "drop-0.2m"
+  std::string recording;                          ///< e.g. "drop-0.2m"
   double baseline_mean = 0.0, effect_mean = 0.0;  ///< SI (deg for tilt)
 };
 
 struct ConcealResult {
-  std::vector<Recording> recordings;   ///< with tracks and summaries; trials carry "orientation_wxyz"
-  std::vector<std::string> names;      ///< a directory name per recording
-  Interaction baseline;                ///< coefficients of the effect-free model
-  Interaction truth;                   ///< coefficients used with the effect (after concealment)
-  std::vector<double> values;          ///< the effect's parameters used
-  std::vector<SummaryMatch> summaries; ///< study set-ups: baseline vs concealed effect
+  std::vector<Recording> recordings;    ///< with tracks and summaries; release orientations as `orientation` says
+  std::vector<std::string> names;       ///< a directory name per recording
+  Interaction baseline;                 ///< coefficients of the effect-free model
+  Interaction truth;                    ///< coefficients used with the effect (after concealment)
+  std::vector<double> values;           ///< the effect's parameters used
+  std::vector<SummaryMatch> summaries;  ///< study set-ups: baseline vs concealed effect
 };
 
-Result<ConcealResult> make_concealed_recordings(const Clump& clump, const MaterialTable& table, const ConcealOptions& options,
-                                                const RunContext& context = {});
+Result<ConcealResult> make_concealed_recordings(const Clump& clump, const MaterialTable& table,
+                                                const ConcealOptions& options, const RunContext& context = {});
 
 /// The answer as JSON, for the scorer only.
 std::string answer_json(const ConcealOptions& options, const ConcealResult& result);

@@ -22,32 +22,36 @@
 #include "core/clump.hpp"
 #include "core/recording.hpp"
 #include "core/run_context.hpp"
-#include "diagnose/effects.hpp"
 #include "dem/lab.hpp"
+#include "diagnose/effects.hpp"
 
 namespace clumpforge {
 
 struct DiagnoseOptions {
   LabOptions lab = diagnosis_lab_options();  ///< contact settings, particle material, time step
-  std::vector<Effect> effects;     ///< candidates (empty: the whole library)
-  double min_delta_bic = 10.0;     ///< margin over the baseline and over the next best
-  int max_evaluations = 45;        ///< fit budget per candidate: Levenberg-Marquardt iterations are a fifth of it
+  std::vector<Effect> effects;               ///< candidates (empty: the whole library)
+  double min_delta_bic = 10.0;               ///< margin over the baseline and over the next best
+  int max_evaluations = 45;            ///< fit budget per candidate: Levenberg-Marquardt iterations are a fifth of it
   double horizon_perturbation = 1e-4;  ///< [rad] release-orientation perturbation for the predictability horizon
-  int release_orientations = 12;   ///< drawn from each release prior to find how long the trials stay predictable, >= 2
+  int release_orientations = 12;  ///< drawn from each release prior to find how long the trials stay predictable, >= 2
   double orientation_prior_deg = 15.0;  ///< uncertainty of a recorded release orientation [deg], (0, 180]
+  /// [m] how closely any clump and contact law can follow a real particle's tracked point,
+  /// [0, 0.01]: residuals are weighed against hypot(camera noise, this). 0 trusts the model
+  /// as much as the camera (data made by the diagnoser's own model).
+  double model_accuracy_m = 3e-4;
   std::uint64_t seed = 1;
 };
 
 struct PhaseReport {
-  std::string recording;   ///< recording name
+  std::string recording;  ///< recording name
   std::string phase;
-  int values = 0;          ///< residual cells (x and z)
+  int values = 0;  ///< residual cells (x and z)
   double chi2_per_value = 0.0;
-  double p_value = 1.0;    ///< chi^2 against the noise level (Wilson-Hilferty)
-  bool significant = false;  ///< p below 0.001 / (number of groups) and chi^2/value above 1.1
-  double bias_x_mm = 0.0, bias_z_mm = 0.0;   ///< mean residual, recorded - model
-  int growth_power = 0;    ///< residual grows like t^k within the phase (0: no trend)
-  double end_residual_mm = 0.0;  ///< the fitted growth law at the phase's typical end (z, or x when larger)
+  double p_value = 1.0;                     ///< chi^2 against the noise level (Wilson-Hilferty)
+  bool significant = false;                 ///< p below 0.001 / (number of groups) and chi^2/value above 1.1
+  double bias_x_mm = 0.0, bias_z_mm = 0.0;  ///< mean residual, recorded - model
+  int growth_power = 0;                     ///< residual grows like t^k within the phase (0: no trend)
+  double end_residual_mm = 0.0;             ///< the fitted growth law at the phase's typical end (z, or x when larger)
   std::string axis = "z";
   std::string statement;
   double improved_chi2_per_value = 0.0;  ///< under the improved model (= baseline when none)
@@ -62,16 +66,22 @@ struct HypothesisReport {
   std::string name;
   std::vector<ParameterValue> values;
   std::vector<SurfaceParameters> base;
-  int values_used = 0;                 ///< training residual cells in its tests
-  double delta_chi2 = 0.0;             ///< training: baseline - hypothesis
-  double delta_bic = 0.0;              ///< delta_chi2 - k ln n
-  double heldout_delta_chi2 = 0.0;     ///< held-out trials: baseline - hypothesis
-  double all_trials_delta_bic = NAN;   ///< every trial: against the coefficients refitted on every trial (set for candidates passing the rest)
-  bool plausible = false, improves_heldout = false, clears_signature = false, beats_refitted_null = false, passes = false;
+  int values_used = 0;              ///< training residual cells in its tests
+  double delta_chi2 = 0.0;          ///< training: baseline - hypothesis
+  double delta_bic = 0.0;           ///< delta_chi2 - k ln n
+  double heldout_delta_chi2 = 0.0;  ///< held-out trials: baseline - hypothesis
+  double all_trials_delta_bic =
+      NAN;  ///< every trial: against the coefficients refitted on every trial (set for candidates passing the rest)
+  bool plausible = false, improves_heldout = false, clears_signature = false, beats_refitted_null = false,
+       passes = false;
+  /// It at least halves a flagged phase's misfit of three times hypot(noise, model accuracy)
+  /// RMS or more: a misfit no particle model's inaccuracy explains.
+  bool clears_large_misfit = false;
   double flagged_excess_before = 0.0, flagged_excess_after = 0.0;  ///< chi^2 - values in the baseline's flagged phases
-  std::vector<std::string> worsened_phases;  ///< flagged phases it makes worse (training trials), with chi^2 per value before -> after
+  std::vector<std::string>
+      worsened_phases;  ///< flagged phases it makes worse (training trials), with chi^2 per value before -> after
   int evaluations = 0;
-  double smallest_detectable = 0.0;    ///< of its first parameter (reported with verdict "none")
+  double smallest_detectable = 0.0;  ///< of its first parameter (reported with verdict "none")
 };
 
 struct FitQuality {
@@ -83,17 +93,17 @@ struct FitQuality {
 /// What the plots need: per recording, its first trial's track against both models.
 struct TrackComparison {
   std::string recording;
-  std::vector<double> t, x, z;                   ///< recorded (replay time, horizontal origin removed)
+  std::vector<double> t, x, z;  ///< recorded (replay time, horizontal origin removed)
   std::vector<double> baseline_t, baseline_x, baseline_z;
   std::vector<double> improved_t, improved_x, improved_z;
   double horizon = 0.0;
 };
 
 struct DiagnoseResult {
-  std::string verdict;                 ///< "none", "ambiguous", "unexplained", "undecidable" or the effect's name
-  std::string statement;               ///< one paragraph for a person
-  std::vector<std::string> candidates; ///< ambiguous: the effects it could be
-  std::string experiment;              ///< what would separate them / reveal more
+  std::string verdict;                  ///< "none", "ambiguous", "unexplained", "undecidable" or the effect's name
+  std::string statement;                ///< one paragraph for a person
+  std::vector<std::string> candidates;  ///< ambiguous: the effects it could be
+  std::string experiment;               ///< what would separate them / reveal more
   std::vector<ParameterValue> effect_parameters;
   std::vector<std::pair<std::string, double>> noise_m;  ///< per recording, estimated
   std::vector<SurfaceParameters> baseline, improved;
@@ -104,7 +114,7 @@ struct DiagnoseResult {
   std::vector<std::string> unexplained;  ///< phases a smooth discrepancy explains and no effect does
   std::vector<TrackComparison> tracks;
   std::vector<std::string> notes;
-  bool summaries_only = false;         ///< no tracks: what summaries can and cannot decide (in `decidable`, `undecidable`)
+  bool summaries_only = false;  ///< no tracks: what summaries can and cannot decide (in `decidable`, `undecidable`)
   std::vector<std::string> decidable, undecidable;
   int tracked_trials = 0, training_trials = 0, evaluations = 0;
   double seconds = 0.0;
@@ -126,13 +136,15 @@ Decision decide(const std::vector<HypothesisReport>& hypotheses, double min_delt
 
 /// Diagnoses `recordings` (names parallel to them) for `clump`. Recordings without tracks
 /// give the summaries-only statement (see diagnose_summaries).
-Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table, const std::vector<Recording>& recordings,
-                                const std::vector<std::string>& names, const DiagnoseOptions& options, const RunContext& context = {});
+Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
+                                const std::vector<Recording>& recordings, const std::vector<std::string>& names,
+                                const DiagnoseOptions& options, const RunContext& context = {});
 
 /// What summaries alone (no tracks) can and cannot decide: a joint calibration of the
 /// means, the restitution gap explained by multi-contact impacts and rotation, and the
 /// effects that need tracks or more set-ups. Verdict "none" with decidable = false notes.
-Result<DiagnoseResult> diagnose_summaries(const Clump& clump, const MaterialTable& table, const std::vector<Recording>& recordings,
+Result<DiagnoseResult> diagnose_summaries(const Clump& clump, const MaterialTable& table,
+                                          const std::vector<Recording>& recordings,
                                           const std::vector<std::string>& names, const DiagnoseOptions& options,
                                           const RunContext& context = {});
 

@@ -13,6 +13,8 @@ LabOptions lab_options_for(const Evaluator& ev, const Model& model, const Record
   }
   if (model.effect) apply_effect(*model.effect, model.values, options);
   if (recording.tilt_rate_deg_per_s) options.tilt_rate_deg_per_s = *recording.tilt_rate_deg_per_s;
+  if (recording.test == LabTest::Drop)
+    options.steps_per_contact = std::max(options.steps_per_contact, ev.drop_steps_per_contact);
   return options;
 }
 
@@ -43,7 +45,8 @@ double replay_summary(const std::vector<ReplaySample>& replay, LabTest test) {
       }
       return apex;
     }
-    case LabTest::Roll: return std::max(0.0, replay.back().x);
+    case LabTest::Roll:
+      return std::max(0.0, replay.back().x);
     case LabTest::Tilt: {
       const double start = replay.front().along_plate;
       for (const auto& s : replay) {
@@ -55,8 +58,8 @@ double replay_summary(const std::vector<ReplaySample>& replay, LabTest test) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model, const std::vector<std::size_t>& which, bool keep_replays,
-                                         bool keep_residuals) {
+Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model, const std::vector<std::size_t>& which,
+                                         bool keep_replays, bool keep_residuals) {
   const auto& recordings = *ev.recordings;
   // One lab world per recording that is needed.
   std::vector<std::optional<LabWorld>> worlds(recordings.size());
@@ -91,8 +94,9 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
       score.alignment = align(track, samples, sigma, tt.origins, ev.shift[which[k]], window, window, tt.cutoff,
                               ev.shift[which[k]] + first_phase_end);
     } else {
-      score.alignment = align(track, samples, sigma, tt.origins, tt.shift_guess, ev.shift_range[which[k]], 5e-4, tt.cutoff,
-                              tt.shift_guess + first_phase_end + (recording.test == LabTest::Drop ? 0.0 : ev.shift_range[which[k]]));
+      score.alignment =
+          align(track, samples, sigma, tt.origins, tt.shift_guess, ev.shift_range[which[k]], 5e-4, tt.cutoff,
+                tt.shift_guess + first_phase_end + (recording.test == LabTest::Drop ? 0.0 : ev.shift_range[which[k]]));
     }
     score.summary = replay_summary(samples, recording.test);
     if (keep_residuals) {
@@ -125,7 +129,7 @@ void set_shift_ranges(Evaluator& ev) {
   ev.shift_range.assign(ev.trials.size(), 0.0);
   for (std::size_t i = 0; i < ev.trials.size(); ++i) {
     const LabTest test = (*ev.recordings)[ev.trials[i].recording].test;
-    ev.shift_range[i] = test == LabTest::Drop ? 0.02 : test == LabTest::Tilt ? 0.02 : 0.3;
+    ev.shift_range[i] = test == LabTest::Roll ? 0.1 : 0.02;  // a roll may creep before it rolls
   }
 }
 

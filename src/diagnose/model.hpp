@@ -8,20 +8,21 @@
 #include "core/clump.hpp"
 #include "core/recording.hpp"
 #include "core/run_context.hpp"
+#include "dem/lab.hpp"
 #include "diagnose/effects.hpp"
 #include "diagnose/tracks.hpp"
-#include "dem/lab.hpp"
 
 namespace clumpforge {
 
 struct TrackedTrial {
   std::size_t recording = 0, trial = 0;  ///< indices into the recordings
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< release orientation replayed (one the prior allows)
-  OriginFit origins;                     ///< camera-frame origins fitted besides the time origin
-  bool training = true;                  ///< false: held out of every fit
-  double shift_guess = 0.0;              ///< [s] from the data alone
-  double duration = 0.0;                 ///< [s] replayed after release
-  double record_from = 0.0;              ///< [s] first replay time the camera saw (tilt)
+  Eigen::Quaterniond orientation =
+      Eigen::Quaterniond::Identity();  ///< release orientation replayed (one the prior allows)
+  OriginFit origins;                   ///< camera-frame origins fitted besides the time origin
+  bool training = true;                ///< false: held out of every fit
+  double shift_guess = 0.0;            ///< [s] from the data alone
+  double duration = 0.0;               ///< [s] replayed after release
+  double record_from = 0.0;            ///< [s] first replay time the camera saw (tilt)
   /// [s] replay time up to which the trajectory is predictable: replays from release
   /// orientations 0.1 mrad apart stay within the noise level until then. An irregular
   /// body's later bounces and tumbles depend on its release state beyond what any lab
@@ -31,20 +32,21 @@ struct TrackedTrial {
   /// agree (see release_horizon); the horizon is never later.
   double release_horizon = std::numeric_limits<double>::infinity();
   double cutoff = std::numeric_limits<double>::infinity();  ///< the horizon in the track's own time [s]
-  double early_cutoff = std::numeric_limits<double>::infinity();  ///< the end of the first phase (+ the impact), track time [s]
+  double early_cutoff =
+      std::numeric_limits<double>::infinity();  ///< the end of the first phase (+ the impact), track time [s]
 };
 
 struct Model {
   std::vector<SurfaceParameters> base;  ///< one per surface of the recordings
   std::optional<Effect> effect;
-  std::vector<double> values;           ///< the effect's parameter values
+  std::vector<double> values;  ///< the effect's parameter values
 };
 
 struct TrialScore {
   Alignment alignment;
-  std::vector<ReplaySample> replay;     ///< kept when asked
+  std::vector<ReplaySample> replay;                           ///< kept when asked
   double summary = std::numeric_limits<double>::quiet_NaN();  ///< the replay's summary value (SI, deg for tilt)
-  std::vector<double> residuals;        ///< (recorded - replay) / sigma of every fitted cell, when asked
+  std::vector<double> residuals;  ///< (recorded - replay) / sigma of every fitted cell, when asked
 };
 
 /// The set-up shared by every evaluation of a diagnosis.
@@ -52,20 +54,24 @@ struct Evaluator {
   const Clump* clump = nullptr;
   const MaterialTable* table = nullptr;
   const std::vector<Recording>* recordings = nullptr;
-  std::vector<double> sigma;            ///< per recording [m]
+  std::vector<double> sigma;  ///< per recording [m]
   std::vector<TrackedTrial> trials;
-  LabOptions lab;                       ///< contact settings, time step, particle material
-  double sample_interval = 1e-4;        ///< replay sampling [s]
-  double shift_window = 3e-3;           ///< the time shift is refitted within +-this of its first value [s]
-  std::vector<double> shift;            ///< per trial, fixed by `initialise`
-  std::vector<double> shift_range;      ///< per trial: half range of the first alignment [s]
-  bool full_duration = false;           ///< replay whole tracks, not only up to each trial's horizon (plots, summaries)
+  LabOptions lab;  ///< contact settings, time step, particle material
+  /// Steps per Hertz contact in drops: the rebound is where restitution must come back within
+  /// 1 % (25 steps leave a height-dependent error of that size, 50 do not).
+  int drop_steps_per_contact = 50;
+  double sample_interval = 1e-4;    ///< replay sampling [s]
+  double shift_window = 3e-3;       ///< the time shift is refitted within +-this of its first value [s]
+  std::vector<double> shift;        ///< per trial, fixed by `initialise`
+  std::vector<double> shift_range;  ///< per trial: half range of the first alignment [s]
+  bool full_duration = false;       ///< replay whole tracks, not only up to each trial's horizon (plots, summaries)
 };
 
 /// Replays and scores the trials `which` (indices into evaluator.trials) under `model`,
 /// in parallel; results do not depend on the thread count.
-Result<std::vector<TrialScore>> evaluate(const Evaluator& evaluator, const Model& model, const std::vector<std::size_t>& which,
-                                         bool keep_replays, bool keep_residuals = false);
+Result<std::vector<TrialScore>> evaluate(const Evaluator& evaluator, const Model& model,
+                                         const std::vector<std::size_t>& which, bool keep_replays,
+                                         bool keep_residuals = false);
 
 /// The lab options of `model` for one recording (its surface's coefficients, the effect).
 LabOptions lab_options_for(const Evaluator& evaluator, const Model& model, const Recording& recording);

@@ -8,8 +8,8 @@
 
 namespace clumpforge {
 
-std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count, std::uint64_t seed,
-                                                          std::uint64_t stream) {
+std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count,
+                                                          std::uint64_t seed, std::uint64_t stream) {
   Rng rng(seed, stream);
   std::vector<Eigen::Quaterniond> out;
   out.reserve(static_cast<std::size_t>(std::max(0, count)));

@@ -6,12 +6,11 @@
 /// recording has none, within a stated spread of the recorded one otherwise (never exact).
 /// Replays from orientations the prior allows show how long a trial stays predictable:
 /// only that part of a track is fitted frame by frame.
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <numbers>
 #include <optional>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "core/recording.hpp"
 #include "dem/lab.hpp"
@@ -20,7 +19,7 @@ namespace clumpforge {
 
 /// What is known of one trial's release orientation.
 struct OrientationPrior {
-  std::optional<Eigen::Quaterniond> recorded;  ///< the lab's, when written down (a prior centre)
+  std::optional<Eigen::Quaterniond> recorded;       ///< the lab's, when written down (a prior centre)
   double spread = 15.0 * std::numbers::pi / 180.0;  ///< [rad] how far from `recorded` the release may be, (0, pi]
 };
 
@@ -28,8 +27,8 @@ struct OrientationPrior {
 /// uniform over all rotations (drop, roll) or over headings about the vertical (tilt: the
 /// particle lies as the test places it) when nothing was recorded; uniform within a ball of
 /// rotation angle `spread` about the recorded one otherwise, the recorded one first.
-std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count, std::uint64_t seed,
-                                                          std::uint64_t stream);
+std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count,
+                                                          std::uint64_t seed, std::uint64_t stream);
 
 /// The release horizon of replays from orientations the prior allows [s since release]:
 /// the first sample time at which the tracked points' displacements from their own first

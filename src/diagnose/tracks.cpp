@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
 
 namespace clumpforge {
 
@@ -19,7 +22,8 @@ double estimate_noise(const std::vector<const Track*>& tracks) {
     const double interval = frame_interval(*track);
     for (std::size_t i = 3; i < track->size(); ++i) {
       bool consecutive = true;
-      for (std::size_t k = i - 2; k <= i; ++k) consecutive = consecutive && std::abs(track->t[k] - track->t[k - 1] - interval) < 0.25 * interval;
+      for (std::size_t k = i - 2; k <= i; ++k)
+        consecutive = consecutive && std::abs(track->t[k] - track->t[k - 1] - interval) < 0.25 * interval;
       if (!consecutive) continue;
       for (const auto* column : {&track->x, &track->z}) {
         const auto& c = *column;
@@ -29,7 +33,8 @@ double estimate_noise(const std::vector<const Track*>& tracks) {
     }
   }
   if (differences.size() < 10) return std::numeric_limits<double>::quiet_NaN();
-  std::nth_element(differences.begin(), differences.begin() + static_cast<std::ptrdiff_t>(differences.size() / 2), differences.end());
+  std::nth_element(differences.begin(), differences.begin() + static_cast<std::ptrdiff_t>(differences.size() / 2),
+                   differences.end());
   // For Gaussian noise the median |d| is 0.6745 sd(d), sd(d) = sqrt(20) sigma.
   return differences[differences.size() / 2] / (0.6744897501960817 * std::sqrt(20.0));
 }
@@ -50,8 +55,8 @@ ReplayPoint interpolate(const std::vector<ReplaySample>& replay, double t) {
   return {replay[i].x + f * (replay[i + 1].x - replay[i].x), replay[i].z + f * (replay[i + 1].z - replay[i].z), i};
 }
 
-Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset, double z_offset,
-                   double cutoff) {
+Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift,
+                   double x_offset, double z_offset, double cutoff) {
   Alignment a;
   a.shift = shift;
   a.x_offset = x_offset;
@@ -73,7 +78,8 @@ Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, 
   return a;
 }
 
-Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, OriginFit origins, double cutoff) {
+Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift,
+                OriginFit origins, double cutoff) {
   // Each fitted origin is the mean residual of its axis (least squares).
   double sum_x = 0.0, sum_z = 0.0;
   int count_x = 0, count_z = 0;
@@ -91,11 +97,12 @@ Alignment score(const Track& track, const std::vector<ReplaySample>& replay, dou
       }
     }
   }
-  return score_at(track, replay, sigma, shift, count_x > 0 ? sum_x / count_x : 0.0, count_z > 0 ? sum_z / count_z : 0.0, cutoff);
+  return score_at(track, replay, sigma, shift, count_x > 0 ? sum_x / count_x : 0.0, count_z > 0 ? sum_z / count_z : 0.0,
+                  cutoff);
 }
 
-Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, OriginFit origins, double guess,
-                double half_range, double step, double cutoff, double align_cutoff) {
+Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, OriginFit origins,
+                double guess, double half_range, double step, double cutoff, double align_cutoff) {
   const double fit_cutoff = std::min(cutoff, align_cutoff);
   Alignment best = score(track, replay, sigma, guess, origins, fit_cutoff);
   for (double s = guess - half_range; s <= guess + half_range + 1e-12; s += step) {
@@ -106,7 +113,8 @@ Alignment align(const Track& track, const std::vector<ReplaySample>& replay, dou
   constexpr double kGolden = 0.6180339887498949;
   double lo = best.shift - step, hi = best.shift + step;
   double c = hi - kGolden * (hi - lo), d = lo + kGolden * (hi - lo);
-  Alignment fc = score(track, replay, sigma, c, origins, fit_cutoff), fd = score(track, replay, sigma, d, origins, fit_cutoff);
+  Alignment fc = score(track, replay, sigma, c, origins, fit_cutoff),
+            fd = score(track, replay, sigma, d, origins, fit_cutoff);
   while (hi - lo > 1e-6) {
     if (fc.chi_squared < fd.chi_squared) {
       hi = d;
@@ -129,7 +137,7 @@ Alignment align(const Track& track, const std::vector<ReplaySample>& replay, dou
   return score_at(track, replay, sigma, best.shift, best.x_offset, best.z_offset, cutoff);
 }
 
-double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s) {
+double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s, double incline_deg) {
   if (track.size() == 0) return 0.0;
   if (test == LabTest::Tilt && !track.tilt.empty() && tilt_rate_deg_per_s > 0.0) {
     double sum = 0.0;
@@ -141,18 +149,52 @@ double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s)
     }
     if (count > 0) return sum / count;
   }
-  if (test == LabTest::Drop) {
-    double start = std::numeric_limits<double>::quiet_NaN();
-    for (std::size_t i = 0; i < track.size(); ++i) {
-      if (!std::isfinite(track.z[i])) continue;
-      if (std::isnan(start)) start = track.z[i];
-      if (track.z[i] < start - 2e-3) return track.t[i] - std::sqrt(2.0 * 2e-3 / 9.81);
+  if (test == LabTest::Tilt) return track.t.front();
+  // Drop and roll: a camera often runs long before the release (the particle held still).
+  // The release is where the point has left its resting place by 2 mm for three frames in a
+  // row, less the time a body starting from rest takes to get there (free fall; a roll down
+  // the incline at 5/7 g sin(incline), a rolling sphere's).
+  double x0 = std::numeric_limits<double>::quiet_NaN(), z0 = x0;
+  {
+    std::vector<double> xs, zs;
+    for (std::size_t i = 0; i < track.size() && xs.size() < 5; ++i) {
+      if (!std::isfinite(track.x[i]) || !std::isfinite(track.z[i])) continue;
+      xs.push_back(track.x[i]);
+      zs.push_back(track.z[i]);
+    }
+    if (xs.empty()) return track.t.front();
+    std::sort(xs.begin(), xs.end());
+    std::sort(zs.begin(), zs.end());
+    x0 = xs[xs.size() / 2];
+    z0 = zs[zs.size() / 2];
+  }
+  constexpr double kMoved = 2e-3;
+  const double acceleration =
+      test == LabTest::Drop ? 9.81 : 9.81 * std::sin(incline_deg * std::numbers::pi / 180.0) * 5.0 / 7.0;
+  int run = 0;
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    if (!std::isfinite(track.x[i]) || !std::isfinite(track.z[i])) continue;
+    const double moved = test == LabTest::Drop ? z0 - track.z[i] : std::hypot(track.x[i] - x0, track.z[i] - z0);
+    run = moved > kMoved ? run + 1 : 0;
+    if (run == 1) {
+      // Where the run began, unless it ends here.
+      const double t = track.t[i];
+      std::size_t j = i + 1;
+      int more = 0;
+      for (; j < track.size() && more < 2; ++j) {
+        if (!std::isfinite(track.x[j]) || !std::isfinite(track.z[j])) continue;
+        const double m = test == LabTest::Drop ? z0 - track.z[j] : std::hypot(track.x[j] - x0, track.z[j] - z0);
+        if (m <= kMoved) break;
+        ++more;
+      }
+      if (more == 2) return t - std::sqrt(2.0 * kMoved / acceleration);
     }
   }
   return track.t.front();
 }
 
-std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, double sigma, const Alignment& a) {
+std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, double sigma,
+                                     const Alignment& a) {
   std::vector<FrameResidual> out;
   out.reserve(track.size());
   for (std::size_t i = 0; i < track.size(); ++i) {
@@ -161,8 +203,10 @@ std::vector<FrameResidual> residuals(const Track& track, const std::vector<Repla
     FrameResidual r;
     r.t = t;
     r.sample = p.index;
-    r.rx = std::isfinite(track.x[i]) ? (track.x[i] - p.x - a.x_offset) / sigma : std::numeric_limits<double>::quiet_NaN();
-    r.rz = std::isfinite(track.z[i]) ? (track.z[i] - p.z - a.z_offset) / sigma : std::numeric_limits<double>::quiet_NaN();
+    r.rx =
+        std::isfinite(track.x[i]) ? (track.x[i] - p.x - a.x_offset) / sigma : std::numeric_limits<double>::quiet_NaN();
+    r.rz =
+        std::isfinite(track.z[i]) ? (track.z[i] - p.z - a.z_offset) / sigma : std::numeric_limits<double>::quiet_NaN();
     out.push_back(r);
   }
   return out;

@@ -40,38 +40,40 @@ struct Alignment {
   double x_offset = 0.0;  ///< x_recorded = x_replay + x_offset [m]
   double z_offset = 0.0;  ///< z_recorded = z_replay + z_offset [m]
   double chi_squared = 0.0;
-  int values = 0;         ///< recorded cells used
+  int values = 0;  ///< recorded cells used
 };
 
 /// chi^2 of `track` against `replay` for a given shift (the origins in `origins` fitted), over
 /// the frames recorded up to `cutoff` (recorded time; beyond it the release state cannot
 /// predict the trajectory, see TrackedTrial::horizon). The cutoff does not move with the
 /// shift, so every shift is scored on the same frames.
-Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, OriginFit origins,
-                double cutoff = std::numeric_limits<double>::infinity());
+Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift,
+                OriginFit origins, double cutoff = std::numeric_limits<double>::infinity());
 
 /// chi^2 at a given shift and origin offsets, frames recorded up to `cutoff`.
-Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift, double x_offset, double z_offset,
-                   double cutoff = std::numeric_limits<double>::infinity());
+Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift,
+                   double x_offset, double z_offset, double cutoff = std::numeric_limits<double>::infinity());
 
 /// Best shift in [guess - half_range, guess + half_range]: a grid of `step`, then a golden
 /// section to 1 microsecond around the best grid point. The shift (and x offset) is chosen
 /// on the frames up to `align_cutoff` (recorded time: the first phase, where the release
 /// alone decides the motion); the returned chi^2 covers the frames up to `cutoff`.
-Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, OriginFit origins, double guess,
-                double half_range, double step, double cutoff = std::numeric_limits<double>::infinity(),
+Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, OriginFit origins,
+                double guess, double half_range, double step, double cutoff = std::numeric_limits<double>::infinity(),
                 double align_cutoff = std::numeric_limits<double>::infinity());
 
-/// A first guess of the shift from the data alone: for a drop, the release instant from the
-/// first 2 mm of fall; for a tilt, the plate angle column; otherwise the first frame.
-double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s);
+/// A first guess of the shift from the data alone: for a drop or a roll, the release
+/// instant from the first 2 mm the point moves (held still before it, however long the
+/// camera ran); for a tilt, the plate angle column; otherwise the first frame.
+double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s, double incline_deg = 30.0);
 
 /// One recorded frame against the replay: residuals in units of sigma.
 struct FrameResidual {
-  double t = 0.0;           ///< replay time [s]
+  double t = 0.0;             ///< replay time [s]
   double rx = 0.0, rz = 0.0;  ///< (recorded - replay) / sigma; NaN for an empty cell
-  std::size_t sample = 0;   ///< replay sample index at t
+  std::size_t sample = 0;     ///< replay sample index at t
 };
-std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, double sigma, const Alignment& a);
+std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, double sigma,
+                                     const Alignment& a);
 
 }  // namespace clumpforge

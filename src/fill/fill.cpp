@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <optional>
+
 namespace clumpforge {
 
 namespace {
@@ -42,16 +44,21 @@ Result<FillResult> fill_body(const PreparedBody& body, const FillOptions& option
   if (options.method == FillMethod::Lattice) {
     context.report("lattice fill", 0.0);
     clump.spheres = lattice_spheres(body, options.diameter, options.placement);
-    clump.parameters = {{"diameter_m", options.diameter},
-                        {"placement_offset_m", options.placement == LatticePlacement::CellAtCentroid ? 0.5 * options.diameter : 0.0}};
+    clump.parameters = {
+        {"diameter_m", options.diameter},
+        {"placement_offset_m", options.placement == LatticePlacement::CellAtCentroid ? 0.5 * options.diameter : 0.0}};
   } else {
     auto outcome = adaptive_spheres(body, options, context);
     clump.spheres = std::move(outcome.spheres);
     result.coverage = outcome.coverage;
-    clump.parameters = {{"max_spheres", options.max_spheres},       {"target_error", options.target_error},
-                        {"min_radius_m", options.min_radius},       {"max_protrusion_m", options.max_protrusion},
-                        {"coverage_cells", options.coverage_cells}, {"coverage", outcome.coverage},
-                        {"match_volume", options.match_volume ? 1.0 : 0.0}, {"match_moments", options.match_moments ? 1.0 : 0.0},
+    clump.parameters = {{"max_spheres", options.max_spheres},
+                        {"target_error", options.target_error},
+                        {"min_radius_m", options.min_radius},
+                        {"max_protrusion_m", options.max_protrusion},
+                        {"coverage_cells", options.coverage_cells},
+                        {"coverage", outcome.coverage},
+                        {"match_volume", options.match_volume ? 1.0 : 0.0},
+                        {"match_moments", options.match_moments ? 1.0 : 0.0},
                         {"inflation_m", outcome.inflation}};
   }
   if (context.should_stop()) return fail(ErrorCode::Cancelled, "fill cancelled");
@@ -68,6 +75,30 @@ Result<FillResult> fill_body(const PreparedBody& body, const FillOptions& option
   clump.error = evaluate_clump(body, clump.spheres, options.evaluation);
   context.report("done", 1.0);
   return result;
+}
+
+Result<FillResult> fill_to_surface_accuracy(const PreparedBody& body, FillOptions options, double surface_target,
+                                            int max_spheres, std::vector<std::pair<int, double>>* ladder,
+                                            const RunContext& context) {
+  if (!(surface_target > 0.0) || max_spheres < 1) {
+    return fail(
+        ErrorCode::InvalidArgument,
+        fmt::format("a surface target {} m and a budget of {} spheres cannot be met", surface_target, max_spheres));
+  }
+  options.method = FillMethod::Adaptive;
+  options.target_error = 0.0;
+  std::optional<FillResult> best;
+  for (int n = 1;; n = std::min(2 * n, max_spheres)) {
+    if (context.should_stop()) return fail(ErrorCode::Cancelled, "cancelled");
+    options.max_spheres = n;
+    auto filled = fill_body(body, options, context);
+    if (!filled) return std::unexpected(filled.error());
+    const double rms = filled->clump.error.surface_rms;
+    if (ladder != nullptr) ladder->emplace_back(static_cast<int>(filled->clump.spheres.size()), rms);
+    if (!best || rms < best->clump.error.surface_rms) best = std::move(*filled);
+    if (rms <= surface_target || n >= max_spheres) break;
+  }
+  return std::move(*best);
 }
 
 }  // namespace clumpforge

@@ -3,8 +3,8 @@
 /// variable-radius method.
 #include <cstdint>
 
-#include "fill/body.hpp"
 #include "core/clump.hpp"
+#include "fill/body.hpp"
 #include "fill/evaluate.hpp"
 
 namespace clumpforge {
@@ -42,9 +42,9 @@ struct FillOptions {
 };
 
 struct FillResult {
-  Clump clump;                      ///< spheres, corrected properties, error report
-  double voxel_size = 0.0;          ///< [m] of the signed distance field used
-  double coverage = 0.0;            ///< adaptive: covered fraction of the coverage grid
+  Clump clump;              ///< spheres, corrected properties, error report
+  double voxel_size = 0.0;  ///< [m] of the signed distance field used
+  double coverage = 0.0;    ///< adaptive: covered fraction of the coverage grid
   std::vector<Diagnostic> notes;
 };
 
@@ -52,6 +52,15 @@ struct FillResult {
 /// options (non-positive diameter, a diameter larger than the body, a zero budget) or when
 /// no sphere fits.
 Result<FillResult> fill_body(const PreparedBody& body, const FillOptions& options, const RunContext& context = {});
+
+/// An adaptive clump whose resolution is chosen by convergence to the scan, not by a fixed
+/// budget: fills with 1, 2, 4, ... up to `max_spheres` spheres (the rest of `options` as
+/// given) and keeps the first whose surface RMS distance to the mesh is at most
+/// `surface_target` [m], else the one closest to it. A sphere needs one sphere; an irregular
+/// body many. `ladder` (when given) receives each tried count and its surface RMS [m].
+Result<FillResult> fill_to_surface_accuracy(const PreparedBody& body, FillOptions options, double surface_target,
+                                            int max_spheres, std::vector<std::pair<int, double>>* ladder = nullptr,
+                                            const RunContext& context = {});
 
 /// The lattice nodes of pitch `diameter` whose centres lie inside the body (the study's
 /// automatic filling, as EDEM does it), on the body's principal axes.

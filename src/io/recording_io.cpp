@@ -41,17 +41,20 @@ class ManifestReader {
     return bounded(object, key, where, 0.0, std::numeric_limits<double>::max(), "");
   }
   /// A number in (low, high] (or [low, high] with `closed_low`); `unit` names the limit's unit.
-  double bounded(const json& object, const char* key, const std::string& where, double low, double high, std::string_view unit,
-                 bool closed_low = false) const {
+  double bounded(const json& object, const char* key, const std::string& where, double low, double high,
+                 std::string_view unit, bool closed_low = false) const {
     if (!object.contains(key)) error(where, fmt::format("'{}' is missing its '{}'", where, key));
     const auto& value = object.at(key);
     if (!value.is_number()) error(key, fmt::format("'{}' must be a number", key));
     const double v = value.get<double>();
     if (!std::isfinite(v) || !(closed_low ? v >= low : v > low)) {
       if (low == 0.0 && !closed_low) error(key, fmt::format("'{}' must be positive, not {}", key, v));
-      error(key, fmt::format("'{}' is {}: it must lie in {}{}, {}] {}", key, v, closed_low ? "[" : "(", low, high, unit));
+      error(key,
+            fmt::format("'{}' is {}: it must lie in {}{}, {}] {}", key, v, closed_low ? "[" : "(", low, high, unit));
     }
-    if (v > high) error(key, fmt::format("'{}' is {}: it must lie in {}{}, {}] {} (no experiment exceeds that)", key, v, closed_low ? "[" : "(", low, high, unit));
+    if (v > high)
+      error(key, fmt::format("'{}' is {}: it must lie in {}{}, {}] {} (no experiment exceeds that)", key, v,
+                             closed_low ? "[" : "(", low, high, unit));
     return v;
   }
   std::string string(const json& object, const char* key) const {
@@ -98,18 +101,25 @@ Result<fs::path> track_path(const fs::path& dir, const std::string& name) {
   const fs::path relative(name);
   if (name.empty()) return fail(ErrorCode::InvalidArgument, "the track path is empty");
   if (relative.is_absolute() || relative.has_root_name() || relative.has_root_directory()) {
-    return fail(ErrorCode::InvalidArgument, fmt::format("the track path '{}' is absolute; it must name a file inside the recording's folder", name));
+    return fail(
+        ErrorCode::InvalidArgument,
+        fmt::format("the track path '{}' is absolute; it must name a file inside the recording's folder", name));
   }
   for (const auto& part : relative) {
-    if (part == "..") return fail(ErrorCode::InvalidArgument, fmt::format("the track path '{}' leaves the recording's folder ('..')", name));
+    if (part == "..")
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("the track path '{}' leaves the recording's folder ('..')", name));
   }
   std::error_code ec;
   const fs::path folder = fs::weakly_canonical(fs::absolute(dir, ec), ec);
   const fs::path resolved = fs::weakly_canonical(fs::absolute(dir / relative, ec), ec);
-  if (ec) return fail(ErrorCode::InvalidArgument, fmt::format("the track path '{}' cannot be resolved: {}", name, ec.message()));
+  if (ec)
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("the track path '{}' cannot be resolved: {}", name, ec.message()));
   auto [end, at] = std::mismatch(folder.begin(), folder.end(), resolved.begin(), resolved.end());
   if (end != folder.end()) {
-    return fail(ErrorCode::InvalidArgument, fmt::format("the track path '{}' leads out of the recording's folder (through a link)", name));
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("the track path '{}' leads out of the recording's folder (through a link)", name));
   }
   return dir / relative;
 }
@@ -144,11 +154,16 @@ Result<Track> read_track(const fs::path& path) {
   std::vector<std::vector<double>*> targets;
   bool has_t = false, has_x = false, has_z = false;
   for (const auto& c : columns) {
-    if (c == "t_s") targets.push_back(&track.t), has_t = true;
-    else if (c == "x_m") targets.push_back(&track.x), has_x = true;
-    else if (c == "z_m") targets.push_back(&track.z), has_z = true;
-    else if (c == "angle_rad") targets.push_back(&track.angle);
-    else if (c == "tilt_deg") targets.push_back(&track.tilt);
+    if (c == "t_s")
+      targets.push_back(&track.t), has_t = true;
+    else if (c == "x_m")
+      targets.push_back(&track.x), has_x = true;
+    else if (c == "z_m")
+      targets.push_back(&track.z), has_z = true;
+    else if (c == "angle_rad")
+      targets.push_back(&track.angle);
+    else if (c == "tilt_deg")
+      targets.push_back(&track.tilt);
     else {
       return fail(ErrorCode::ParseError,
                   fmt::format("{}:1: unknown column '{}'{} (t_s, x_m, z_m, angle_rad, tilt_deg)", path.string(), c,
@@ -179,22 +194,23 @@ Result<Track> read_track(const fs::path& path) {
         const char* end = begin + cells[k].size();
         auto [ptr, ec] = std::from_chars(begin, end, value);
         if (ec != std::errc{} || ptr != end || !std::isfinite(value)) {
-          return fail(ErrorCode::ParseError, fmt::format("{}:{}: '{}' in column {} is not a number", path.string(), number,
-                                                         cells[k], columns[k]));
+          return fail(ErrorCode::ParseError, fmt::format("{}:{}: '{}' in column {} is not a number", path.string(),
+                                                         number, cells[k], columns[k]));
         }
       } else if (columns[k] == "t_s") {
         return fail(ErrorCode::ParseError, fmt::format("{}:{}: the time cell is empty", path.string(), number));
       }
       if (const double limit = column_limit(columns[k]); std::abs(value) > limit) {
-        return fail(ErrorCode::ParseError, fmt::format("{}:{}: {:g} in column {} is beyond the limit of +-{:g} {}", path.string(), number,
-                                                       value, columns[k], limit, column_unit(columns[k])));
+        return fail(ErrorCode::ParseError,
+                    fmt::format("{}:{}: {:g} in column {} is beyond the limit of +-{:g} {}", path.string(), number,
+                                value, columns[k], limit, column_unit(columns[k])));
       }
       targets[k]->push_back(value);
     }
     const auto& t = track.t;
     if (t.size() >= 2 && !(t.back() > t[t.size() - 2])) {
-      return fail(ErrorCode::ParseError, fmt::format("{}:{}: time {} does not increase (previous {})", path.string(), number,
-                                                     t.back(), t[t.size() - 2]));
+      return fail(ErrorCode::ParseError, fmt::format("{}:{}: time {} does not increase (previous {})", path.string(),
+                                                     number, t.back(), t[t.size() - 2]));
     }
   }
   if (track.t.empty()) return fail(ErrorCode::ParseError, fmt::format("{}: the track has no rows", path.string()));
@@ -208,42 +224,58 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
     reader.error("format", fmt::format("format '{}' is not \"recording/1\"", manifest["format"].get<std::string>()));
   }
   const std::string test = reader.string(manifest, "test");
-  if (test == "drop") r.test = LabTest::Drop;
-  else if (test == "roll") r.test = LabTest::Roll;
-  else if (test == "tilt") r.test = LabTest::Tilt;
-  else reader.error("test", fmt::format("unknown test '{}'{} (drop, roll or tilt)", test, did_you_mean(test, {"drop", "roll", "tilt"})));
+  if (test == "drop")
+    r.test = LabTest::Drop;
+  else if (test == "roll")
+    r.test = LabTest::Roll;
+  else if (test == "tilt")
+    r.test = LabTest::Tilt;
+  else
+    reader.error("test", fmt::format("unknown test '{}'{} (drop, roll or tilt)", test,
+                                     did_you_mean(test, {"drop", "roll", "tilt"})));
   r.surface = reader.string(manifest, "surface");
-  if (!manifest.contains("setup") || !manifest["setup"].is_object()) reader.error("setup", "the manifest has no 'setup' object");
+  if (!manifest.contains("setup") || !manifest["setup"].is_object())
+    reader.error("setup", "the manifest has no 'setup' object");
   const json& setup = manifest["setup"];
   using L = RecordingLimits;
-  if (r.test == LabTest::Drop) r.release_height = reader.bounded(setup, "release_height_m", "setup", 0.0, L::max_release_height, "m");
+  if (r.test == LabTest::Drop)
+    r.release_height = reader.bounded(setup, "release_height_m", "setup", 0.0, L::max_release_height, "m");
   if (r.test == LabTest::Roll) {
     r.incline_deg = reader.positive(setup, "incline_deg", "setup");
     if (r.incline_deg >= 90.0) reader.error("incline_deg", "'incline_deg' must be below 90");
     r.start_distance = reader.bounded(setup, "start_distance_m", "setup", 0.0, L::max_start_distance, "m");
   }
   if (r.test == LabTest::Tilt) {
-    if (setup.contains("tilt_rate_deg_per_s")) r.tilt_rate_deg_per_s = reader.bounded(setup, "tilt_rate_deg_per_s", "setup", 0.0, L::max_tilt_rate, "deg/s");
+    if (setup.contains("tilt_rate_deg_per_s"))
+      r.tilt_rate_deg_per_s = reader.bounded(setup, "tilt_rate_deg_per_s", "setup", 0.0, L::max_tilt_rate, "deg/s");
     if (setup.contains("composite")) {
       const std::string composite = setup["composite"].is_string() ? setup["composite"].get<std::string>() : "";
-      if (composite == "single") r.composite = Composite::Single;
-      else if (composite == "four-square") r.composite = Composite::FourSquare;
-      else reader.error("composite", fmt::format("composite '{}' is not \"single\" or \"four-square\"", composite));
+      if (composite == "single")
+        r.composite = Composite::Single;
+      else if (composite == "four-square")
+        r.composite = Composite::FourSquare;
+      else
+        reader.error("composite", fmt::format("composite '{}' is not \"single\" or \"four-square\"", composite));
     }
   }
   for (const char* key : {"particle", "camera"}) {
-    if (manifest.contains(key) && !manifest[key].is_object()) reader.error(key, fmt::format("'{}' must be an object", key));
+    if (manifest.contains(key) && !manifest[key].is_object())
+      reader.error(key, fmt::format("'{}' must be an object", key));
   }
   if (manifest.contains("particle")) {
     const json& p = manifest["particle"];
     if (p.contains("mesh")) r.particle_mesh = reader.string(p, "mesh");
     if (p.contains("mesh_units")) r.particle_mesh_units = reader.string(p, "mesh_units");
-    if (p.contains("density_kg_m3")) r.particle_density = reader.bounded(p, "density_kg_m3", "particle", L::min_density, L::max_density, "kg/m^3", true);
+    if (p.contains("density_kg_m3"))
+      r.particle_density =
+          reader.bounded(p, "density_kg_m3", "particle", L::min_density, L::max_density, "kg/m^3", true);
   }
   if (manifest.contains("camera")) {
     const json& c = manifest["camera"];
-    if (c.contains("frame_rate_hz")) r.frame_rate_hz = reader.bounded(c, "frame_rate_hz", "camera", 0.0, L::max_frame_rate, "Hz");
-    if (c.contains("position_noise_m")) r.position_noise_m = reader.bounded(c, "position_noise_m", "camera", 0.0, L::max_noise, "m");
+    if (c.contains("frame_rate_hz"))
+      r.frame_rate_hz = reader.bounded(c, "frame_rate_hz", "camera", 0.0, L::max_frame_rate, "Hz");
+    if (c.contains("position_noise_m"))
+      r.position_noise_m = reader.bounded(c, "position_noise_m", "camera", 0.0, L::max_noise, "m");
   }
   if (!manifest.contains("trials") || !manifest["trials"].is_array() || manifest["trials"].empty()) {
     reader.error("trials", "the manifest needs a non-empty 'trials' list");
@@ -258,7 +290,9 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
     if (entry.contains("summary")) {
       const json& summary = entry["summary"];
       if (!summary.is_object() || !summary.contains(key) || !summary[key].is_number()) {
-        reader.error("summary", fmt::format("trial '{}': the summary of a {} test is {{\"{}\": number}}", trial.id, test, key), search_from);
+        reader.error("summary",
+                     fmt::format("trial '{}': the summary of a {} test is {{\"{}\": number}}", trial.id, test, key),
+                     search_from);
       }
       const double v = summary[key].get<double>();
       if (!std::isfinite(v) || (r.test != LabTest::Tilt && v < 0.0)) {
@@ -267,7 +301,8 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
       trial.summary = v;
     }
     if (entry.contains("track")) {
-      if (!entry["track"].is_string()) reader.error("track", fmt::format("trial '{}': 'track' must be a file name", trial.id), search_from);
+      if (!entry["track"].is_string())
+        reader.error("track", fmt::format("trial '{}': 'track' must be a file name", trial.id), search_from);
       trial.track_file = entry["track"].get<std::string>();
       auto path = track_path(dir, trial.track_file);
       if (!path) reader.error("track", fmt::format("trial '{}': {}", trial.id, path.error().message), search_from);
@@ -278,11 +313,15 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
     if (entry.contains("orientation_wxyz")) {
       trial.release_orientation = parse_orientation(entry["orientation_wxyz"]);
       if (!trial.release_orientation) {
-        reader.error("orientation_wxyz", fmt::format("trial '{}': 'orientation_wxyz' must be a unit quaternion [w, x, y, z] of four numbers", trial.id),
-                     search_from);
+        reader.error(
+            "orientation_wxyz",
+            fmt::format("trial '{}': 'orientation_wxyz' must be a unit quaternion [w, x, y, z] of four numbers",
+                        trial.id),
+            search_from);
       }
     }
-    if (!trial.summary && !trial.track) reader.error("id", fmt::format("trial '{}' has neither a summary nor a track", trial.id), search_from);
+    if (!trial.summary && !trial.track)
+      reader.error("id", fmt::format("trial '{}' has neither a summary nor a track", trial.id), search_from);
     trial.extra_json = extras(entry, {"id", "summary", "track", "orientation_wxyz"});
     r.trials.push_back(std::move(trial));
   }
@@ -318,7 +357,9 @@ Result<Recording> read_recording(const fs::path& path) {
   try {
     manifest = json::parse(text);
   } catch (const json::parse_error& e) {
-    const std::size_t line = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<long>(std::min<std::size_t>(e.byte, text.size())), '\n'));
+    const std::size_t line =
+        1 + static_cast<std::size_t>(std::count(
+                text.begin(), text.begin() + static_cast<long>(std::min<std::size_t>(e.byte, text.size())), '\n'));
     return fail(ErrorCode::ParseError, fmt::format("{}:{}: not valid JSON", manifest_path.string(), line));
   }
   try {

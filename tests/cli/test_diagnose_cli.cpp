@@ -1,20 +1,21 @@
 // End-to-end: diagnose on bad input, on summaries only (the study's tables), and its report.
-#include <gtest/gtest.h>
-
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-#include <nlohmann/json.hpp>
 
 #include "support/test_support.hpp"
 
 namespace clumpforge {
 namespace {
-std::string clump() { return (test::source_dir() / "clumps" / "tuber-default-diagnosis.h5").string(); }
+std::string clump() {
+  return (test::source_dir() / "clumps" / "tuber-default-diagnosis.h5").string();
+}
 
 void write(const std::filesystem::path& path, const std::string& text) {
   std::filesystem::create_directories(path.parent_path());
@@ -34,8 +35,8 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   // A track whose time goes backwards: refused with the file and the line.
   write(dir / "rec" / "recording.json", kManifest);
   write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n0.0005,0,0.21\n");
-  auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --out '{}'", (dir / "rec").string(), clump(),
-                                              (dir / "out").string()));
+  auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --out '{}'",
+                                              (dir / "rec").string(), clump(), (dir / "out").string()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("trial-01.csv:4"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("does not increase"), std::string::npos) << run.err;
@@ -46,18 +47,22 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("unknown column 'speed'"), std::string::npos) << run.err;
   // Both particle sources, neither, a missing directory, an unknown effect.
-  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --mesh x.stl", (dir / "rec").string(), clump()));
+  run = test::run_clumpforge(
+      fmt::format("diagnose --recordings '{}' --clump '{}' --mesh x.stl", (dir / "rec").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("exactly one of --mesh and --clump"), std::string::npos) << run.err;
-  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}'", (dir / "nowhere").string(), clump()));
+  run =
+      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}'", (dir / "nowhere").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("nowhere"), std::string::npos) << run.err;
   write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n");
-  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --effects air_drga", (dir / "rec").string(), clump()));
+  run = test::run_clumpforge(
+      fmt::format("diagnose --recordings '{}' --clump '{}' --effects air_drga", (dir / "rec").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("did you mean 'air_drag'"), std::string::npos) << run.err;
   // A track too short to decide anything: that verdict, not a guess.
-  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --json", (dir / "rec").string(), clump()));
+  run = test::run_clumpforge(
+      fmt::format("diagnose --recordings '{}' --clump '{}' --json", (dir / "rec").string(), clump()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(nlohmann::json::parse(run.out)["verdict"], "undecidable");
 }
@@ -67,7 +72,8 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
 TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
   test::ScratchDir dir("diagnose-hostile");
   write(dir / "outside.csv", "t_s,x_m,z_m\nSECRET-LINE,0,0\n");
-  const std::string drop = R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": %H%},
+  const std::string drop =
+      R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": %H%},
   "trials": [{"id": "01", "track": "%T%"}]})";
   auto manifest = [&](const std::string& height, const std::string& track) {
     std::string m = drop;
@@ -87,8 +93,8 @@ TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
     std::filesystem::remove_all(dir / "rec");
     write(dir / "rec" / "recording.json", m);
     if (!track.empty()) write(dir / "rec" / "trial-01.csv", track);
-    const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --out '{}' --json", (dir / "rec").string(), clump(),
-                                                      (dir / "out").string()));
+    const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --out '{}' --json",
+                                                      (dir / "rec").string(), clump(), (dir / "out").string()));
     EXPECT_EQ(run.exit_code, 1) << run.err;
     EXPECT_NE(run.err.find((dir / "rec").string()), std::string::npos) << run.err;  // names the file
     EXPECT_NE(run.err.find(expected), std::string::npos) << run.err;
@@ -104,8 +110,8 @@ TEST(ConcealCli, BadOptionsAreRefusedAndNothingIsWritten) {
   const auto out = dir / "recordings";
   const auto answer = dir / "answer.json";
   auto conceal = [&](const std::string& clump_file, const std::string& options) {
-    return test::run_command(fmt::format("'{}' '{}' --small --out '{}' --answer '{}' {}", CLUMPFORGE_CONCEAL, clump_file, out.string(),
-                                         answer.string(), options));
+    return test::run_command(fmt::format("'{}' '{}' --small --out '{}' --answer '{}' {}", CLUMPFORGE_CONCEAL,
+                                         clump_file, out.string(), answer.string(), options));
   };
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"--effect air_drgg", "did you mean 'air_drag'"},
@@ -114,7 +120,11 @@ TEST(ConcealCli, BadOptionsAreRefusedAndNothingIsWritten) {
       {"--effect air_drag --magnitude 0.4,2", "takes 1 parameter(s), not 2"},
       {"--restitution 1.5", "restitution 1.5 is outside (0, 1]"},
       {"--trials 0", "trials per recording must be 1 to 1000"},
-      {"--noise -1", "noise must be >= 0"},
+      {"--noise -1", "camera noise must lie in [0, 10] mm"},
+      {"--fps 0", "the frame rate in (0, 100000] Hz"},
+      {"--orientation sideways", "is not none, noisy:DEG or exact"},
+      {"--orientation noisy:abc", "noisy takes an angle in degrees"},
+      {"--steps-per-contact 5", "--steps-per-contact must be between 20 and 10000"},
       {"--surface marble", "tuber - marble"},
   };
   for (const auto& [options, message] : cases) {
@@ -135,8 +145,8 @@ TEST(DiagnoseCli, SummariesOnlySayWhatTheyCanDecide) {
   test::ScratchDir dir("diagnose-paper");
   const auto paper = test::shared_dir() / "data" / "paper";
   const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' '{}' --clump '{}' --json --out '{}'",
-                                                    (paper / "drop-Q235").string(), (paper / "roll-Q235").string(), clump(),
-                                                    (dir / "out").string()));
+                                                    (paper / "drop-Q235").string(), (paper / "roll-Q235").string(),
+                                                    clump(), (dir / "out").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   EXPECT_EQ(j["verdict"], "none");

@@ -1,7 +1,6 @@
 // Recordings exactly as ../shared/spec/recording-format.md defines them.
-#include <gtest/gtest.h>
-
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 
@@ -68,12 +67,14 @@ TEST(Recording, BadInputNamesFileAndLine) {
     std::string manifest, track, expected;
   };
   const std::vector<Case> cases{
-      {R"({"format": "recording/1", "test": "bounce", "surface": "Q235", "setup": {}, "trials": [{"id": "1", "summary": {}}]})", "",
-       "recording.json:1: unknown test 'bounce'"},
-      {"{\n\"format\": \"recording/1\",\n\"test\": \"drop\",\n\"surface\": \"Q235\",\n\"setup\": {\"release_height_m\": -0.2},\n\"trials\": []}", "",
-       "recording.json:5: 'release_height_m' must be positive"},
-      {"{\n\"format\": \"recording/1\",\n\"test\": \"roll\",\n\"surface\": \"Q235\",\n\"setup\": {\"incline_deg\": 30},\n\"trials\": []}", "",
-       "is missing its 'start_distance_m'"},
+      {R"({"format": "recording/1", "test": "bounce", "surface": "Q235", "setup": {}, "trials": [{"id": "1", "summary": {}}]})",
+       "", "recording.json:1: unknown test 'bounce'"},
+      {"{\n\"format\": \"recording/1\",\n\"test\": \"drop\",\n\"surface\": \"Q235\",\n\"setup\": "
+       "{\"release_height_m\": -0.2},\n\"trials\": []}",
+       "", "recording.json:5: 'release_height_m' must be positive"},
+      {"{\n\"format\": \"recording/1\",\n\"test\": \"roll\",\n\"surface\": \"Q235\",\n\"setup\": {\"incline_deg\": "
+       "30},\n\"trials\": []}",
+       "", "is missing its 'start_distance_m'"},
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
        "t_s,x_m,z_m\n0.0,0,0.2\n0.002,0,0.2\n0.001,0,0.2\n", "t.csv:4: time 0.001 does not increase"},
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
@@ -107,7 +108,8 @@ std::string with_track(const std::string& name) {
   return m;
 }
 
-std::string refusal(const fs::path& dir, const std::string& manifest, const std::string& track = "t_s,x_m,z_m\n0,0,0.2\n0.001,0,0.2\n") {
+std::string refusal(const fs::path& dir, const std::string& manifest,
+                    const std::string& track = "t_s,x_m,z_m\n0,0,0.2\n0.001,0,0.2\n") {
   fs::remove_all(dir);
   fs::create_directories(dir);
   test::write_text(dir / "recording.json", manifest);
@@ -124,7 +126,8 @@ TEST(RecordingLimits, TrackPathWithDotDotIsRefusedUnread) {
   EXPECT_NE(m.find("recording.json:2"), std::string::npos) << m;
   EXPECT_NE(m.find("leaves the recording's folder"), std::string::npos) << m;
   EXPECT_EQ(m.find("first line"), std::string::npos) << m;
-  EXPECT_NE(refusal(dir / "r", with_track("sub/../../secret.csv")).find("leaves the recording's folder"), std::string::npos);
+  EXPECT_NE(refusal(dir / "r", with_track("sub/../../secret.csv")).find("leaves the recording's folder"),
+            std::string::npos);
 }
 
 TEST(RecordingLimits, AbsoluteTrackPathIsRefused) {
@@ -183,7 +186,8 @@ TEST(RecordingLimits, ReleaseHeightOutside0To100MetresIsRefused) {
 
 TEST(RecordingLimits, FrameRateOutside0To1MHzIsRefused) {
   test::ScratchDir dir("rec-limits");
-  const std::string m = R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2},
+  const std::string m =
+      R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2},
  "camera": {"frame_rate_hz": 5e6}, "trials": [{"id": "1", "track": "t.csv"}]})";
   const std::string message = refusal(dir / "r", m);
   EXPECT_NE(message.find("recording.json:2"), std::string::npos) << message;
@@ -193,9 +197,10 @@ TEST(RecordingLimits, FrameRateOutside0To1MHzIsRefused) {
 TEST(RecordingLimits, DensityOutside1To25000IsRefused) {
   test::ScratchDir dir("rec-limits");
   for (const char* density : {"0.5", "30000"}) {
-    const std::string m = fmt::format(R"({{"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {{"release_height_m": 0.2}},
+    const std::string m = fmt::format(
+        R"({{"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {{"release_height_m": 0.2}},
  "particle": {{"density_kg_m3": {}}}, "trials": [{{"id": "1", "track": "t.csv"}}]}})",
-                                      density);
+        density);
     const std::string message = refusal(dir / "r", m);
     EXPECT_NE(message.find("recording.json:2"), std::string::npos) << message;
     EXPECT_NE(message.find("must lie in [1, 25000] kg/m^3"), std::string::npos) << message;
@@ -229,7 +234,8 @@ TEST(RecordingLimits, MalformedJsonAnywhereIsAParseError) {
 TEST(RecordingLimits, RecordedOrientationIsATypedPrior) {
   test::ScratchDir dir("rec-limits");
   fs::create_directories(dir / "r");
-  test::write_text(dir / "r" / "recording.json", R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2},
+  test::write_text(dir / "r" / "recording.json",
+                   R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2},
  "trials": [{"id": "1", "track": "t.csv", "orientation_wxyz": [0, 1, 0, 0]}, {"id": "2", "summary": {"rebound_height_m": 0.01}}]})");
   test::write_text(dir / "r" / "t.csv", "t_s,x_m,z_m\n0,0,0.2\n0.001,0,0.2\n");
   const auto r = read_recording(dir / "r");
