@@ -172,10 +172,16 @@ TEST(DiagnoseDecision, PassingCandidatesCompeteOnEveryTrial) {
   EXPECT_FALSE(decide({}, 10.0).best);
 }
 
-// The fast blind subset: recordings made by the generator, diagnosed by the library against
-// a fixed candidate list (the same for every case); the answer is only compared afterwards.
+// The fast blind subset: recordings made by the generator from a finer clump of the same
+// scan (340 spheres against the diagnosis's 32, 100 steps per contact against its 50), with
+// no release orientation recorded, diagnosed by the library against a fixed candidate list
+// (the same for every case); the answer is only compared afterwards.
 TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
   const Clump clump = diagnosis_clump();
+  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
+  ASSERT_TRUE(library) << library.error().message;
+  auto finer = select_clump(std::move(*library), "adaptive-340", "tuber-default.h5");
+  ASSERT_TRUE(finer) << finer.error().message;
   const MaterialTable table = default_material_table();
   DiagnoseOptions options;
   options.effects = {Effect::AirDrag, Effect::ViscoelasticRestitution, Effect::StaticKineticFriction};
@@ -183,7 +189,8 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
   for (bool with_drag : {false, true}) {
     SCOPED_TRACE(with_drag);
     const ConcealOptions conceal = with_drag ? one_metre_drops(Effect::AirDrag, {1.5}) : one_metre_drops();
-    auto made = make_concealed_recordings(clump, table, conceal);
+    ASSERT_EQ(conceal.orientation, OrientationRecord::None);
+    auto made = make_concealed_recordings(*finer, table, conceal);
     ASSERT_TRUE(made) << made.error().message;
     auto result = diagnose(clump, table, made->recordings, made->names, options);
     ASSERT_TRUE(result) << result.error().message;
