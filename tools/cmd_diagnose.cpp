@@ -211,6 +211,9 @@ void print_text(const DiagnoseResult& r) {
     return;
   }
   std::cout << fmt::format("verdict: {}\n{}\n", r.verdict, r.statement);
+  if (!r.undecidable.empty())
+    std::cout << fmt::format("not decidable from these tracks: {}\n", fmt::join(r.undecidable, ", "));
+  if (!r.experiment.empty()) std::cout << fmt::format("to decide more: {}\n", r.experiment);
   std::cout << "\nnoise (estimated from the tracks):";
   for (const auto& [name, s] : r.noise_m) std::cout << fmt::format(" {} {:.3f} mm;", name, s * 1000.0);
   std::cout << "\n\nwhere the baseline misses (phases beyond the noise):\n";

@@ -809,12 +809,12 @@ Result<std::vector<std::string>> settle_release_state(Context& c, const Model& m
     const bool recorded =
         std::any_of(groups.begin(), groups.end(), [](const auto& g) { return g.first.recorded.has_value(); });
     notes.push_back(fmt::format(
-        "{}: release orientation {}; replays from {} orientations it allows agree up to {} s after release", c.names[r],
+        "{}: release orientation {}; replays from {} orientations it allows agree until {} after release", c.names[r],
         recorded ? fmt::format("recorded (a prior of +-{:g} deg)", options.orientation_prior_deg)
                  : std::string("unknown (uniform prior)"),
         options.release_orientations,
         fmt::join(horizons | std::views::transform([](double h) {
-                    return std::isfinite(h) ? fmt::format("{:.3f}", h) : std::string("the end");
+                    return std::isfinite(h) ? fmt::format("{:.3f} s", h) : std::string("the end");
                   }),
                   ", ")));
   }
@@ -1498,7 +1498,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
       }
       Eigen::MatrixXd absorb(base_cells->size(), static_cast<Eigen::Index>(directions.size()));
       for (std::size_t k = 0; k < directions.size(); ++k) absorb.col(static_cast<Eigen::Index>(k)) = directions[k];
-      std::vector<std::string> limits;
+      std::vector<std::string> limits, untestable;
       for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
         auto& report = result.hypotheses[h];
         const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
@@ -1530,6 +1530,12 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
               signal > 0.0 ? null_value + (probed - null_value) * std::sqrt(needed / signal) : kNever;
           limits.push_back(fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable));
         }
+        // Beyond its strong magnitude (or never): the predictable parts of these tracks cannot
+        // decide it; said, not counted as absent.
+        const bool testable =
+            first.log_scale ? std::isfinite(report.smallest_detectable)
+                            : std::isfinite(report.smallest_detectable) && report.smallest_detectable <= first.strong;
+        if (!testable) untestable.push_back(spec.name);
       }
       // Phases still beyond the noise, but by less than kLargeMisfit and with no shape the
       // trials share: said, not hidden.
@@ -1568,6 +1574,20 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
           "have revealed (at delta-BIC {:g}, "
           "after the coefficients absorb what they can, to first order): {}.",
           residual_state, options.min_delta_bic, fmt::join(limits, "; "));
+      if (!untestable.empty()) {
+        // What the frame-by-frame fit cannot reach: the effects that act after the release
+        // horizon of an irregular body (its contacts) need more than these tracks.
+        result.undecidable = untestable;
+        result.statement += fmt::format(
+            " Not decidable from the predictable parts of these tracks (even at their strong magnitude): {}; they act "
+            "where the "
+            "unknown release orientation decides the path.",
+            fmt::join(untestable, ", "));
+        result.experiment =
+            "record each trial's release orientation to a few degrees (a marked particle, a release jig), or repeat "
+            "the tests "
+            "with a sphere of the same material, whose path does not depend on it";
+      }
     }
   }
   // Plots: each recording's first trial against both models.

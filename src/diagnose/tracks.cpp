@@ -143,7 +143,9 @@ double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s,
     double sum = 0.0;
     int count = 0;
     for (std::size_t i = 0; i < track.size(); ++i) {
-      if (!std::isfinite(track.tilt[i])) continue;
+      // Only frames with the plate turning: a camera started before the plate shows 0 deg
+      // for as long as it waited, which says nothing of when the plate started.
+      if (!std::isfinite(track.tilt[i]) || track.tilt[i] <= 0.0) continue;
       sum += track.t[i] - track.tilt[i] / tilt_rate_deg_per_s;
       ++count;
     }
