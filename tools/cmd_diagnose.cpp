@@ -103,6 +103,7 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
   j["baseline"] = coefficients_json(r.baseline);
   j["refitted_on_all"] = r.refitted_on_all.empty() ? nlohmann::json() : coefficients_json(r.refitted_on_all);
   j["improved"] = coefficients_json(r.improved);
+  j["uncalibrated"] = r.uncalibrated;
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
   j["phases"] = nlohmann::json::array();
   for (const auto& p : r.phases) {

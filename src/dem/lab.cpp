@@ -187,7 +187,7 @@ TrialOutcome tilt_trial(World world, const Recording& setup, const LabOptions& o
   Wall& plate = world.walls[0];
   // Settle, then tilt.
   while (world.time < 0.05) step(world, dt);
-  plate.spin = {0, -rate, 0};  // the +x side goes down: sliding towards +x
+  plate.spin = {0, rate, 0};  // the +x side goes down: the particle travels towards +x (the spec's direction of travel)
   const double start_time = world.time;
   auto plate_coordinate = [&] { return (world.bodies[0].position - plate.pivot).dot(plate.u_axis); };
   const double start = plate_coordinate();
@@ -323,7 +323,7 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
   if (setup.test == LabTest::Tilt) {
     while (world.time < replay.settle) step(world, dt);
     rate = (setup.tilt_rate_deg_per_s ? *setup.tilt_rate_deg_per_s : options.tilt_rate_deg_per_s) * kPi / 180.0;
-    world.walls[0].spin = {0, -rate, 0};
+    world.walls[0].spin = {0, rate, 0};  // as tilt_trial: travel towards +x
     origin = world.time;
   }
   std::vector<ReplaySample> samples;

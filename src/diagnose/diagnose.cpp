@@ -13,6 +13,7 @@
 #include <numbers>
 #include <numeric>
 #include <ranges>
+#include <set>
 
 #include "core/rng.hpp"
 #include "diagnose/model.hpp"
@@ -319,6 +320,8 @@ bool outlier_trial(const Group& g, const TrialSpread& spread) {
 
 struct Context {
   Evaluator ev;
+  std::set<std::pair<std::string, Coefficient>>
+      unpinned;  ///< coefficients the fitted windows do not pin (surface, which)
   std::vector<std::string> names;
   std::vector<std::size_t> training, heldout, all;
   int evaluations = 0;
@@ -447,16 +450,25 @@ Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vect
       };
       // A coarse grid (the chi^2 of irregular bodies can have several dips), then golden section.
       const int grid = narrow ? 7 : wide_grid(coefficient);
-      double best = current, best_value = chi2(current);
+      double best = current, best_value = chi2(current), worst_value = best_value;
       for (int k = 0; k < grid; ++k) {
         const double v = low + (high - low) * k / (grid - 1);
         const double f = chi2(v);
+        if (std::isfinite(f)) worst_value = std::max(worst_value, f);
         if (f < best_value) {
           best_value = f;
           best = v;
         }
       }
       if (failure) return std::unexpected(*failure);
+      // Not pinned: across its whole range the chi^2 moves by less than one (the fitted
+      // windows end before the coefficient acts, a tuber's e before its first contact). The
+      // starting value is kept and said to be uncalibrated, not a grid's edge reported.
+      if (worst_value - best_value < 1.0) {
+        c.unpinned.insert({model.base[s].surface, coefficient});
+        continue;
+      }
+      c.unpinned.erase({model.base[s].surface, coefficient});
       const double cell = (high - low) / (grid - 1);
       // Tight: within the predictability horizon a 1 % error in mu_r already shows.
       const double tolerance = coefficient == Coefficient::RollingFriction ? 1e-5 : 1e-4;
@@ -1143,6 +1155,15 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   if (!polished) return std::unexpected(polished.error());
   baseline = polished->model;
   result.baseline = baseline.base;
+  for (const auto& [surface, coefficient] : c.unpinned) {
+    const auto it =
+        std::find_if(baseline.base.begin(), baseline.base.end(), [&](const auto& b) { return b.surface == surface; });
+    result.notes.push_back(
+        fmt::format("{} on {} is not pinned by the fitted parts of the tracks (its chi^2 moves by less than 1 over "
+                    "its range): the starting value {:.4g} is kept, uncalibrated",
+                    coefficient_name(coefficient), surface, coefficient_of(it->interaction, coefficient)));
+    result.uncalibrated.push_back(fmt::format("{}:{}", surface, coefficient_name(coefficient)));
+  }
   for (std::size_t r = 0; r < recordings.size(); ++r) {
     std::vector<std::string> horizons;
     for (const auto& tt : c.ev.trials) {

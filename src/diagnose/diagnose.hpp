@@ -107,6 +107,8 @@ struct DiagnoseResult {
   std::vector<ParameterValue> effect_parameters;
   std::vector<std::pair<std::string, double>> noise_m;  ///< per recording, estimated
   std::vector<SurfaceParameters> baseline, improved;
+  std::vector<std::string>
+      uncalibrated;  ///< "surface:coefficient" the fitted parts of the tracks do not pin (the starting value kept)
   std::vector<SurfaceParameters> refitted_on_all;  ///< the second null's coefficients (every trial), when it was needed
   FitQuality before, after;
   std::vector<PhaseReport> phases;

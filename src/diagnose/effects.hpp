@@ -26,18 +26,18 @@ enum class Effect {
 };
 
 struct EffectParameter {
-  std::string name;     ///< JSON key, SI unit in the name (e.g. "drag_coefficient", "offset_x_m")
-  double lower = 0.0, upper = 1.0;           ///< search range
+  std::string name;                 ///< JSON key, SI unit in the name (e.g. "drag_coefficient", "offset_x_m")
+  double lower = 0.0, upper = 1.0;  ///< search range
   double plausible_low = 0.0, plausible_high = 1.0;  ///< physically plausible values
-  double start = 0.0;   ///< first guess of a fit
-  double realistic = 0.0, strong = 0.0;      ///< magnitudes for concealed-effect recordings
-  bool log_scale = false;  ///< searched in log10
+  double start = 0.0;                                ///< first guess of a fit
+  double realistic = 0.0, strong = 0.0;              ///< magnitudes for concealed-effect recordings
+  bool log_scale = false;                            ///< searched in log10
 };
 
 struct EffectSpec {
   Effect effect = Effect::AirDrag;
-  std::string name;          ///< the verdict's name, e.g. "air_drag"
-  std::string description;   ///< one line, for reports
+  std::string name;         ///< the verdict's name, e.g. "air_drag"
+  std::string description;  ///< one line, for reports
   std::vector<EffectParameter> parameters;
   std::vector<LabTest> tests;  ///< where it shows (the fit uses these recordings)
 };
@@ -53,17 +53,29 @@ void apply_effect(Effect effect, std::span<const double> values, LabOptions& opt
 /// The base coefficient a test measures: e (drop), mu_s (tilt), mu_r (roll).
 enum class Coefficient { Restitution, StaticFriction, RollingFriction };
 inline Coefficient coefficient_for(LabTest test) {
-  return test == LabTest::Drop ? Coefficient::Restitution : test == LabTest::Tilt ? Coefficient::StaticFriction : Coefficient::RollingFriction;
+  return test == LabTest::Drop   ? Coefficient::Restitution
+         : test == LabTest::Tilt ? Coefficient::StaticFriction
+                                 : Coefficient::RollingFriction;
 }
 inline double& coefficient_of(Interaction& i, Coefficient c) {
-  return c == Coefficient::Restitution ? i.restitution : c == Coefficient::StaticFriction ? i.static_friction : i.rolling_friction;
+  return c == Coefficient::Restitution      ? i.restitution
+         : c == Coefficient::StaticFriction ? i.static_friction
+                                            : i.rolling_friction;
 }
 inline double coefficient_of(const Interaction& i, Coefficient c) {
-  return c == Coefficient::Restitution ? i.restitution : c == Coefficient::StaticFriction ? i.static_friction : i.rolling_friction;
+  return c == Coefficient::Restitution      ? i.restitution
+         : c == Coefficient::StaticFriction ? i.static_friction
+                                            : i.rolling_friction;
+}
+/// The report's name of a coefficient (as the materials table's keys).
+inline std::string_view coefficient_name(Coefficient c) {
+  return c == Coefficient::Restitution      ? "restitution"
+         : c == Coefficient::StaticFriction ? "static_friction"
+                                            : "rolling_friction";
 }
 
-/// The lab options the diagnosis and the generator share: 25 steps per Hertz contact (the
-/// replays run thousands of times; both sides must step the same way).
+/// The diagnosis's lab options: 25 steps per Hertz contact (the replays run thousands of
+/// times; drops get 50, see Evaluator). The generator steps finer (generator_lab_options).
 inline LabOptions diagnosis_lab_options() {
   LabOptions lab;
   lab.steps_per_contact = 25;
