@@ -237,13 +237,8 @@ int main(int argc, char** argv) {
   camera.frame_rate_hz = fps;
   camera.noise_m = noise;
   camera.pre_roll = !no_pre_roll;
-  if (orientation == "exact")
-    camera.orientation = OrientationRecord::Exact;
-  else if (orientation.starts_with("noisy:")) {
-    camera.orientation = OrientationRecord::Noisy;
-    camera.orientation_noise_deg = std::atof(orientation.c_str() + 6);
-  } else if (orientation != "none") {
-    std::cerr << "--orientation '" << orientation << "' is not none, noisy:DEG or exact\n";
+  if (auto ok = parse_orientation_record(orientation, camera); !ok) {
+    std::cerr << ok.error().message << "\n";
     return 1;
   }
   auto base_options = [&](const std::string& surface, std::uint64_t case_seed) {

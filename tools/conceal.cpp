@@ -45,28 +45,6 @@ Result<std::vector<double>> parse_values(const std::string& text, const EffectSp
   }
   return values;
 }
-/// --orientation none | noisy:DEG | exact
-Result<void> parse_orientation(const std::string& text, ConcealOptions& options) {
-  if (text == "none")
-    options.orientation = OrientationRecord::None;
-  else if (text == "exact")
-    options.orientation = OrientationRecord::Exact;
-  else if (text.starts_with("noisy:")) {
-    options.orientation = OrientationRecord::Noisy;
-    try {
-      std::size_t used = 0;
-      const std::string number = text.substr(6);
-      options.orientation_noise_deg = std::stod(number, &used);
-      if (used != number.size()) throw std::invalid_argument(number);
-    } catch (const std::exception&) {
-      return fail(ErrorCode::InvalidArgument,
-                  fmt::format("--orientation '{}': noisy takes an angle in degrees (noisy:15)", text));
-    }
-  } else {
-    return fail(ErrorCode::InvalidArgument, fmt::format("--orientation '{}' is not none, noisy:DEG or exact", text));
-  }
-  return {};
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -116,7 +94,7 @@ int main(int argc, char** argv) {
                              {ErrorCode::InvalidArgument, "--steps-per-contact must be between 20 and 10000"});
   }
   options.lab.steps_per_contact = steps_per_contact;
-  if (auto ok = parse_orientation(orientation, options); !ok) return cli::report_error(kCommand, ok.error());
+  if (auto ok = parse_orientation_record(orientation, options); !ok) return cli::report_error(kCommand, ok.error());
   options.conceal = !no_conceal;
   if (small) {
     options.drop_heights = {0.2, 1.0};

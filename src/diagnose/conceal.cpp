@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <numbers>
 
@@ -195,6 +196,27 @@ std::pair<double, double> coefficient_bounds(LabTest test) {
 }
 
 }  // namespace
+
+Result<void> parse_orientation_record(std::string_view text, ConcealOptions& options) {
+  if (text == "none") {
+    options.orientation = OrientationRecord::None;
+  } else if (text == "exact") {
+    options.orientation = OrientationRecord::Exact;
+  } else if (text.starts_with("noisy:")) {
+    const std::string_view number = text.substr(6);
+    double degrees = 0.0;
+    const auto [end, ec] = std::from_chars(number.data(), number.data() + number.size(), degrees);
+    if (ec != std::errc{} || end != number.data() + number.size() || !(degrees > 0.0 && degrees <= 180.0)) {
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("--orientation '{}': noisy takes an angle in degrees, (0, 180] (noisy:15)", text));
+    }
+    options.orientation = OrientationRecord::Noisy;
+    options.orientation_noise_deg = degrees;
+  } else {
+    return fail(ErrorCode::InvalidArgument, fmt::format("--orientation '{}' is not none, noisy:DEG or exact", text));
+  }
+  return {};
+}
 
 Result<ConcealResult> make_concealed_recordings(const Clump& clump, const MaterialTable& table,
                                                 const ConcealOptions& options, const RunContext& context) {

@@ -68,6 +68,9 @@ struct ConcealResult {
   std::vector<SummaryMatch> summaries;  ///< study set-ups: baseline vs concealed effect
 };
 
+/// Reads what recordings say of the release: "none", "noisy:DEG" or "exact" into `options`.
+Result<void> parse_orientation_record(std::string_view text, ConcealOptions& options);
+
 Result<ConcealResult> make_concealed_recordings(const Clump& clump, const MaterialTable& table,
                                                 const ConcealOptions& options, const RunContext& context = {});
 

@@ -43,6 +43,9 @@ double chi2_tail(double chi2, double n) {
 /// `groups` phases, and large (kPracticalExcess).
 /// chi^2 per value of a misfit three times the noise (RMS): a mismatch whatever its shape.
 constexpr double kLargeMisfit = 10.0;
+/// A coefficient whose chi^2 moves by less than this across its whole range is not pinned by
+/// the fitted windows (the delta-BIC margin: no evidence either way).
+constexpr double kUnpinned = 10.0;
 
 bool beyond_noise(double chi2, int values, std::size_t groups) {
   return values > 0 && chi2_tail(chi2, values) < 1e-3 / std::max<std::size_t>(1, groups) &&
@@ -320,8 +323,10 @@ bool outlier_trial(const Group& g, const TrialSpread& spread) {
 
 struct Context {
   Evaluator ev;
-  std::set<std::pair<std::string, Coefficient>>
-      unpinned;  ///< coefficients the fitted windows do not pin (surface, which)
+  /// Coefficients the fitted windows do not pin (surface, which), and the materials table's
+  /// values they keep.
+  std::set<std::pair<std::string, Coefficient>> unpinned;
+  std::vector<SurfaceParameters> table_values;
   std::vector<std::string> names;
   std::vector<std::size_t> training, heldout, all;
   int evaluations = 0;
@@ -461,11 +466,16 @@ Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vect
         }
       }
       if (failure) return std::unexpected(*failure);
-      // Not pinned: across its whole range the chi^2 moves by less than one (the fitted
-      // windows end before the coefficient acts, a tuber's e before its first contact). The
-      // starting value is kept and said to be uncalibrated, not a grid's edge reported.
-      if (worst_value - best_value < 1.0) {
+      // Not pinned: across its whole range the chi^2 moves by less than kUnpinned (the fitted
+      // windows end before the coefficient acts, a tuber's e at its first contact). The
+      // materials table's value is kept and said to be uncalibrated, not a grid's edge.
+      if (worst_value - best_value < kUnpinned) {
         c.unpinned.insert({model.base[s].surface, coefficient});
+        for (const auto& b : c.table_values) {
+          if (b.surface == model.base[s].surface) {
+            coefficient_of(model.base[s].interaction, coefficient) = coefficient_of(b.interaction, coefficient);
+          }
+        }
         continue;
       }
       c.unpinned.erase({model.base[s].surface, coefficient});
@@ -622,6 +632,7 @@ std::pair<Model, std::vector<FitParameter>> fit_parameters(const Context& c, con
       });
       if (!present) continue;
       const Coefficient coefficient = coefficient_for(test);
+      if (c.unpinned.contains({model.base[s].surface, coefficient})) continue;  // nothing to fit it to
       auto [low, high] = coefficient_range(coefficient);
       const double current = coefficient_of(model.base[s].interaction, coefficient);
       // Within +-40 % of the current value: an effect changes a coefficient, not its order.
@@ -1136,6 +1147,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     auto pair = table.interaction(options.lab.particle_material, rec.surface);
     if (!pair) return std::unexpected(pair.error());
     baseline.base.push_back({rec.surface, *pair});
+    c.table_values.push_back({rec.surface, *pair});
   }
   run.report("release state", 0.02);
   auto release_notes = settle_release_state(c, baseline, options);
@@ -1159,9 +1171,9 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     const auto it =
         std::find_if(baseline.base.begin(), baseline.base.end(), [&](const auto& b) { return b.surface == surface; });
     result.notes.push_back(
-        fmt::format("{} on {} is not pinned by the fitted parts of the tracks (its chi^2 moves by less than 1 over "
-                    "its range): the starting value {:.4g} is kept, uncalibrated",
-                    coefficient_name(coefficient), surface, coefficient_of(it->interaction, coefficient)));
+        fmt::format("{} on {} is not pinned by the fitted parts of the tracks (its chi^2 moves by less than {:g} over "
+                    "its range): the materials table's {:.4g} is kept, uncalibrated",
+                    coefficient_name(coefficient), surface, kUnpinned, coefficient_of(it->interaction, coefficient)));
     result.uncalibrated.push_back(fmt::format("{}:{}", surface, coefficient_name(coefficient)));
   }
   for (std::size_t r = 0; r < recordings.size(); ++r) {
