@@ -88,7 +88,7 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
   nlohmann::json j;
   j["format"] = "clumpforge-diagnosis/1";
   j["clump"] = clump_name;
-  j["verdict"] = r.verdict;
+  j["verdict"] = verdict_name(r);
   j["statement"] = r.statement;
   j["candidates"] = r.candidates;
   j["experiment"] = r.experiment;
@@ -163,7 +163,7 @@ std::vector<std::pair<fs::path, std::string>> plots(const DiagnoseResult& r, con
     for (int axis = 0; axis < 2; ++axis) {
       Plot plot;
       plot.title = fmt::format("{}: recorded vs baseline vs improved ({}; fitted up to {:.3f} s)", t.recording,
-                               r.verdict, std::min(t.horizon, 99.0));
+                               verdict_name(r), std::min(t.horizon, 99.0));
       plot.x_label = "time since release [s]";
       plot.y_label = axis == 0 ? "height z [mm]" : "horizontal x [mm]";
       auto mm = [](const std::vector<double>& v) {
@@ -204,14 +204,14 @@ void print_text(const DiagnoseResult& r) {
   if (r.summaries_only) {
     std::cout << fmt::format(
         "verdict: {} (summaries only: no tracks, so no effect can be named)\n\nwhat these summaries decide:\n",
-        r.verdict);
+        verdict_name(r));
     for (const auto& d : r.decidable) std::cout << "  - " << d << "\n";
     std::cout << "\nwhat they cannot decide:\n";
     for (const auto& d : r.undecidable) std::cout << "  - " << d << "\n";
     std::cout << "\nto decide more: " << r.experiment << "\n";
     return;
   }
-  std::cout << fmt::format("verdict: {}\n{}\n", r.verdict, r.statement);
+  std::cout << fmt::format("verdict: {}\n{}\n", verdict_name(r), r.statement);
   if (!r.undecidable.empty())
     std::cout << fmt::format("not decidable from these tracks: {}\n", fmt::join(r.undecidable, ", "));
   if (!r.experiment.empty()) std::cout << fmt::format("to decide more: {}\n", r.experiment);

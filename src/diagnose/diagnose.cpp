@@ -996,6 +996,22 @@ std::string experiment_for(const std::string& a, const std::string& b) {
 
 }  // namespace
 
+std::string verdict_name(const DiagnoseResult& result) {
+  switch (result.verdict) {
+    case Verdict::None:
+      return "none";
+    case Verdict::Named:
+      return result.effect ? effect_spec(effect_library(), *result.effect).name : "none";
+    case Verdict::Ambiguous:
+      return "ambiguous";
+    case Verdict::Unexplained:
+      return "unexplained";
+    case Verdict::Undecidable:
+      return "undecidable";
+  }
+  return "none";
+}
+
 Decision decide(const std::vector<HypothesisReport>& hypotheses, double min_delta_bic) {
   Decision decision;
   std::vector<std::size_t> order(hypotheses.size());
@@ -1121,7 +1137,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     if (std::isfinite(s)) worst_sigma = std::max(worst_sigma, s);
   }
   auto undecidable = [&](std::string why) {
-    result.verdict = "undecidable";
+    result.verdict = Verdict::Undecidable;
     result.statement = std::move(why);
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     return result;
@@ -1355,7 +1371,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   } else if (decision.best) {
     const auto& best = result.hypotheses[*decision.best];
     const auto& other = result.hypotheses[decision.close.front()];
-    result.verdict = "ambiguous";
+    result.verdict = Verdict::Ambiguous;
     result.candidates.push_back(best.name);
     for (std::size_t k : decision.close) result.candidates.push_back(result.hypotheses[k].name);
     result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
@@ -1375,7 +1391,8 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     const std::size_t h = *named;
     HypothesisReport& report = result.hypotheses[h];
     improved = fits[h].model;
-    result.verdict = report.name;
+    result.verdict = Verdict::Named;
+    result.effect = *improved.effect;
     // 95 % intervals of the effect's parameters from the chi^2 curvature (others held).
     const EffectSpec& spec = effect_spec(library, *improved.effect);
     for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
@@ -1491,9 +1508,9 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
         p.improved_chi2_per_value = g.chi2 / g.values;
     }
   }
-  if (!named && result.verdict.empty()) {
+  if (!named && result.verdict != Verdict::Ambiguous) {
     if (!result.unexplained.empty()) {
-      result.verdict = "unexplained";
+      result.verdict = Verdict::Unexplained;
       result.statement = fmt::format(
           "Mismatch not explained by any known effect in: {}. Each is beyond the noise after the coefficients are "
           "refitted "
@@ -1503,7 +1520,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
           fmt::join(result.unexplained, "; "), options.min_delta_bic, result.hypotheses.size());
       result.experiment = "look at the residual plots of these phases; add set-ups that isolate them";
     } else {
-      result.verdict = "none";
+      result.verdict = Verdict::None;
       // The smallest effect the data could have shown: an effect's signal (its replays minus
       // the baseline's at a fifth of its realistic magnitude) with the part the coefficients
       // could absorb projected out (their own finite-difference directions), scaled

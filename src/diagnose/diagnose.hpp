@@ -99,8 +99,15 @@ struct TrackComparison {
   double horizon = 0.0;
 };
 
+/// What a diagnosis concludes. Named: one effect of the library (DiagnoseResult::effect);
+/// Ambiguous: several fit (candidates); Unexplained: a large misfit no candidate removes;
+/// Undecidable: too few or too noisy tracks; None: nothing beyond the noise and the model's
+/// accuracy that an effect explains.
+enum class Verdict { None, Named, Ambiguous, Unexplained, Undecidable };
+
 struct DiagnoseResult {
-  std::string verdict;                  ///< "none", "ambiguous", "unexplained", "undecidable" or the effect's name
+  Verdict verdict = Verdict::None;
+  std::optional<Effect> effect;         ///< the named effect (verdict Named)
   std::string statement;                ///< one paragraph for a person
   std::vector<std::string> candidates;  ///< ambiguous: the effects it could be
   std::string experiment;               ///< what would separate them / reveal more
@@ -135,6 +142,10 @@ struct Decision {
   bool named() const { return best && close.empty(); }
 };
 Decision decide(const std::vector<HypothesisReport>& hypotheses, double min_delta_bic);
+
+/// The verdict as reports write it: the named effect's name, or none, ambiguous, unexplained,
+/// undecidable.
+std::string verdict_name(const DiagnoseResult& result);
 
 /// Diagnoses `recordings` (names parallel to them) for `clump`. Recordings without tracks
 /// give the summaries-only statement (see diagnose_summaries).

@@ -224,10 +224,11 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
     auto result = diagnose(clump, table, made->recordings, made->names, options);
     ASSERT_TRUE(result) << result.error().message;
     if (!with_drag) {
-      EXPECT_EQ(result->verdict, "none") << result->statement;
+      EXPECT_EQ(result->verdict, Verdict::None) << result->statement;
       EXPECT_NEAR(result->before.train_rms_mm, 0.1, 0.02);  // the camera's noise, nothing else
     } else {
-      ASSERT_EQ(result->verdict, "air_drag") << result->statement;
+      ASSERT_EQ(result->verdict, Verdict::Named) << result->statement;
+      ASSERT_EQ(result->effect, Effect::AirDrag);
       ASSERT_EQ(result->effect_parameters.size(), 1u);
       EXPECT_NEAR(result->effect_parameters[0].value, 1.5, 0.3);
       EXPECT_LT(result->after.heldout_rms_mm, 0.5 * result->before.heldout_rms_mm);
@@ -247,7 +248,7 @@ TEST(DiagnoseBlind, AnEffectOutsideTheCandidatesIsUnexplainedNotNamed) {
   ASSERT_TRUE(made) << made.error().message;
   auto result = diagnose(clump, table, made->recordings, made->names, options);
   ASSERT_TRUE(result) << result.error().message;
-  ASSERT_EQ(result->verdict, "unexplained") << result->statement;
+  ASSERT_EQ(result->verdict, Verdict::Unexplained) << result->statement;
   EXPECT_TRUE(result->effect_parameters.empty());
   bool flight = false;
   for (const auto& u : result->unexplained) flight = flight || u.find("flight phases of drop-1m") != std::string::npos;
@@ -278,7 +279,7 @@ TEST(DiagnoseBlind, OneTrialsMisfitIsAnOutlierNotAMismatch) {
   options.max_evaluations = 30;
   auto result = diagnose(clump, table, made->recordings, made->names, options);
   ASSERT_TRUE(result) << result.error().message;
-  EXPECT_EQ(result->verdict, "none") << result->statement;
+  EXPECT_EQ(result->verdict, Verdict::None) << result->statement;
   EXPECT_NE(result->statement.find("one trial alone misfits"), std::string::npos) << result->statement;
 }
 
@@ -295,7 +296,7 @@ TEST(DiagnoseBlind, TooShortOrTooNoisyIsUndecidable) {
   ASSERT_TRUE(noisy) << noisy.error().message;
   auto result = diagnose(clump, table, noisy->recordings, noisy->names, {});
   ASSERT_TRUE(result) << result.error().message;
-  EXPECT_EQ(result->verdict, "undecidable");
+  EXPECT_EQ(result->verdict, Verdict::Undecidable);
   EXPECT_NE(result->statement.find("too noisy"), std::string::npos) << result->statement;
   // Tracks of 20 frames each.
   conceal.noise_m = 1e-4;
@@ -309,7 +310,7 @@ TEST(DiagnoseBlind, TooShortOrTooNoisyIsUndecidable) {
   }
   result = diagnose(clump, table, made->recordings, made->names, {});
   ASSERT_TRUE(result) << result.error().message;
-  EXPECT_EQ(result->verdict, "undecidable");
+  EXPECT_EQ(result->verdict, Verdict::Undecidable);
   EXPECT_NE(result->statement.find("usable tracked trial"), std::string::npos) << result->statement;
 }
 
