@@ -174,23 +174,13 @@ double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s,
   const double acceleration =
       test == LabTest::Drop ? 9.81 : 9.81 * std::sin(incline_deg * std::numbers::pi / 180.0) * 5.0 / 7.0;
   int run = 0;
+  double run_start = 0.0;
   for (std::size_t i = 0; i < track.size(); ++i) {
     if (!std::isfinite(track.x[i]) || !std::isfinite(track.z[i])) continue;
     const double moved = test == LabTest::Drop ? z0 - track.z[i] : std::hypot(track.x[i] - x0, track.z[i] - z0);
     run = moved > kMoved ? run + 1 : 0;
-    if (run == 1) {
-      // Where the run began, unless it ends here.
-      const double t = track.t[i];
-      std::size_t j = i + 1;
-      int more = 0;
-      for (; j < track.size() && more < 2; ++j) {
-        if (!std::isfinite(track.x[j]) || !std::isfinite(track.z[j])) continue;
-        const double m = test == LabTest::Drop ? z0 - track.z[j] : std::hypot(track.x[j] - x0, track.z[j] - z0);
-        if (m <= kMoved) break;
-        ++more;
-      }
-      if (more == 2) return t - std::sqrt(2.0 * kMoved / acceleration);
-    }
+    if (run == 1) run_start = track.t[i];
+    if (run == 3) return run_start - std::sqrt(2.0 * kMoved / acceleration);
   }
   return track.t.front();
 }
