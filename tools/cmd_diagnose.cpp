@@ -27,7 +27,8 @@ constexpr int kMaxAutoSpheres = 256;
 struct DiagnoseArgs {
   std::vector<std::string> recordings, effects;
   std::string mesh, clump, clump_name, out, materials, units = "mm";
-  double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3;
+  double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3, impact_accuracy_pct = 1.0;
+  int ensemble_replays = 12;
   int spheres = 0, max_evaluations = 45, release_orientations = 12;
   std::uint64_t seed = 1;
   bool json = false;
@@ -104,6 +105,57 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
   j["refitted_on_all"] = r.refitted_on_all.empty() ? nlohmann::json() : coefficients_json(r.refitted_on_all);
   j["improved"] = coefficients_json(r.improved);
   j["uncalibrated"] = r.uncalibrated;
+  if (r.ensemble) {
+    const auto& e = *r.ensemble;
+    auto comparisons_json = [&](const std::vector<OutcomeComparison>& list) {
+      nlohmann::json out = nlohmann::json::array();
+      for (const auto& c : list) {
+        out.push_back({{"recording", e.recordings.at(c.recording)},
+                       {"outcome", outcome_name(c.outcome)},
+                       {"recorded_mean", c.recorded_mean},
+                       {"recorded_sd", c.recorded_sd},
+                       {"recorded_n", c.recorded_n},
+                       {"replayed_mean", c.ensemble_mean},
+                       {"replayed_sd", c.ensemble_sd},
+                       {"replays", c.ensemble_n},
+                       {"floor", c.floor},
+                       {"z", c.z}});
+      }
+      return out;
+    };
+    const nlohmann::json outcomes = comparisons_json(e.null_comparisons);
+    nlohmann::json tried = nlohmann::json::array();
+    const auto library = effect_library();
+    for (const auto& h : e.hypotheses) {
+      const EffectSpec& spec = effect_spec(library, h.effect);
+      nlohmann::json values = nlohmann::json::object();
+      for (std::size_t k = 0; k < spec.parameters.size() && k < h.values.size(); ++k)
+        values[spec.parameters[k].name] = h.values[k];
+      tried.push_back({{"name", spec.name},
+                       {"values", values},
+                       {"chi2", h.chi2},
+                       {"delta_bic", h.delta_bic},
+                       {"plausible", h.plausible},
+                       {"comparisons", comparisons_json(h.comparisons)}});
+    }
+    nlohmann::json detect = nlohmann::json::array();
+    for (const auto& d : e.detectability) {
+      detect.push_back(
+          {{"name", effect_spec(library, d.effect).name},
+           {"strong_signal", d.strong_signal},
+           {"needed", d.needed},
+           {"trials_needed", std::isfinite(d.trials_needed) ? nlohmann::json(d.trials_needed) : nlohmann::json()}});
+    }
+    j["ensemble"] = {{"replays", e.replays},
+                     {"trials", e.trials},
+                     {"detectability", detect},
+                     {"outcomes", e.outcomes},
+                     {"null_chi2", e.null_chi2},
+                     {"calibrated", coefficients_json(e.calibrated)},
+                     {"calibrated_here", e.calibrated_here},
+                     {"comparisons", outcomes},
+                     {"hypotheses", tried}};
+  }
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
   j["phases"] = nlohmann::json::array();
   for (const auto& p : r.phases) {
@@ -272,6 +324,8 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.max_evaluations = args.max_evaluations;
   options.orientation_prior_deg = args.orientation_prior_deg;
   options.model_accuracy_m = args.model_accuracy_mm * 1e-3;
+  options.impact_accuracy = args.impact_accuracy_pct / 100.0;
+  options.ensemble_replays = args.ensemble_replays;
   options.release_orientations = args.release_orientations;
   for (const auto& name : args.effects) {
     auto e = parse_effect(name);
@@ -367,6 +421,12 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_option("--model-accuracy", args->model_accuracy_mm,
                   "How closely the particle model can follow a real particle [mm]; residuals are weighed against it "
                   "and the camera noise together");
+  sub->add_option("--impact-accuracy", args->impact_accuracy_pct,
+                  "How closely a replay's speed leaving an impact follows the particle's [%]; the position error it "
+                  "leaves grows with the time since the impact");
+  sub->add_option("--ensemble-replays", args->ensemble_replays,
+                  "Replays per drop and roll recording from the release prior, to compare the recorded outcomes "
+                  "beyond the release horizon (0: skip)");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   sub->add_option("--out", args->out, "Write report.json and SVG plots here");

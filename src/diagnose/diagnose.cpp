@@ -130,8 +130,8 @@ using Groups = std::map<GroupKey, Group>;
 
 /// Adds one trial's residuals, frame by frame, to its recording's phase groups.
 void accumulate(Groups& groups, std::size_t recording, LabTest test, const Track& track,
-                const std::vector<ReplaySample>& replay, double sigma, const Alignment& alignment, double cutoff,
-                bool training, std::size_t trial) {
+                const std::vector<ReplaySample>& replay, const Weights& sigma, const Alignment& alignment,
+                double cutoff, bool training, std::size_t trial) {
   const PhaseMarks marks = phase_marks(replay, test);
   const auto frames = residuals(track, replay, sigma, alignment);
   Phase current = Phase::Hold;
@@ -899,8 +899,9 @@ Groups phase_groups(const Context& c, const std::vector<std::size_t>& which, con
   for (std::size_t k = 0; k < which.size(); ++k) {
     const TrackedTrial& tt = c.ev.trials[which[k]];
     const Recording& rec = recs[tt.recording];
-    accumulate(groups, tt.recording, rec.test, *rec.trials[tt.trial].track, scores[k].replay, c.ev.sigma[tt.recording],
-               scores[k].alignment, tt.cutoff, tt.training, which[k]);
+    accumulate(groups, tt.recording, rec.test, *rec.trials[tt.trial].track, scores[k].replay,
+               weights_for(scores[k].replay, c.ev.sigma[tt.recording], c.ev.impact_accuracy), scores[k].alignment,
+               tt.cutoff, tt.training, which[k]);
   }
   return groups;
 }
@@ -1043,6 +1044,135 @@ Decision decide(const std::vector<HypothesisReport>& hypotheses, double min_delt
   return decision;
 }
 
+/// Beyond the release horizons: the recorded trials against replays from the release prior
+/// (diagnose/ensemble.hpp). The coefficients the frame fits left unpinned are calibrated on
+/// the outcomes; a candidate is named when its replays beat that null by the delta-BIC
+/// margin, at a plausible magnitude, and no other comes within the margin (else ambiguous).
+/// Runs when the frame-by-frame stages named nothing.
+Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& baseline,
+                             const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
+                             const DiagnoseOptions& options) {
+  std::vector<FreeCoefficient> free;
+  for (const auto& [surface, coefficient] : c.unpinned) {
+    if (coefficient == Coefficient::StaticFriction) continue;  // a tilt's, fitted frame by frame
+    for (std::size_t b = 0; b < baseline.base.size(); ++b) {
+      if (baseline.base[b].surface == surface) free.push_back({b, coefficient});
+    }
+  }
+  std::vector<Effect> candidates;
+  for (Effect e : effects) {
+    if (e != Effect::StaticKineticFriction) candidates.push_back(e);
+  }
+  EnsembleOptions eo;
+  eo.replays = options.ensemble_replays;
+  eo.orientation_prior_deg = options.orientation_prior_deg;
+  eo.impact_accuracy = options.impact_accuracy;
+  eo.min_delta_bic = options.min_delta_bic;
+  eo.seed = options.seed;
+  auto ens = compare_ensembles(c.ev, baseline, full_scores, free, candidates, eo);
+  if (!ens) return std::unexpected(ens.error());
+  c.evaluations += ens->replays;
+  EnsembleReport report;
+  report.replays = ens->replays;
+  report.outcomes = ens->outcomes;
+  report.null_chi2 = ens->null_chi2;
+  report.recordings = c.names;
+  report.null_comparisons = ens->null_comparisons;
+  report.calibrated = ens->calibrated;
+  for (const auto& f : free) {
+    const auto& surface = baseline.base[f.surface].surface;
+    report.calibrated_here.push_back(fmt::format("{}:{}", surface, coefficient_name(f.coefficient)));
+    result.notes.push_back(
+        fmt::format("{} on {} calibrated on the recorded outcomes against replays from the release prior: {:.4g}",
+                    coefficient_name(f.coefficient), surface,
+                    coefficient_of(ens->calibrated[f.surface].interaction, f.coefficient)));
+  }
+  report.hypotheses = ens->hypotheses;
+  report.detectability = ens->detectability;
+  report.trials = ens->trials;
+  const auto library = effect_library();
+  // What the outcomes could decide: a candidate whose strong magnitude would have shown is
+  // decidable (and, not named below, absent); for the others, the trials per set-up at which
+  // it would show.
+  std::vector<std::string> more_trials;
+  for (const auto& d : ens->detectability) {
+    const std::string& name = effect_spec(library, d.effect).name;
+    if (d.strong_signal >= d.needed) {
+      std::erase(result.undecidable, name);
+    } else if (std::find(result.undecidable.begin(), result.undecidable.end(), name) != result.undecidable.end()) {
+      more_trials.push_back(std::isfinite(d.trials_needed) && d.trials_needed <= 1000
+                                ? fmt::format("{} about {:.0f}", name, d.trials_needed)
+                                : fmt::format("{} (the outcomes do not respond to it)", name));
+    }
+  }
+  if (result.verdict == Verdict::None && !more_trials.empty()) {
+    result.experiment = fmt::format(
+        "{}; or repeat each set-up more often: compared as a sample with replays over the unknown release, the "
+        "recorded outcomes would show each at its strong magnitude with these trials per set-up: {}",
+        result.experiment.empty() ? std::string("record each trial's release orientation to a few degrees")
+                                  : result.experiment,
+        fmt::join(more_trials, ", "));
+  }
+  // A candidate passes when it beats the calibrated null by the margin at a plausible value
+  // and leaves the outcomes consistent with the recordings (chi^2 tail >= 1e-4 over the
+  // outcomes less its parameters): a better fit that still misses by far explains nothing.
+  std::vector<const EnsembleHypothesis*> passing;
+  for (const auto& h : ens->hypotheses) {
+    const double dof = ens->outcomes - static_cast<double>(h.values.size());
+    const bool consistent = chi2_tail(h.chi2, dof) >= 1e-4;
+    if (h.plausible && h.delta_bic >= options.min_delta_bic && consistent) passing.push_back(&h);
+    if (h.plausible && h.delta_bic >= options.min_delta_bic && !consistent) {
+      result.notes.push_back(fmt::format(
+          "beyond the release horizon {} improves the outcomes by delta-BIC {:.1f} but leaves chi^2 {:.1f} over {} "
+          "recorded means: not an explanation",
+          effect_spec(effect_library(), h.effect).name, h.delta_bic, h.chi2, ens->outcomes));
+    }
+  }
+  if (!ens->outcomes || ens->hypotheses.empty() || passing.empty()) {
+    result.ensemble = std::move(report);
+    return {};
+  }
+  const EnsembleHypothesis& best = *passing.front();
+  const EffectSpec& spec = effect_spec(library, best.effect);
+  const bool close = passing.size() > 1 && best.delta_bic - passing[1]->delta_bic < options.min_delta_bic;
+  if (close) {
+    result.verdict = Verdict::Ambiguous;
+    result.effect.reset();
+    result.candidates = {spec.name, effect_spec(library, passing[1]->effect).name};
+    result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
+    result.statement = fmt::format(
+        "Frame by frame nothing is named, but the recorded outcomes (rebound heights, drifts, roll distances, times "
+        "to rest) differ from replays over the unknown release orientation, and {} and {} explain that about equally "
+        "well (delta-BIC {:.1f} vs {:.1f}). To separate them: {}.",
+        result.candidates[0], result.candidates[1], best.delta_bic, passing[1]->delta_bic, result.experiment);
+  } else {
+    result.verdict = Verdict::Named;
+    result.effect = best.effect;
+    result.effect_parameters.clear();
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k)
+      result.effect_parameters.push_back({spec.parameters[k].name, best.values[k], NAN, NAN});
+    result.improved = best.base;
+    result.unexplained.clear();
+    std::erase(result.undecidable, spec.name);
+    result.statement = fmt::format(
+        "Missing physics found beyond the release horizon: {} ({}), {}. Frame by frame the tracks do not decide it; "
+        "the recorded outcomes against replays from the unknown release orientation do: chi^2 {:.1f} -> {:.1f} over "
+        "{} recorded means (delta-BIC {:.1f}){}.",
+        spec.name, spec.description,
+        fmt::join(result.effect_parameters | std::views::transform([](const ParameterValue& p) {
+                    return fmt::format("{} = {:.4g}", p.name, p.value);
+                  }),
+                  ", "),
+        ens->null_chi2, best.chi2, ens->outcomes, best.delta_bic,
+        passing.size() > 1 ? fmt::format("; next: {} at delta-BIC {:.1f}",
+                                         effect_spec(library, passing[1]->effect).name, passing[1]->delta_bic)
+                           : std::string());
+    result.experiment.clear();
+  }
+  result.ensemble = std::move(report);
+  return {};
+}
+
 Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
                                 const std::vector<Recording>& recordings, const std::vector<std::string>& names,
                                 const DiagnoseOptions& options, const RunContext& run) {
@@ -1053,6 +1183,16 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     return fail(
         ErrorCode::InvalidArgument,
         fmt::format("the particle model's accuracy must lie in [0, 10] mm, not {} m", options.model_accuracy_m));
+  }
+  if (!(options.impact_accuracy >= 0.0 && options.impact_accuracy <= 0.2)) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("the accuracy of a replayed impact's outgoing speed must lie in [0, 20] %, not {} %",
+                            100.0 * options.impact_accuracy));
+  }
+  if (options.ensemble_replays != 0 && (options.ensemble_replays < 4 || options.ensemble_replays > 1000)) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("replays per recording for the ensemble comparison must be 0 (skip) or 4 to 1000, not {}",
+                            options.ensemble_replays));
   }
   if (options.release_orientations < 2 || options.release_orientations > 1000) {
     return fail(
@@ -1078,6 +1218,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   c.ev.table = &table;
   c.ev.recordings = &recordings;
   c.ev.lab = options.lab;
+  c.ev.impact_accuracy = options.impact_accuracy;
   // Noise level per recording, from its own tracks.
   std::vector<double> camera_noise;
   for (std::size_t r = 0; r < recordings.size(); ++r) {
@@ -1639,6 +1780,11 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
             "with a sphere of the same material, whose path does not depend on it";
       }
     }
+  }
+  if (!named && result.verdict != Verdict::Ambiguous && options.ensemble_replays > 0) {
+    run.report("ensembles", 0.9);
+    if (auto ok = judge_ensembles(c, result, baseline, *full_base, effects, options); !ok)
+      return std::unexpected(ok.error());
   }
   // Plots: each recording's first trial against both models.
   for (std::size_t r = 0; r < recordings.size(); ++r) {

@@ -24,6 +24,7 @@
 #include "core/run_context.hpp"
 #include "dem/lab.hpp"
 #include "diagnose/effects.hpp"
+#include "diagnose/ensemble.hpp"
 
 namespace clumpforge {
 
@@ -39,6 +40,13 @@ struct DiagnoseOptions {
   /// [0, 0.01]: residuals are weighed against hypot(camera noise, this). 0 trusts the model
   /// as much as the camera (data made by the diagnoser's own model).
   double model_accuracy_m = 3e-4;
+  /// How closely a replay's speed leaving an impact follows a real particle's, relative,
+  /// [0, 0.2]: the position error it leaves grows with the time since the impact (see
+  /// Weights in diagnose/tracks.hpp). 0 trusts replayed impacts exactly.
+  double impact_accuracy = 0.01;
+  /// Replays per drop and roll recording, from release orientations drawn from the prior,
+  /// for the comparison beyond the release horizon (see diagnose/ensemble.hpp); 0 skips it.
+  int ensemble_replays = 12;
   std::uint64_t seed = 1;
 };
 
@@ -105,6 +113,20 @@ struct TrackComparison {
 /// accuracy that an effect explains.
 enum class Verdict { None, Named, Ambiguous, Unexplained, Undecidable };
 
+/// The comparison beyond the release horizon (diagnose/ensemble.hpp), when it ran.
+struct EnsembleReport {
+  int replays = 0;                      ///< DEM replays it ran
+  int outcomes = 0;                     ///< recorded means compared
+  std::vector<std::string> recordings;  ///< names, indexed by OutcomeComparison::recording
+  double null_chi2 = 0.0;
+  std::vector<OutcomeComparison> null_comparisons;  ///< the calibrated null against the recordings
+  std::vector<SurfaceParameters> calibrated;        ///< the null's coefficients
+  std::vector<std::string> calibrated_here;         ///< "surface:coefficient" calibrated on the outcomes
+  std::vector<EnsembleHypothesis> hypotheses;       ///< tried with replays, best first
+  std::vector<Detectability> detectability;         ///< per candidate
+  double trials = 0.0;                              ///< recorded trials per recording (mean)
+};
+
 struct DiagnoseResult {
   Verdict verdict = Verdict::None;
   std::optional<Effect> effect;         ///< the named effect (verdict Named)
@@ -125,6 +147,7 @@ struct DiagnoseResult {
   std::vector<std::string> notes;
   bool summaries_only = false;  ///< no tracks: what summaries can and cannot decide (in `decidable`, `undecidable`)
   std::vector<std::string> decidable, undecidable;
+  std::optional<EnsembleReport> ensemble;
   int tracked_trials = 0, training_trials = 0, evaluations = 0;
   double seconds = 0.0;
 };

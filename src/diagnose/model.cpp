@@ -82,7 +82,7 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
     replay.record_from = tt.record_from;
     auto samples = replay_trial(*worlds[tt.recording], recording, tt.orientation, options[tt.recording], replay);
     const Track& track = *recording.trials[tt.trial].track;
-    const double sigma = ev.sigma[tt.recording];
+    const Weights sigma = weights_for(samples, ev.sigma[tt.recording], ev.impact_accuracy);
     TrialScore& score = scores[k];
     // The time origin is chosen on the first phase (free fall, the incline), where the
     // release alone decides the motion; a later misfit then shows where it is.

@@ -54,7 +54,8 @@ struct Evaluator {
   const Clump* clump = nullptr;
   const MaterialTable* table = nullptr;
   const std::vector<Recording>* recordings = nullptr;
-  std::vector<double> sigma;  ///< per recording [m]
+  std::vector<double> sigma;      ///< per recording [m]
+  double impact_accuracy = 0.01;  ///< relative accuracy of a replay's speed leaving an impact (see Weights)
   std::vector<TrackedTrial> trials;
   LabOptions lab;  ///< contact settings, time step, particle material
   /// Steps per Hertz contact in drops: the rebound is where restitution must come back within

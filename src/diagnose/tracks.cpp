@@ -55,7 +55,34 @@ ReplayPoint interpolate(const std::vector<ReplaySample>& replay, double t) {
   return {replay[i].x + f * (replay[i + 1].x - replay[i].x), replay[i].z + f * (replay[i + 1].z - replay[i].z), i};
 }
 
-Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift,
+Weights weights_for(const std::vector<ReplaySample>& replay, double sigma, double impact_accuracy) {
+  Weights w(sigma);
+  if (impact_accuracy <= 0.0 || replay.empty()) return w;
+  // Each separation (contacts to none) starts an error that grows with the speed it left
+  // with, frozen when the next contact begins; independent impacts add in quadrature.
+  w.growth.assign(replay.size(), 0.0);
+  double frozen = 0.0;  // squared errors of the impacts whose flights have ended [m^2]
+  double left_at = 0.0, left_speed = 0.0;
+  bool flying = false;
+  for (std::size_t k = 1; k < replay.size(); ++k) {
+    if (replay[k - 1].contacts > 0 && replay[k].contacts == 0) {
+      flying = true;
+      left_at = replay[k].t;
+      left_speed = replay[k].speed;
+    }
+    const double open = flying ? impact_accuracy * left_speed * (replay[k].t - left_at) : 0.0;
+    if (flying && replay[k].contacts > 0) {
+      frozen += open * open;
+      flying = false;
+      w.growth[k] = std::sqrt(frozen);
+      continue;
+    }
+    w.growth[k] = std::sqrt(frozen + open * open);
+  }
+  return w;
+}
+
+Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, double shift,
                    double x_offset, double z_offset, double cutoff) {
   Alignment a;
   a.shift = shift;
@@ -65,12 +92,12 @@ Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, 
     if (track.t[i] > cutoff) break;
     const ReplayPoint p = interpolate(replay, track.t[i] - shift);
     if (std::isfinite(track.x[i])) {
-      const double r = (track.x[i] - p.x - x_offset) / sigma;
+      const double r = (track.x[i] - p.x - x_offset) / sigma.at(p.index);
       a.chi_squared += r * r;
       ++a.values;
     }
     if (std::isfinite(track.z[i])) {
-      const double r = (track.z[i] - p.z - z_offset) / sigma;
+      const double r = (track.z[i] - p.z - z_offset) / sigma.at(p.index);
       a.chi_squared += r * r;
       ++a.values;
     }
@@ -78,7 +105,7 @@ Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, 
   return a;
 }
 
-Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift,
+Alignment score(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, double shift,
                 OriginFit origins, double cutoff) {
   // Each fitted origin is the mean residual of its axis (least squares).
   double sum_x = 0.0, sum_z = 0.0;
@@ -101,7 +128,7 @@ Alignment score(const Track& track, const std::vector<ReplaySample>& replay, dou
                   cutoff);
 }
 
-Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, OriginFit origins,
+Alignment align(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, OriginFit origins,
                 double guess, double half_range, double step, double cutoff, double align_cutoff) {
   const double fit_cutoff = std::min(cutoff, align_cutoff);
   Alignment best = score(track, replay, sigma, guess, origins, fit_cutoff);
@@ -185,7 +212,7 @@ double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s,
   return track.t.front();
 }
 
-std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, double sigma,
+std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma,
                                      const Alignment& a) {
   std::vector<FrameResidual> out;
   out.reserve(track.size());
@@ -195,10 +222,10 @@ std::vector<FrameResidual> residuals(const Track& track, const std::vector<Repla
     FrameResidual r;
     r.t = t;
     r.sample = p.index;
-    r.rx =
-        std::isfinite(track.x[i]) ? (track.x[i] - p.x - a.x_offset) / sigma : std::numeric_limits<double>::quiet_NaN();
-    r.rz =
-        std::isfinite(track.z[i]) ? (track.z[i] - p.z - a.z_offset) / sigma : std::numeric_limits<double>::quiet_NaN();
+    r.rx = std::isfinite(track.x[i]) ? (track.x[i] - p.x - a.x_offset) / sigma.at(p.index)
+                                     : std::numeric_limits<double>::quiet_NaN();
+    r.rz = std::isfinite(track.z[i]) ? (track.z[i] - p.z - a.z_offset) / sigma.at(p.index)
+                                     : std::numeric_limits<double>::quiet_NaN();
     out.push_back(r);
   }
   return out;

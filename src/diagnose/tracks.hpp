@@ -3,6 +3,7 @@
 /// time origin is unknown (a shift is fitted per track), a drop's or tilt's horizontal origin
 /// too (an offset), frames may be missing and cells empty, and positions carry noise whose
 /// level is estimated from the data. The tracked point is the body's visible centroid.
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -43,22 +44,36 @@ struct Alignment {
   int values = 0;  ///< recorded cells used
 };
 
+/// How far a recorded frame may lie from a replay, per replay sample: the noise with the
+/// particle model's accuracy (`sigma`), and after each impact a part that grows: no particle
+/// model reproduces the speed a body leaves a contact with to better than about 1 %
+/// (`impact_accuracy`; the contact law, gravity during a millisecond-long soft contact), so
+/// the position error an impact leaves grows as impact_accuracy * v * (time since it) until
+/// the next contact. Without impacts (a free flight, a roll, a slide) it is `sigma`.
+struct Weights {
+  double sigma = 1.0;
+  std::vector<double> growth;      ///< per replay sample [m]; empty: none
+  Weights(double s) : sigma(s) {}  // NOLINT(google-explicit-constructor): a bare sigma is the common case
+  double at(std::size_t sample) const { return sample < growth.size() ? std::hypot(sigma, growth[sample]) : sigma; }
+};
+Weights weights_for(const std::vector<ReplaySample>& replay, double sigma, double impact_accuracy);
+
 /// chi^2 of `track` against `replay` for a given shift (the origins in `origins` fitted), over
 /// the frames recorded up to `cutoff` (recorded time; beyond it the release state cannot
 /// predict the trajectory, see TrackedTrial::horizon). The cutoff does not move with the
 /// shift, so every shift is scored on the same frames.
-Alignment score(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift,
+Alignment score(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, double shift,
                 OriginFit origins, double cutoff = std::numeric_limits<double>::infinity());
 
 /// chi^2 at a given shift and origin offsets, frames recorded up to `cutoff`.
-Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, double sigma, double shift,
+Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, double shift,
                    double x_offset, double z_offset, double cutoff = std::numeric_limits<double>::infinity());
 
 /// Best shift in [guess - half_range, guess + half_range]: a grid of `step`, then a golden
 /// section to 1 microsecond around the best grid point. The shift (and x offset) is chosen
 /// on the frames up to `align_cutoff` (recorded time: the first phase, where the release
 /// alone decides the motion); the returned chi^2 covers the frames up to `cutoff`.
-Alignment align(const Track& track, const std::vector<ReplaySample>& replay, double sigma, OriginFit origins,
+Alignment align(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, OriginFit origins,
                 double guess, double half_range, double step, double cutoff = std::numeric_limits<double>::infinity(),
                 double align_cutoff = std::numeric_limits<double>::infinity());
 
@@ -73,7 +88,7 @@ struct FrameResidual {
   double rx = 0.0, rz = 0.0;  ///< (recorded - replay) / sigma; NaN for an empty cell
   std::size_t sample = 0;     ///< replay sample index at t
 };
-std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, double sigma,
+std::vector<FrameResidual> residuals(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma,
                                      const Alignment& a);
 
 }  // namespace clumpforge

@@ -1,0 +1,500 @@
+#include "diagnose/ensemble.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "diagnose/release.hpp"
+#include "diagnose/tracks.hpp"
+
+namespace clumpforge {
+
+std::string_view outcome_name(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::ReboundHeight:
+      return "rebound_height";
+    case Outcome::Drift:
+      return "drift";
+    case Outcome::RollDistance:
+      return "roll_distance";
+    case Outcome::RollTime:
+      return "roll_time";
+  }
+  return "?";
+}
+
+namespace {
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+std::vector<Outcome> outcomes_of(LabTest test) {
+  if (test == LabTest::Drop) return {Outcome::ReboundHeight, Outcome::Drift};
+  if (test == LabTest::Roll) return {Outcome::RollDistance, Outcome::RollTime};
+  return {};
+}
+
+}  // namespace
+
+std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved) {
+  std::vector<std::size_t> valid;
+  for (std::size_t i = 0; i < path.t.size(); ++i) {
+    if (path.t[i] >= 0.0 && std::isfinite(path.x[i]) && std::isfinite(path.z[i])) valid.push_back(i);
+  }
+  if (valid.size() < 10 || (test != LabTest::Drop && test != LabTest::Roll)) return {};
+  // Where it came to rest: the median of its last ten frames.
+  std::vector<double> xs, zs;
+  for (std::size_t k = valid.size() - 10; k < valid.size(); ++k) {
+    xs.push_back(path.x[valid[k]]);
+    zs.push_back(path.z[valid[k]]);
+  }
+  const double x_rest = median_of(xs), z_rest = median_of(zs);
+  // Time to rest: the last frame farther than `moved` from the rest point.
+  double rest_time = 0.0;
+  for (std::size_t i : valid) {
+    if (std::hypot(path.x[i] - x_rest, path.z[i] - z_rest) > moved) rest_time = path.t[i];
+  }
+  if (test == LabTest::Roll) return {{Outcome::RollDistance, x_rest}, {Outcome::RollTime, rest_time}};
+  // The first impact: the lowest point before the path first rises by `moved` above its
+  // running minimum; the rebound height is the highest point after it, above the rest height.
+  double low = path.z[valid.front()];
+  std::size_t low_at = 0;
+  std::optional<std::size_t> impact;
+  for (std::size_t k = 0; k < valid.size(); ++k) {
+    const double z = path.z[valid[k]];
+    if (z < low) {
+      low = z;
+      low_at = k;
+    } else if (z > low + moved) {
+      impact = low_at;
+      break;
+    }
+  }
+  double rebound = 0.0;
+  if (impact) {
+    double apex = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = *impact; k < valid.size(); ++k) apex = std::max(apex, path.z[valid[k]]);
+    rebound = std::max(0.0, apex - z_rest);
+  }
+  // No time to rest for a drop: a lab's track often ends before a tumbling body settles, and
+  // the replays' would measure where the replay stops, not the body.
+  return {{Outcome::ReboundHeight, rebound}, {Outcome::Drift, std::abs(x_rest)}};
+}
+
+OutcomeComparison compare_outcome(const std::vector<double>& recorded, const std::vector<double>& ensemble,
+                                  double floor) {
+  OutcomeComparison c;
+  c.floor = floor;
+  auto moments = [](const std::vector<double>& v, double& mean, double& ss) {
+    mean = 0.0;
+    for (double x : v) mean += x;
+    mean /= static_cast<double>(std::max<std::size_t>(1, v.size()));
+    ss = 0.0;
+    for (double x : v) ss += (x - mean) * (x - mean);
+  };
+  double ss_r = 0.0, ss_e = 0.0;
+  moments(recorded, c.recorded_mean, ss_r);
+  moments(ensemble, c.ensemble_mean, ss_e);
+  c.recorded_n = static_cast<int>(recorded.size());
+  c.ensemble_n = static_cast<int>(ensemble.size());
+  c.recorded_sd = c.recorded_n > 1 ? std::sqrt(ss_r / (c.recorded_n - 1)) : 0.0;
+  c.ensemble_sd = c.ensemble_n > 1 ? std::sqrt(ss_e / (c.ensemble_n - 1)) : 0.0;
+  const int dof = c.recorded_n + c.ensemble_n - 2;
+  const double pooled = dof > 0 ? (ss_r + ss_e) / dof : 0.0;
+  const double se2 = c.recorded_n > 0 && c.ensemble_n > 0
+                         ? pooled * (1.0 / c.recorded_n + 1.0 / c.ensemble_n) + floor * floor
+                         : floor * floor;
+  c.z = se2 > 0.0 ? (c.recorded_mean - c.ensemble_mean) / std::sqrt(se2) : 0.0;
+  return c;
+}
+
+namespace {
+
+/// One recording compared: its recorded outcomes and the orientations its replays start from.
+struct Plan {
+  std::size_t recording = 0;
+  std::vector<Outcome> outcomes;
+  std::vector<std::vector<double>> recorded;  ///< [outcome][trial]
+  std::vector<Eigen::Quaterniond> orientations;
+  double duration = 0.0, frame = 1e-3, moved = 1e-3, sigma = 1e-4;
+};
+
+using Sample = std::vector<std::vector<std::vector<double>>>;  ///< [plan][outcome][replay]
+
+PathSample recorded_path(const Track& track, const TrialScore& score) {
+  PathSample p;
+  const double x0 = score.replay.empty() ? 0.0 : interpolate(score.replay, 0.0).x;
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    p.t.push_back(track.t[i] - score.alignment.shift);
+    p.x.push_back(track.x[i] - score.alignment.x_offset - x0);
+    p.z.push_back(track.z[i] - score.alignment.z_offset);
+  }
+  return p;
+}
+
+std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>& scores,
+                             const EnsembleOptions& options) {
+  const auto& recs = *ev.recordings;
+  std::vector<Plan> plans;
+  for (std::size_t r = 0; r < recs.size(); ++r) {
+    const Recording& rec = recs[r];
+    Plan plan;
+    plan.recording = r;
+    plan.outcomes = outcomes_of(rec.test);
+    if (plan.outcomes.empty()) continue;
+    plan.sigma = ev.sigma[r];
+    plan.moved = std::max(1e-3, 6.0 * ev.sigma[r]);
+    plan.recorded.resize(plan.outcomes.size());
+    std::optional<Eigen::Quaterniond> shared;
+    bool every_recorded = true;
+    for (std::size_t i = 0; i < ev.trials.size(); ++i) {
+      const TrackedTrial& tt = ev.trials[i];
+      if (tt.recording != r) continue;
+      const Track& track = *rec.trials[tt.trial].track;
+      plan.frame = frame_interval(track);
+      plan.duration = std::max(plan.duration, tt.duration);
+      const auto measured = measure_outcomes(rec.test, recorded_path(track, scores[i]), plan.moved);
+      for (std::size_t k = 0; k < measured.size(); ++k) plan.recorded[k].push_back(measured[k].second);
+      every_recorded = every_recorded && rec.trials[tt.trial].release_orientation.has_value();
+      if (!shared && rec.trials[tt.trial].release_orientation) shared = rec.trials[tt.trial].release_orientation;
+    }
+    if (plan.recorded.front().size() < 2) continue;
+    // The prior: uniform unless every trial carries a recorded orientation (then a ball
+    // about the first, a lab's orientations being alike; never exact).
+    OrientationPrior prior;
+    prior.spread = options.orientation_prior_deg * std::numbers::pi / 180.0;
+    if (every_recorded) prior.recorded = shared;
+    plan.orientations = draw_release_orientations(rec.test, prior, options.replays, options.seed, 90000 + r);
+    plans.push_back(std::move(plan));
+  }
+  return plans;
+}
+
+/// The outcomes of every plan's replays under `model`; plans in `skip` keep `reuse`'s values.
+Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const std::vector<Plan>& plans,
+                               const std::vector<bool>& run, const Sample* reuse, int& replays) {
+  const auto& recs = *ev.recordings;
+  Sample out(plans.size());
+  for (std::size_t p = 0; p < plans.size(); ++p) {
+    const Plan& plan = plans[p];
+    if (!run[p] && reuse != nullptr) {
+      out[p] = (*reuse)[p];
+      continue;
+    }
+    const Recording& rec = recs[plan.recording];
+    const LabOptions lab = lab_options_for(ev, model, rec);
+    auto world = make_lab_world(*ev.clump, *ev.table, rec, lab);
+    if (!world) return std::unexpected(world.error());
+    std::vector<std::vector<std::pair<Outcome, double>>> measured(plan.orientations.size());
+    tbb::parallel_for(std::size_t{0}, plan.orientations.size(), [&](std::size_t k) {
+      ReplayOptions replay;
+      replay.duration = plan.duration;
+      replay.sample_interval = plan.frame;  // sampled as the camera samples
+      const auto samples = replay_trial(*world, rec, plan.orientations[k], lab, replay);
+      PathSample path;
+      const double x0 = samples.empty() ? 0.0 : samples.front().x;
+      for (const auto& s : samples) {
+        path.t.push_back(s.t);
+        path.x.push_back(s.x - x0);
+        path.z.push_back(s.z);
+      }
+      measured[k] = measure_outcomes(rec.test, path, plan.moved);
+    });
+    replays += static_cast<int>(plan.orientations.size());
+    out[p].assign(plan.outcomes.size(), {});
+    for (const auto& m : measured) {
+      for (std::size_t o = 0; o < m.size() && o < plan.outcomes.size(); ++o) out[p][o].push_back(m[o].second);
+    }
+  }
+  return out;
+}
+
+double floor_for(const Plan& plan, Outcome outcome, double recorded_mean, double impact_accuracy) {
+  const double scaled = 2.0 * impact_accuracy * std::abs(recorded_mean);
+  switch (outcome) {
+    case Outcome::ReboundHeight:
+    case Outcome::RollDistance:
+      return std::hypot(3.0 * plan.sigma, scaled);
+    case Outcome::Drift:
+      return std::hypot(3.0 * plan.sigma, 1e-3, scaled);
+    case Outcome::RollTime:
+      return std::hypot(2.0 * plan.frame, scaled);
+  }
+  return scaled;
+}
+
+std::vector<OutcomeComparison> compare_all(const std::vector<Plan>& plans, const Sample& sample,
+                                           double impact_accuracy) {
+  std::vector<OutcomeComparison> out;
+  for (std::size_t p = 0; p < plans.size(); ++p) {
+    for (std::size_t o = 0; o < plans[p].outcomes.size(); ++o) {
+      const auto& rec = plans[p].recorded[o];
+      double mean = 0.0;
+      for (double v : rec) mean += v;
+      mean /= static_cast<double>(std::max<std::size_t>(1, rec.size()));
+      OutcomeComparison c =
+          compare_outcome(rec, sample[p][o], floor_for(plans[p], plans[p].outcomes[o], mean, impact_accuracy));
+      c.recording = plans[p].recording;
+      c.outcome = plans[p].outcomes[o];
+      out.push_back(c);
+    }
+  }
+  return out;
+}
+
+double chi2_of(const std::vector<OutcomeComparison>& c) {
+  double sum = 0.0;
+  for (const auto& x : c) sum += x.z * x.z;
+  return sum;
+}
+
+/// Ensemble means as one vector, in compare_all's order.
+Eigen::VectorXd means_of(const std::vector<OutcomeComparison>& c) {
+  Eigen::VectorXd v(static_cast<Eigen::Index>(c.size()));
+  for (std::size_t j = 0; j < c.size(); ++j) v(static_cast<Eigen::Index>(j)) = c[j].ensemble_mean;
+  return v;
+}
+
+/// The effect's parameters at level u: 0 none, 1 realistic, 2 strong, linear between (in
+/// log10 for a log-scale parameter) and beyond, within the search range.
+std::vector<double> effect_values(const EffectSpec& spec, double u) {
+  std::vector<double> values;
+  for (const auto& p : spec.parameters) {
+    const double none = p.log_scale ? p.upper : (p.lower <= 0.0 && p.upper >= 0.0 ? 0.0 : p.lower);
+    auto map = [&](double v) { return p.log_scale ? std::log10(v) : v; };
+    const double a = map(none), b = map(p.realistic), s = map(p.strong);
+    const double m = u <= 1.0 ? a + u * (b - a) : b + (u - 1.0) * (s - b);
+    const double v = p.log_scale ? std::pow(10.0, m) : m;
+    values.push_back(std::clamp(v, std::min(p.lower, p.upper), std::max(p.lower, p.upper)));
+  }
+  return values;
+}
+
+double coefficient_step(Coefficient c, double value) {
+  return c == Coefficient::Restitution       ? (value > 0.5 ? -0.05 : 0.05)
+         : c == Coefficient::RollingFriction ? 0.005
+                                             : 0.05;
+}
+
+std::pair<double, double> free_range(Coefficient c) {
+  return c == Coefficient::Restitution       ? std::pair{0.1, 0.97}
+         : c == Coefficient::RollingFriction ? std::pair{0.0, 0.12}
+                                             : std::pair{0.05, 1.3};
+}
+
+/// The surrogate's best coefficient changes for ensemble means `target_shift` away:
+/// weighted least squares of (recorded - mean - J dc) / se, within the coefficients' ranges.
+Eigen::VectorXd solve_coefficients(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residual,
+                                   const Eigen::VectorXd& inverse_se) {
+  if (jacobian.cols() == 0) return Eigen::VectorXd();
+  const Eigen::MatrixXd a = inverse_se.asDiagonal() * jacobian;
+  const Eigen::VectorXd b = inverse_se.asDiagonal() * residual;
+  return a.colPivHouseholderQr().solve(b);
+}
+
+Model with_coefficients(const Model& start, const std::vector<FreeCoefficient>& free, const Eigen::VectorXd& delta) {
+  Model m = start;
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    double& v = coefficient_of(m.base[free[k].surface].interaction, free[k].coefficient);
+    const auto [low, high] = free_range(free[k].coefficient);
+    v = std::clamp(v + delta(static_cast<Eigen::Index>(k)), low, high);
+  }
+  return m;
+}
+
+struct Proposal {
+  Effect effect = Effect::AirDrag;
+  double level = 0.0, predicted = 0.0;
+  Eigen::VectorXd delta;
+};
+
+/// A candidate's response at its realistic and strong magnitudes (new replays, the same
+/// orientations), its detectability, and the surrogate's best level: a proposal when the
+/// surrogate's delta-BIC reaches the margin.
+Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<Plan>& plans, const Model& null_model,
+                                        const Sample& null_sample, const Eigen::VectorXd& null_means,
+                                        const Eigen::VectorXd& recorded, const Eigen::VectorXd& inverse_se,
+                                        const Eigen::MatrixXd& jacobian, const std::vector<FreeCoefficient>& free,
+                                        const EffectSpec& spec, const EnsembleOptions& options,
+                                        EnsembleResult& result) {
+  const auto& recs = *ev.recordings;
+  std::vector<bool> run(plans.size());
+  bool any = false;
+  for (std::size_t p = 0; p < plans.size(); ++p) {
+    run[p] = std::find(spec.tests.begin(), spec.tests.end(), recs[plans[p].recording].test) != spec.tests.end();
+    any = any || run[p];
+  }
+  if (!any) return std::nullopt;
+  std::array<Eigen::VectorXd, 2> response;
+  for (int level = 1; level <= 2; ++level) {
+    Model m = null_model;
+    m.effect = spec.effect;
+    m.values = effect_values(spec, level);
+    auto out = replay_outcomes(ev, m, plans, run, &null_sample, result.replays);
+    if (!out) return std::unexpected(out.error());
+    response[level - 1] = means_of(compare_all(plans, *out, options.impact_accuracy)) - null_means;
+  }
+  const double penalty = static_cast<double>(spec.parameters.size()) * std::log(std::max(1, result.outcomes));
+  {
+    // Its strong magnitude's signal with what the free coefficients absorb projected out;
+    // the standard errors fall as 1/sqrt(trials), so the signal grows with them.
+    const Eigen::VectorXd weighted = inverse_se.asDiagonal() * response[1];
+    Eigen::VectorXd kept = weighted;
+    if (!free.empty()) {
+      const Eigen::MatrixXd a = inverse_se.asDiagonal() * jacobian;
+      kept = weighted - a * a.colPivHouseholderQr().solve(weighted);
+    }
+    Detectability d{spec.effect, kept.squaredNorm(), options.min_delta_bic + penalty,
+                    std::numeric_limits<double>::infinity()};
+    if (d.strong_signal > 0.0) d.trials_needed = std::ceil(result.trials * d.needed / d.strong_signal);
+    result.detectability.push_back(d);
+  }
+  Proposal best{spec.effect, 0.0, result.null_chi2, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()))};
+  for (int step = 1; step <= 60; ++step) {
+    const double u = 0.05 * step;
+    const Eigen::VectorXd shift = u <= 1.0 ? Eigen::VectorXd(u * response[0])
+                                           : Eigen::VectorXd(response[0] + (u - 1.0) * (response[1] - response[0]));
+    const Eigen::VectorXd residual = recorded - null_means - shift;
+    const Eigen::VectorXd delta = solve_coefficients(jacobian, residual, inverse_se);
+    const Eigen::VectorXd left = free.empty() ? residual : Eigen::VectorXd(residual - jacobian * delta);
+    const double chi2 = (inverse_se.asDiagonal() * left).squaredNorm();
+    if (chi2 < best.predicted) best = {spec.effect, u, chi2, free.empty() ? Eigen::VectorXd() : delta};
+  }
+  if (best.level > 0.0 && result.null_chi2 - best.predicted - penalty >= options.min_delta_bic) return best;
+  return std::nullopt;
+}
+
+/// A proposal judged by new replays at its level, and (when that beats the null by the
+/// margin) at 0.6 and 1.6 times it: the surrogate is linear, the outcomes are not.
+Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>& plans, const Model& null_model,
+                                   const std::vector<FreeCoefficient>& free, const EffectSpec& spec, const Proposal& p,
+                                   const EnsembleOptions& options, EnsembleResult& result) {
+  const std::vector<bool> every(plans.size(), true);
+  const double penalty = static_cast<double>(spec.parameters.size()) * std::log(std::max(1, result.outcomes));
+  EnsembleHypothesis best;
+  best.chi2 = std::numeric_limits<double>::infinity();
+  for (double factor : {1.0, 0.6, 1.6}) {
+    if (factor != 1.0 && best.delta_bic < options.min_delta_bic) break;
+    Model m = free.empty() ? null_model : with_coefficients(null_model, free, p.delta);
+    m.effect = spec.effect;
+    m.values = effect_values(spec, p.level * factor);
+    auto out = replay_outcomes(ev, m, plans, every, nullptr, result.replays);
+    if (!out) return std::unexpected(out.error());
+    auto cmp = compare_all(plans, *out, options.impact_accuracy);
+    if (chi2_of(cmp) >= best.chi2) continue;
+    best.effect = spec.effect;
+    best.values = m.values;
+    best.base = m.base;
+    best.chi2 = chi2_of(cmp);
+    best.delta_bic = result.null_chi2 - best.chi2 - penalty;
+    best.comparisons = std::move(cmp);
+    best.plausible = true;
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
+      const auto& q = spec.parameters[k];
+      best.plausible = best.plausible && m.values[k] >= q.plausible_low && m.values[k] <= q.plausible_high;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& baseline,
+                                         const std::vector<TrialScore>& scores,
+                                         const std::vector<FreeCoefficient>& free,
+                                         const std::vector<Effect>& candidates, const EnsembleOptions& options) {
+  if (options.replays < 4) return fail(ErrorCode::InvalidArgument, "an ensemble needs 4 or more replays");
+  if (scores.size() != ev.trials.size())
+    return fail(ErrorCode::InvalidArgument, "one full-duration score per tracked trial is needed");
+  const auto& recs = *ev.recordings;
+  EnsembleResult result;
+  const std::vector<Plan> plans = make_plans(ev, scores, options);
+  if (plans.empty()) return result;
+  for (const Plan& p : plans) result.trials += static_cast<double>(p.recorded.front().size()) / plans.size();
+  const std::vector<bool> every(plans.size(), true);
+  auto base = replay_outcomes(ev, baseline, plans, every, nullptr, result.replays);
+  if (!base) return std::unexpected(base.error());
+  const auto base_cmp = compare_all(plans, *base, options.impact_accuracy);
+  result.outcomes = static_cast<int>(base_cmp.size());
+  Eigen::VectorXd recorded(result.outcomes), inverse_se(result.outcomes);
+  for (std::size_t j = 0; j < base_cmp.size(); ++j) {
+    const auto& c = base_cmp[j];
+    recorded(static_cast<Eigen::Index>(j)) = c.recorded_mean;
+    const double diff = c.recorded_mean - c.ensemble_mean;
+    inverse_se(static_cast<Eigen::Index>(j)) = c.z != 0.0 ? std::abs(c.z / diff) : 1.0 / std::max(c.floor, 1e-12);
+  }
+  // The free coefficients' responses (one set of replays each, only where they act).
+  Eigen::MatrixXd jacobian(result.outcomes, static_cast<Eigen::Index>(free.size()));
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    Model moved = baseline;
+    const std::string& surface = baseline.base[free[k].surface].surface;
+    double& v = coefficient_of(moved.base[free[k].surface].interaction, free[k].coefficient);
+    const double h = coefficient_step(free[k].coefficient, v);
+    v += h;
+    std::vector<bool> run(plans.size());
+    for (std::size_t p = 0; p < plans.size(); ++p) run[p] = recs[plans[p].recording].surface == surface;
+    auto out = replay_outcomes(ev, moved, plans, run, &*base, result.replays);
+    if (!out) return std::unexpected(out.error());
+    jacobian.col(static_cast<Eigen::Index>(k)) =
+        (means_of(compare_all(plans, *out, options.impact_accuracy)) - means_of(base_cmp)) / h;
+  }
+  // The calibrated null: Gauss-Newton steps on the outcomes, each judged by new replays, the
+  // response matrix updated from every step taken (Broyden): a tuber's rebound height is
+  // far from linear in its restitution.
+  Model null_model = baseline;
+  Sample null_sample = *base;
+  Eigen::VectorXd means = means_of(base_cmp);
+  double chi2 = chi2_of(base_cmp);
+  for (int iteration = 0; iteration < 4 && !free.empty(); ++iteration) {
+    const Model trial = with_coefficients(null_model, free, solve_coefficients(jacobian, recorded - means, inverse_se));
+    Eigen::VectorXd taken(static_cast<Eigen::Index>(free.size()));
+    for (std::size_t k = 0; k < free.size(); ++k) {
+      taken(static_cast<Eigen::Index>(k)) =
+          coefficient_of(trial.base[free[k].surface].interaction, free[k].coefficient) -
+          coefficient_of(null_model.base[free[k].surface].interaction, free[k].coefficient);
+    }
+    if (taken.norm() < 1e-4) break;
+    auto out = replay_outcomes(ev, trial, plans, every, nullptr, result.replays);
+    if (!out) return std::unexpected(out.error());
+    const auto cmp = compare_all(plans, *out, options.impact_accuracy);
+    const Eigen::VectorXd moved = means_of(cmp);
+    jacobian += ((moved - means) - jacobian * taken) * taken.transpose() / taken.squaredNorm();
+    if (chi2_of(cmp) >= chi2) break;
+    chi2 = chi2_of(cmp);
+    null_model = trial;
+    null_sample = std::move(*out);
+    means = moved;
+  }
+  result.calibrated = null_model.base;
+  result.null_comparisons = compare_all(plans, null_sample, options.impact_accuracy);
+  result.null_chi2 = chi2_of(result.null_comparisons);
+  const Eigen::VectorXd null_means = means_of(result.null_comparisons);
+  const auto library = effect_library();
+  std::vector<Proposal> proposals;
+  for (Effect e : candidates) {
+    auto proposal = propose(ev, plans, null_model, null_sample, null_means, recorded, inverse_se, jacobian, free,
+                            effect_spec(library, e), options, result);
+    if (!proposal) return std::unexpected(proposal.error());
+    if (*proposal) proposals.push_back(**proposal);
+  }
+  std::sort(proposals.begin(), proposals.end(),
+            [](const Proposal& a, const Proposal& b) { return a.predicted < b.predicted; });
+  if (proposals.size() > 3) proposals.resize(3);
+  for (const Proposal& p : proposals) {
+    auto h = confirm(ev, plans, null_model, free, effect_spec(library, p.effect), p, options, result);
+    if (!h) return std::unexpected(h.error());
+    result.hypotheses.push_back(std::move(*h));
+  }
+  std::sort(result.hypotheses.begin(), result.hypotheses.end(),
+            [](const EnsembleHypothesis& a, const EnsembleHypothesis& b) { return a.delta_bic > b.delta_bic; });
+  return result;
+}
+
+}  // namespace clumpforge

@@ -1,0 +1,113 @@
+#pragma once
+/// Beyond the release horizon. After its first contact an irregular body's path hangs on its
+/// release orientation, which no lab knows, so no single replay can stand for a trial there.
+/// What can be compared is the recorded trials, as a sample, with replays from release
+/// orientations drawn from the prior: a few outcomes measured alike on both (a drop's
+/// rebound height and its drift from the release point; a roll's distance and time to
+/// rest), recording by recording. The comparison is of means,
+/// each standardised by the pooled trial-to-trial spread and a floor for what no particle
+/// model reproduces (the camera, the impact accuracy).
+///
+/// On that comparison the coefficients the fitted windows left unpinned are calibrated (a
+/// tuber's restitution, its rolling friction) and each candidate effect is tried: its
+/// response is measured at its realistic and strong magnitudes from the same orientations
+/// (common random numbers), a surrogate linear in the coefficients picks its best magnitude,
+/// and new replays at that point decide (delta-BIC against the calibrated null, computed from
+/// replays, never from the surrogate).
+#include <cstdint>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "diagnose/effects.hpp"
+#include "diagnose/model.hpp"
+
+namespace clumpforge {
+
+enum class Outcome { ReboundHeight, Drift, RollDistance, RollTime };
+std::string_view outcome_name(Outcome outcome);
+
+/// A path in the replay's frame: time since release [s], x from the release point and the
+/// tracked point's height [m].
+struct PathSample {
+  std::vector<double> t, x, z;
+};
+
+/// The outcomes of a drop (rebound height above the rest height, drift) or a
+/// roll (distance, time to rest), measured alike on a recorded track and a replay. `moved`
+/// is the displacement that counts as motion [m] (well above the noise). Empty for a tilt
+/// or a path with fewer than 10 frames.
+std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved);
+
+/// One outcome of one recording: the recorded trials against the replays.
+struct OutcomeComparison {
+  std::size_t recording = 0;
+  Outcome outcome = Outcome::ReboundHeight;
+  double recorded_mean = 0.0, recorded_sd = 0.0;
+  double ensemble_mean = 0.0, ensemble_sd = 0.0;
+  int recorded_n = 0, ensemble_n = 0;
+  double floor = 0.0;  ///< what no particle model reproduces, as a standard error
+  double z = 0.0;      ///< (recorded - ensemble mean) / standard error
+};
+
+/// The standardised difference of the means: pooled spread over both samples,
+/// se^2 = s_p^2 (1/n + 1/K) + floor^2.
+OutcomeComparison compare_outcome(const std::vector<double>& recorded, const std::vector<double>& ensemble,
+                                  double floor);
+
+struct EnsembleOptions {
+  int replays = 12;  ///< release orientations per recording, >= 4
+  double orientation_prior_deg = 15.0;
+  double impact_accuracy = 0.01;
+  double min_delta_bic = 10.0;
+  std::uint64_t seed = 1;
+};
+
+/// A candidate effect judged on the outcomes.
+struct EnsembleHypothesis {
+  Effect effect = Effect::AirDrag;
+  std::vector<double> values;           ///< its parameters at the fitted magnitude
+  std::vector<SurfaceParameters> base;  ///< with the free coefficients refitted
+  double chi2 = 0.0;                    ///< from replays at that point
+  double delta_bic = 0.0;               ///< against the calibrated null
+  bool plausible = false;
+  std::vector<OutcomeComparison> comparisons;  ///< its replays against the recordings
+};
+
+/// How well the outcomes could show a candidate: its strong magnitude's signal (delta-chi^2
+/// after the free coefficients absorb what they can, to first order) and the trials per
+/// recording at which that signal would reach the delta-BIC margin.
+struct Detectability {
+  Effect effect = Effect::AirDrag;
+  double strong_signal = 0.0;
+  double needed = 0.0;         ///< delta-chi^2 the margin asks for (margin + k ln n)
+  double trials_needed = 0.0;  ///< per recording; infinity when the outcomes do not respond
+};
+
+struct EnsembleResult {
+  std::vector<SurfaceParameters> calibrated;  ///< the null: free coefficients fitted to the outcomes
+  std::vector<OutcomeComparison> null_comparisons;
+  double null_chi2 = 0.0;
+  int outcomes = 0;
+  std::vector<EnsembleHypothesis> hypotheses;  ///< those the surrogate found worth new replays
+  std::vector<Detectability> detectability;    ///< per candidate tried
+  double trials = 0.0;                         ///< recorded trials per recording (mean)
+  int replays = 0;                             ///< DEM replays run
+};
+
+/// The coefficient of `surface` a fit may move, with its range.
+struct FreeCoefficient {
+  std::size_t surface = 0;  ///< index into Model::base
+  Coefficient coefficient = Coefficient::Restitution;
+};
+
+/// Compares every drop and roll recording's trials with replays from the release prior under
+/// `baseline`, calibrates `free` on the outcomes, and tries `candidates`. `scores` are the
+/// baseline's full-duration scores of ev.trials (alignment and replay of each), which put
+/// the recorded tracks in the replay frame.
+Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& baseline,
+                                         const std::vector<TrialScore>& scores,
+                                         const std::vector<FreeCoefficient>& free,
+                                         const std::vector<Effect>& candidates, const EnsembleOptions& options);
+
+}  // namespace clumpforge

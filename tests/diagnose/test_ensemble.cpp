@@ -1,0 +1,134 @@
+// The comparison beyond the release horizon: outcomes measured on paths with known answers,
+// the test statistic's false-positive rate measured on samples that share a distribution,
+// and the impact-accuracy weights.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/rng.hpp"
+#include "diagnose/ensemble.hpp"
+#include "diagnose/tracks.hpp"
+
+using namespace clumpforge;
+
+namespace {
+
+/// A point dropped from `height` that rebounds once with speed ratio e and then rests on the
+/// plate, sampled at `fps`, drifting sideways by `drift` at the first impact.
+PathSample bouncing_path(double height, double e, double drift, double fps) {
+  constexpr double g = 9.81;
+  const double t1 = std::sqrt(2.0 * height / g), v1 = e * g * t1, flight = 2.0 * v1 / g;
+  PathSample p;
+  for (double t = 0.0; t < t1 + flight + 0.3; t += 1.0 / fps) {
+    double z = 0.0, x = 0.0;
+    if (t < t1) {
+      z = height - 0.5 * g * t * t;
+    } else if (t < t1 + flight) {
+      const double s = t - t1;
+      z = v1 * s - 0.5 * g * s * s;
+      x = drift * s / flight;
+    } else {
+      x = drift;
+    }
+    p.t.push_back(t);
+    p.x.push_back(x);
+    p.z.push_back(z + 0.01);  // the tracked point 10 mm above the plate at rest
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST(EnsembleOutcomes, ReboundHeightAndDriftOfABouncingPath) {
+  // Analytic: rebound height e^2 H; to the frame spacing at 1000 fps (apex curvature g:
+  // 1 ms off the apex lowers it by g dt^2 / 2 = 5 um).
+  const auto outcomes = measure_outcomes(LabTest::Drop, bouncing_path(0.5, 0.6, 0.02, 1000.0), 1e-3);
+  ASSERT_EQ(outcomes.size(), 2u);
+  EXPECT_EQ(outcomes[0].first, Outcome::ReboundHeight);
+  EXPECT_NEAR(outcomes[0].second, 0.36 * 0.5, 1e-4);
+  EXPECT_EQ(outcomes[1].first, Outcome::Drift);
+  EXPECT_NEAR(outcomes[1].second, 0.02, 1e-9);
+  // A dead landing (no rise of a millimetre) has no rebound.
+  const auto dead = measure_outcomes(LabTest::Drop, bouncing_path(0.2, 0.0, 0.0, 1000.0), 1e-3);
+  ASSERT_EQ(dead.size(), 2u);
+  EXPECT_DOUBLE_EQ(dead[0].second, 0.0);
+  // Tilts have no ensemble outcomes; ten frames are the least.
+  EXPECT_TRUE(measure_outcomes(LabTest::Tilt, bouncing_path(0.2, 0.5, 0.0, 1000.0), 1e-3).empty());
+  PathSample short_path;
+  short_path.t = {0, 1e-3, 2e-3};
+  short_path.x = short_path.z = {0, 0, 0};
+  EXPECT_TRUE(measure_outcomes(LabTest::Drop, short_path, 1e-3).empty());
+}
+
+TEST(EnsembleOutcomes, RollDistanceAndTimeToRest) {
+  // Uniform deceleration from 0.3 m/s at 0.5 m/s^2: rest after 0.6 s at 0.09 m.
+  PathSample p;
+  for (double t = 0.0; t < 1.2; t += 1.0 / 250.0) {
+    const double s = std::min(t, 0.6);
+    p.t.push_back(t);
+    p.x.push_back(0.3 * s - 0.25 * s * s);
+    p.z.push_back(0.00935);
+  }
+  const auto outcomes = measure_outcomes(LabTest::Roll, p, 1e-3);
+  ASSERT_EQ(outcomes.size(), 2u);
+  EXPECT_NEAR(outcomes[0].second, 0.09, 1e-9);
+  // 1 mm short of rest: 0.25 (0.6 - t)^2 = 1e-3, t = 0.6 - 0.0632 s, to a frame (4 ms).
+  EXPECT_NEAR(outcomes[1].second, 0.6 - std::sqrt(1e-3 / 0.25), 4e-3);
+}
+
+TEST(EnsembleComparison, StandardisedDifferenceOfMeans) {
+  // Means 1 and 2, spreads 1 and 1 (pooled 1), n = 4, K = 4: se = sqrt(1/4 + 1/4).
+  const auto c = compare_outcome({0.0, 0.5, 1.5, 2.0}, {1.0, 1.5, 2.5, 3.0}, 0.0);
+  EXPECT_NEAR(c.recorded_mean, 1.0, 1e-12);
+  EXPECT_NEAR(c.ensemble_mean, 2.0, 1e-12);
+  const double sd = std::sqrt((1.0 + 0.25 + 0.25 + 1.0) / 3.0);
+  EXPECT_NEAR(c.recorded_sd, sd, 1e-12);
+  EXPECT_NEAR(c.z, -1.0 / (sd * std::sqrt(0.5)), 1e-12);
+  // A floor adds in quadrature: identical degenerate samples 1 mm apart with a 1 mm floor.
+  const auto f = compare_outcome({0.001, 0.001}, {0.0, 0.0, 0.0}, 0.001);
+  EXPECT_NEAR(f.z, 1.0, 1e-12);
+}
+
+TEST(EnsembleComparison, FalsePositiveRateOnSamplesOfOneDistribution) {
+  // The recorded sample (6 trials) and the replays (12) from one skewed distribution, as a
+  // tumbling body's rebound heights are: |z| > 1.96 should happen about 5 % of the time, and
+  // a chi^2 over 15 outcomes beyond its 99.9 % point (37.7) about 0.1 %. Measured over
+  // 4000 sets; tolerances are 4 binomial standard errors and a factor 2 at the tail.
+  Rng rng(17);
+  int beyond = 0, sets_beyond = 0;
+  constexpr int kSets = 4000, kOutcomes = 15;
+  for (int s = 0; s < kSets; ++s) {
+    double chi2 = 0.0;
+    for (int o = 0; o < kOutcomes; ++o) {
+      std::vector<double> recorded, replays;
+      for (int i = 0; i < 6; ++i) recorded.push_back(std::exp(rng.normal(0.0, 0.6)));
+      for (int i = 0; i < 12; ++i) replays.push_back(std::exp(rng.normal(0.0, 0.6)));
+      const double z = compare_outcome(recorded, replays, 0.0).z;
+      chi2 += z * z;
+      if (o == 0) beyond += std::abs(z) > 1.96;
+    }
+    sets_beyond += chi2 > 37.7;
+  }
+  const double rate = static_cast<double>(beyond) / kSets;
+  EXPECT_NEAR(rate, 0.05, 4.0 * std::sqrt(0.05 * 0.95 / kSets) + 0.01);  // t with 16 dof: 6.5 %
+  EXPECT_LE(static_cast<double>(sets_beyond) / kSets, 0.01);
+}
+
+TEST(ImpactAccuracy, ErrorGrowsAfterASeparationAndFreezesAtTheNextContact) {
+  std::vector<ReplaySample> replay;
+  for (int k = 0; k <= 300; ++k) {
+    ReplaySample s;
+    s.t = 1e-3 * k;
+    s.contacts = (k >= 100 && k < 110) || k >= 200 ? 1 : 0;  // an impact, a flight of 90 ms, a landing
+    s.speed = 2.0;
+    replay.push_back(s);
+  }
+  const Weights w = weights_for(replay, 1e-4, 0.01);
+  EXPECT_DOUBLE_EQ(w.at(50), 1e-4);                                     // the first flight: the noise only
+  EXPECT_NEAR(w.at(150), std::hypot(1e-4, 0.01 * 2.0 * 0.040), 1e-12);  // 40 ms after leaving at 2 m/s
+  const double landed = std::hypot(1e-4, 0.01 * 2.0 * 0.090);
+  EXPECT_NEAR(w.at(200), landed, 1e-12);
+  EXPECT_NEAR(w.at(300), landed, 1e-12);  // frozen while it rests
+  EXPECT_DOUBLE_EQ(weights_for(replay, 1e-4, 0.0).at(300), 1e-4);
+}
