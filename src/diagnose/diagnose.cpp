@@ -328,6 +328,7 @@ struct Context {
   std::set<std::pair<std::string, Coefficient>> unpinned;
   std::vector<SurfaceParameters> table_values;
   std::vector<std::string> names;
+  std::vector<double> camera_noise;  ///< per recording [m], from its tracks
   std::vector<std::size_t> training, heldout, all;
   int evaluations = 0;
   const RunContext* run = nullptr;
@@ -1044,6 +1045,441 @@ Decision decide(const std::vector<HypothesisReport>& hypotheses, double min_delt
   return decision;
 }
 
+/// Stage 0: options a diagnosis cannot run with.
+Result<void> check_options(const DiagnoseOptions& options) {
+  if (!(options.model_accuracy_m >= 0.0 && options.model_accuracy_m <= 0.01)) {
+    return fail(
+        ErrorCode::InvalidArgument,
+        fmt::format("the particle model's accuracy must lie in [0, 10] mm, not {} m", options.model_accuracy_m));
+  }
+  if (!(options.impact_accuracy >= 0.0 && options.impact_accuracy <= 0.2)) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("the accuracy of a replayed impact's outgoing speed must lie in [0, 20] %, not {} %",
+                            100.0 * options.impact_accuracy));
+  }
+  if (options.ensemble_replays != 0 && (options.ensemble_replays < 4 || options.ensemble_replays > 1000)) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("replays per recording for the ensemble comparison must be 0 (skip) or 4 to 1000, not {}",
+                            options.ensemble_replays));
+  }
+  if (options.release_orientations < 2 || options.release_orientations > 1000) {
+    return fail(
+        ErrorCode::InvalidArgument,
+        fmt::format("release orientations drawn per prior must be 2 to 1000, not {}", options.release_orientations));
+  }
+  if (!(options.orientation_prior_deg > 0.0 && options.orientation_prior_deg <= 180.0)) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("the recorded orientation's uncertainty must lie in (0, 180] deg, not {}",
+                            options.orientation_prior_deg));
+  }
+  return {};
+}
+
+/// Stage 1, load and noise: each recording's noise level from its own tracks (weighed with
+/// the model's accuracy), and the trials with enough frames, every other one held out.
+/// Returns the camera noise per recording.
+std::vector<double> load_tracks(Context& c, DiagnoseResult& result, const std::vector<Recording>& recordings,
+                                const std::vector<std::string>& names, const DiagnoseOptions& options) {
+  // Noise level per recording, from its own tracks.
+  std::vector<double> camera_noise;
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    std::vector<const Track*> tracks;
+    for (const auto& t : recordings[r].trials) {
+      if (t.track) tracks.push_back(&*t.track);
+    }
+    double sigma = estimate_noise(tracks);
+    if (recordings[r].position_noise_m) {
+      result.notes.push_back(fmt::format("{}: the lab states {:.3g} mm of noise; the tracks show {:.3g} mm (used)",
+                                         names[r], *recordings[r].position_noise_m * 1000.0, sigma * 1000.0));
+      if (!std::isfinite(sigma)) sigma = *recordings[r].position_noise_m;
+    }
+    // Residuals are weighed against the camera noise and the particle model's own accuracy
+    // together: no clump reproduces a real particle to a tenth of a millimetre, and a
+    // misfit within that accuracy is not evidence of missing physics.
+    camera_noise.push_back(sigma);
+    c.ev.sigma.push_back(std::hypot(sigma, options.model_accuracy_m));
+    if (!tracks.empty()) result.noise_m.emplace_back(names[r], sigma);
+  }
+  // The trials that can be used.
+  std::vector<std::string> too_short;
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    const Recording& rec = recordings[r];
+    int used = 0;
+    for (std::size_t i = 0; i < rec.trials.size(); ++i) {
+      const auto& track = rec.trials[i].track;
+      if (!track) continue;
+      int frames = 0;
+      for (std::size_t k = 0; k < track->size(); ++k)
+        frames += std::isfinite(track->x[k]) && std::isfinite(track->z[k]);
+      if (frames < 30 || !std::isfinite(c.ev.sigma[r])) {
+        too_short.push_back(fmt::format("{} trial {} ({} usable frames)", names[r], rec.trials[i].id, frames));
+        continue;
+      }
+      TrackedTrial tt;
+      tt.recording = r;
+      tt.trial = i;
+      tt.training = used % 2 == 0;
+      const double rate = rec.tilt_rate_deg_per_s.value_or(options.lab.tilt_rate_deg_per_s);
+      tt.shift_guess = guess_shift(*track, rec.test, rate, rec.incline_deg);
+      const double last = track->t.back() - tt.shift_guess;
+      tt.duration = std::clamp(last + 0.05, 0.05, rec.test == LabTest::Tilt ? 89.0 / rate : 6.0);
+      if (rec.test == LabTest::Tilt) tt.record_from = std::max(0.0, track->t.front() - tt.shift_guess - 0.05);
+      (tt.training ? c.training : c.heldout).push_back(c.ev.trials.size());
+      c.all.push_back(c.ev.trials.size());
+      c.ev.trials.push_back(tt);
+      ++used;
+    }
+  }
+  result.tracked_trials = static_cast<int>(c.ev.trials.size());
+  result.training_trials = static_cast<int>(c.training.size());
+  if (!too_short.empty())
+    result.notes.push_back(fmt::format("left out (too short or no noise estimate): {}", fmt::join(too_short, ", ")));
+  c.camera_noise = camera_noise;
+  return camera_noise;
+}
+
+/// The starting model: the materials table's coefficients per surface of the recordings.
+Result<Model> starting_model(Context& c, const MaterialTable& table, const std::vector<Recording>& recordings,
+                             const DiagnoseOptions& options) {
+  // Base coefficients: the materials table's, per surface.
+  Model baseline;
+  for (const auto& rec : recordings) {
+    if (std::any_of(baseline.base.begin(), baseline.base.end(),
+                    [&](const auto& b) { return b.surface == rec.surface; }))
+      continue;
+    auto pair = table.interaction(options.lab.particle_material, rec.surface);
+    if (!pair) return std::unexpected(pair.error());
+    baseline.base.push_back({rec.surface, *pair});
+    c.table_values.push_back({rec.surface, *pair});
+  }
+  return baseline;
+}
+
+/// Stages 2 and 3, release state and horizons: the release orientations the prior allows, how
+/// long each trial stays predictable, the first time origins.
+Result<void> release_stage(Context& c, DiagnoseResult& result, const Model& baseline, const DiagnoseOptions& options) {
+  const RunContext& run = *c.run;
+  run.report("release state", 0.02);
+  auto release_notes = settle_release_state(c, baseline, options);
+  if (!release_notes) return std::unexpected(release_notes.error());
+  result.notes.insert(result.notes.end(), release_notes->begin(), release_notes->end());
+  if (auto ok = initialise_shifts(c.ev, baseline); !ok) return std::unexpected(ok.error());
+  if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
+  return {};
+}
+
+/// Stage 4, baseline: e, mu_s and mu_r per surface on the training trials (each on its own
+/// test over a wide grid, then together), the horizons set again under it; the coefficients
+/// the fitted windows do not pin are said to be uncalibrated.
+Result<Model> baseline_stage(Context& c, DiagnoseResult& result, Model baseline, const DiagnoseOptions& options) {
+  const RunContext& run = *c.run;
+  const auto& names = c.names;
+  const auto& recordings = *c.ev.recordings;
+  run.report("baseline", 0.05);
+  auto fitted = fit_baseline(c, baseline, false, c.training);
+  if (!fitted) return std::unexpected(fitted.error());
+  baseline = *fitted;
+  c.ev.shift.clear();
+  if (auto ok = initialise_shifts(c.ev, baseline); !ok) return std::unexpected(ok.error());
+  if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
+  // Again: each coefficient now fitted with the others near their values.
+  auto polished = fit_coefficients(c, baseline, c.training, options.max_evaluations);
+  if (!polished) return std::unexpected(polished.error());
+  baseline = polished->model;
+  result.baseline = baseline.base;
+  for (const auto& [surface, coefficient] : c.unpinned) {
+    const auto it =
+        std::find_if(baseline.base.begin(), baseline.base.end(), [&](const auto& b) { return b.surface == surface; });
+    result.notes.push_back(
+        fmt::format("{} on {} is not pinned by the fitted parts of the tracks (its chi^2 moves by less than {:g} over "
+                    "its range): the materials table's {:.4g} is kept, uncalibrated",
+                    coefficient_name(coefficient), surface, kUnpinned, coefficient_of(it->interaction, coefficient)));
+    result.uncalibrated.push_back(fmt::format("{}:{}", surface, coefficient_name(coefficient)));
+  }
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    std::vector<std::string> horizons;
+    for (const auto& tt : c.ev.trials) {
+      if (tt.recording == r)
+        horizons.push_back(std::isfinite(tt.horizon) ? fmt::format("{:.3f}", tt.horizon) : std::string("end"));
+    }
+    if (!horizons.empty())
+      result.notes.push_back(
+          fmt::format("{}: fitted up to {} s after release (per trial)", names[r], fmt::join(horizons, ", ")));
+  }
+  return baseline;
+}
+
+/// What the baseline leaves, per trial and phase.
+struct Located {
+  std::vector<TrialScore> base_scores;  ///< every trial (c.all), replays kept
+  std::vector<double> base_chi2;        ///< per trial
+  Groups base_train_groups;             ///< the training trials' phases
+  std::vector<GroupKey> flagged;        ///< phases beyond the noise (every trial)
+  double sum(const std::vector<std::size_t>& which) const {
+    double total = 0.0;
+    for (std::size_t i : which) total += base_chi2[i];
+    return total;
+  }
+};
+
+/// Stage 5, locate: the baseline's residuals per recording and phase, and the phases beyond
+/// the noise.
+Result<Located> locate_stage(Context& c, DiagnoseResult& result, const Model& baseline) {
+  Located out;
+  auto base_scores = score(c, baseline, c.all, true);
+  if (!base_scores) return std::unexpected(base_scores.error());
+  out.base_chi2.assign(c.ev.trials.size(), 0.0);
+  for (std::size_t k = 0; k < c.all.size(); ++k) out.base_chi2[c.all[k]] = (*base_scores)[k].alignment.chi_squared;
+  const Groups all_groups = phase_groups(c, c.all, *base_scores);
+  result.phases = locate(c, all_groups);
+  // The training trials' groups, and the flagged ones, for the signature check.
+  std::vector<TrialScore> train_scores;
+  for (std::size_t k = 0; k < c.all.size(); ++k) {
+    if (c.ev.trials[c.all[k]].training) train_scores.push_back((*base_scores)[k]);
+  }
+  out.base_train_groups = phase_groups(c, c.training, train_scores);
+  for (const auto& [key, g] : all_groups) {
+    if (key.phase == Phase::Hold || key.phase == Phase::LaterBounces || g.values < 10) continue;
+    if (beyond_noise(g.chi2, g.values, all_groups.size())) out.flagged.push_back(key);
+  }
+  out.base_scores = std::move(*base_scores);
+  return out;
+}
+
+/// A misfit no particle model's inaccuracy could leave: three times hypot(noise, model
+/// accuracy) RMS or more (chi^2 per value >= kLargeMisfit). A drop's first flight is judged
+/// against the camera noise alone: before the first contact only the release and the air
+/// act on the body, and neither the clump's shape nor its contact law enters.
+bool large_misfit(const Context& c, const GroupKey& key, const Group& g) {
+  if (g.values == 0) return false;
+  double per_value = g.chi2 / g.values;
+  const double camera = key.recording < c.camera_noise.size() ? c.camera_noise[key.recording] : 0.0;
+  if (key.phase == Phase::Flight && std::isfinite(camera) && camera > 0.0) {
+    const double scale = c.ev.sigma[key.recording] / camera;
+    per_value *= scale * scale;
+  }
+  return per_value >= kLargeMisfit;
+}
+
+/// Stage 6, candidates: every effect fitted with all base coefficients free on the training
+/// trials, and judged (delta-BIC, held-out trials, plausibility, signature, large misfit);
+/// one report per effect in result.hypotheses, its fit returned in the same order.
+Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result, const Model& baseline,
+                                             const Located& located, const std::vector<Effect>& effects,
+                                             const DiagnoseOptions& options) {
+  const RunContext& run = *c.run;
+  const auto& recordings = *c.ev.recordings;
+  const auto library = effect_library();
+  std::vector<Fitted> fits;
+  for (std::size_t h = 0; h < effects.size(); ++h) {
+    const EffectSpec& spec = effect_spec(library, effects[h]);
+    run.report("fitting effects", 0.2 + 0.65 * static_cast<double>(h) / static_cast<double>(effects.size()));
+    if (run.should_stop()) return fail(ErrorCode::Cancelled, "cancelled");
+    // Judged on every test: an effect acts wherever the particle moves (drag on a roll,
+    // kinetic friction at an impact), and its fit must not spoil the other tests.
+    const auto& train = c.training;
+    const auto& held = c.heldout;
+    if (train.empty()) {
+      result.notes.push_back(fmt::format("{} not tested: no recordings of the tests it shows in", spec.name));
+      continue;
+    }
+    // Every coefficient stays free: the fair null is the baseline itself, polished the same way.
+    auto fit = fit_hypothesis(c, baseline, spec, train, options.max_evaluations);
+    if (!fit) return std::unexpected(fit.error());
+    HypothesisReport report;
+    report.name = spec.name;
+    report.evaluations = fit->evaluations;
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k)
+      report.values.push_back({spec.parameters[k].name, fit->model.values[k], NAN, NAN});
+    report.base = fit->model.base;
+    const double chi2_0 = located.sum(train);
+    report.delta_chi2 = chi2_0 - fit->chi2;
+    auto train_scores_k = score(c, fit->model, train, true);
+    if (!train_scores_k) return std::unexpected(train_scores_k.error());
+    report.values_used = total_values(*train_scores_k);
+    report.delta_bic =
+        report.delta_chi2 - static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
+    if (!held.empty()) {
+      auto held_scores = score(c, fit->model, held, false);
+      if (!held_scores) return std::unexpected(held_scores.error());
+      report.heldout_delta_chi2 = located.sum(held) - total_chi_squared(*held_scores);
+    }
+    report.improves_heldout = !held.empty() && report.heldout_delta_chi2 > 0.0;
+    report.plausible = true;
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
+      const double v = fit->model.values[k];
+      const auto& p = spec.parameters[k];
+      report.plausible = report.plausible && v >= p.plausible_low && v <= p.plausible_high;
+    }
+    if (spec.effect == Effect::ComOffset) {
+      const double offset = std::hypot(fit->model.values[0], fit->model.values[1]);
+      report.plausible = offset >= 2e-4 && offset <= 3e-3;
+    }
+    // Signature: the flagged phases of its tests, on the training trials.
+    std::vector<GroupKey> own;
+    for (const auto& key : located.flagged) {
+      if (std::find(spec.tests.begin(), spec.tests.end(), recordings[key.recording].test) != spec.tests.end())
+        own.push_back(key);
+    }
+    const Groups after = phase_groups(c, train, *train_scores_k);
+    report.flagged_excess_before = flagged_excess(located.base_train_groups, own);
+    report.flagged_excess_after = flagged_excess(after, own);
+    // It removes its signature: the flagged phases' excess falls by half or more, and none of
+    // them gets worse (beyond the chi^2 per value's own scatter).
+    bool none_worse = true;
+    for (const auto& key : own) {
+      const auto b = located.base_train_groups.find(key), a = after.find(key);
+      if (b == located.base_train_groups.end() || a == after.end() || b->second.values == 0 || a->second.values == 0)
+        continue;
+      const double before_per_value = b->second.chi2 / b->second.values,
+                   after_per_value = a->second.chi2 / a->second.values;
+      if (after_per_value > before_per_value + 3.0 * std::sqrt(2.0 / b->second.values)) {
+        none_worse = false;
+        report.worsened_phases.push_back(fmt::format("{} phases of {}: chi^2/value {:.2f} -> {:.2f}",
+                                                     phase_name(key.phase), c.names[key.recording], before_per_value,
+                                                     after_per_value));
+      }
+    }
+    report.clears_signature = none_worse && (report.flagged_excess_before <= 0.0 ||
+                                             report.flagged_excess_after <= 0.5 * report.flagged_excess_before);
+    // It explains a misfit no particle model's inaccuracy could: a flagged phase three times
+    // hypot(noise, model accuracy) or more (RMS) whose chi^2 it at least halves.
+    for (const auto& key : own) {
+      const auto b = located.base_train_groups.find(key), a = after.find(key);
+      if (b == located.base_train_groups.end() || a == after.end() || b->second.values == 0) continue;
+      report.clears_large_misfit =
+          report.clears_large_misfit || (large_misfit(c, key, b->second) && a->second.chi2 <= 0.5 * b->second.chi2);
+    }
+    report.passes = report.delta_bic >= options.min_delta_bic && report.improves_heldout && report.plausible &&
+                    report.clears_signature && report.clears_large_misfit;
+    result.hypotheses.push_back(std::move(report));
+    fits.push_back(std::move(*fit));
+  }
+  return fits;
+}
+
+/// For a `none`: the smallest effect of each candidate the data could have shown (its
+/// signal at a fifth of its realistic magnitude, the part the coefficients could absorb
+/// projected out, scaled quadratically to the delta-BIC margin; a lower bound), in each
+/// hypothesis report; returns the statements and the candidates not testable even at
+/// their strong magnitude.
+Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_limits(Context& c,
+                                                                                       DiagnoseResult& result,
+                                                                                       const Model& baseline,
+                                                                                       const std::vector<Fitted>& fits,
+                                                                                       const DiagnoseOptions& options) {
+  const auto library = effect_library();
+  // The smallest effect the data could have shown: an effect's signal (its replays minus
+  // the baseline's at a fifth of its realistic magnitude) with the part the coefficients
+  // could absorb projected out (their own finite-difference directions), scaled
+  // quadratically to the delta-BIC margin.
+  auto cells = [&](const Model& m) -> Result<Eigen::VectorXd> {
+    auto scores = evaluate(c.ev, m, c.training, false, true);
+    c.evaluations += static_cast<int>(c.training.size());
+    if (!scores) return std::unexpected(scores.error());
+    std::vector<double> all_cells;
+    for (const auto& sc : *scores) all_cells.insert(all_cells.end(), sc.residuals.begin(), sc.residuals.end());
+    return Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));
+  };
+  auto base_cells = cells(baseline);
+  if (!base_cells) return std::unexpected(base_cells.error());
+  std::vector<Eigen::VectorXd> directions;
+  for (std::size_t b = 0; b < baseline.base.size(); ++b) {
+    for (Coefficient k : {Coefficient::Restitution, Coefficient::StaticFriction, Coefficient::RollingFriction}) {
+      Model moved = baseline;
+      double& v = coefficient_of(moved.base[b].interaction, k);
+      v = k == Coefficient::RollingFriction && v < 1e-3 ? v + 1e-5 : v * 1.002;
+      auto moved_cells = cells(moved);
+      if (!moved_cells) return std::unexpected(moved_cells.error());
+      if (moved_cells->size() == base_cells->size()) directions.push_back(*moved_cells - *base_cells);
+    }
+  }
+  Eigen::MatrixXd absorb(base_cells->size(), static_cast<Eigen::Index>(directions.size()));
+  for (std::size_t k = 0; k < directions.size(); ++k) absorb.col(static_cast<Eigen::Index>(k)) = directions[k];
+  std::vector<std::string> limits, untestable;
+  for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
+    auto& report = result.hypotheses[h];
+    const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
+    Model probe = baseline;
+    probe.effect = spec.effect;
+    for (const auto& p : spec.parameters) probe.values.push_back(p.log_scale ? p.realistic : 0.2 * p.realistic);
+    auto probe_cells = cells(probe);
+    if (!probe_cells) return std::unexpected(probe_cells.error());
+    double signal = 0.0;
+    if (probe_cells->size() == base_cells->size()) {
+      const Eigen::VectorXd d = *base_cells - *probe_cells;
+      const Eigen::VectorXd kept =
+          absorb.cols() > 0 ? Eigen::VectorXd(d - absorb * absorb.colPivHouseholderQr().solve(d)) : d;
+      signal = kept.squaredNorm();
+    }
+    const double needed =
+        options.min_delta_bic + static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
+    const auto& first = spec.parameters[0];
+    if (first.log_scale) {
+      report.smallest_detectable = signal >= needed ? first.realistic : NAN;
+      limits.push_back(signal >= needed
+                           ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.realistic)
+                           : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.realistic));
+    } else {
+      const double null_value = spec.effect == Effect::ComOffset ? 0.0 : first.lower;
+      const double probed = 0.2 * first.realistic;
+      report.smallest_detectable =
+          signal > 0.0 ? null_value + (probed - null_value) * std::sqrt(needed / signal) : kNever;
+      limits.push_back(fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable));
+    }
+    // Beyond its strong magnitude (or never): the predictable parts of these tracks cannot
+    // decide it; said, not counted as absent.
+    const bool testable = first.log_scale
+                              ? std::isfinite(report.smallest_detectable)
+                              : std::isfinite(report.smallest_detectable) && report.smallest_detectable <= first.strong;
+    if (!testable) untestable.push_back(spec.name);
+  }
+  return std::pair{std::move(limits), std::move(untestable)};
+}
+
+/// Stage 8, show: each recording's first tracked trial against the baseline and the improved
+/// model, whole tracks, in the recording's frame.
+void track_plots(const Context& c, DiagnoseResult& result, const std::vector<TrialScore>& full_base,
+                 const std::vector<TrialScore>& full_improved) {
+  const auto& recordings = *c.ev.recordings;
+  const auto& names = c.names;
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    for (std::size_t k = 0; k < c.all.size(); ++k) {
+      const TrackedTrial& tt = c.ev.trials[c.all[k]];
+      if (tt.recording != r) continue;
+      TrackComparison cmp;
+      cmp.recording = names[r];
+      cmp.horizon = tt.horizon;
+      const Track& track = *recordings[r].trials[tt.trial].track;
+      const Alignment& a = full_base[k].alignment;
+      for (std::size_t f = 0; f < track.size(); ++f) {
+        cmp.t.push_back(track.t[f] - a.shift);
+        cmp.x.push_back(track.x[f] - a.x_offset);
+        cmp.z.push_back(track.z[f] - a.z_offset);
+      }
+      const double end = cmp.t.back();
+      auto sampled = [&](const std::vector<ReplaySample>& replay, std::vector<double>& t, std::vector<double>& x,
+                         std::vector<double>& z) {
+        for (std::size_t s = 0; s < replay.size(); s += 10) {
+          if (replay[s].t < cmp.t.front() || replay[s].t > end) continue;
+          t.push_back(replay[s].t);
+          x.push_back(replay[s].x);
+          z.push_back(replay[s].z);
+        }
+      };
+      sampled(full_base[k].replay, cmp.baseline_t, cmp.baseline_x, cmp.baseline_z);
+      sampled(full_improved[k].replay, cmp.improved_t, cmp.improved_x, cmp.improved_z);
+      // The improved model's own x origin differs slightly: shift its curve onto the recording's frame.
+      const double dx = full_improved[k].alignment.x_offset - a.x_offset,
+                   dz = full_improved[k].alignment.z_offset - a.z_offset;
+      for (double& x : cmp.improved_x) x += dx;
+      for (double& z : cmp.improved_z) z += dz;
+      result.tracks.push_back(std::move(cmp));
+      break;
+    }
+  }
+}
+
 /// Beyond the release horizons: the recorded trials against replays from the release prior
 /// (diagnose/ensemble.hpp). The coefficients the frame fits left unpinned are calibrated on
 /// the outcomes; a candidate is named when its replays beat that null by the delta-BIC
@@ -1179,31 +1615,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   const auto started = std::chrono::steady_clock::now();
   if (recordings.empty()) return fail(ErrorCode::InvalidArgument, "no recordings to diagnose");
   if (names.size() != recordings.size()) return fail(ErrorCode::InvalidArgument, "one name per recording is needed");
-  if (!(options.model_accuracy_m >= 0.0 && options.model_accuracy_m <= 0.01)) {
-    return fail(
-        ErrorCode::InvalidArgument,
-        fmt::format("the particle model's accuracy must lie in [0, 10] mm, not {} m", options.model_accuracy_m));
-  }
-  if (!(options.impact_accuracy >= 0.0 && options.impact_accuracy <= 0.2)) {
-    return fail(ErrorCode::InvalidArgument,
-                fmt::format("the accuracy of a replayed impact's outgoing speed must lie in [0, 20] %, not {} %",
-                            100.0 * options.impact_accuracy));
-  }
-  if (options.ensemble_replays != 0 && (options.ensemble_replays < 4 || options.ensemble_replays > 1000)) {
-    return fail(ErrorCode::InvalidArgument,
-                fmt::format("replays per recording for the ensemble comparison must be 0 (skip) or 4 to 1000, not {}",
-                            options.ensemble_replays));
-  }
-  if (options.release_orientations < 2 || options.release_orientations > 1000) {
-    return fail(
-        ErrorCode::InvalidArgument,
-        fmt::format("release orientations drawn per prior must be 2 to 1000, not {}", options.release_orientations));
-  }
-  if (!(options.orientation_prior_deg > 0.0 && options.orientation_prior_deg <= 180.0)) {
-    return fail(ErrorCode::InvalidArgument,
-                fmt::format("the recorded orientation's uncertainty must lie in (0, 180] deg, not {}",
-                            options.orientation_prior_deg));
-  }
+  if (auto ok = check_options(options); !ok) return std::unexpected(ok.error());
   bool any_track = false;
   for (const auto& r : recordings) {
     for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
@@ -1219,60 +1631,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   c.ev.recordings = &recordings;
   c.ev.lab = options.lab;
   c.ev.impact_accuracy = options.impact_accuracy;
-  // Noise level per recording, from its own tracks.
-  std::vector<double> camera_noise;
-  for (std::size_t r = 0; r < recordings.size(); ++r) {
-    std::vector<const Track*> tracks;
-    for (const auto& t : recordings[r].trials) {
-      if (t.track) tracks.push_back(&*t.track);
-    }
-    double sigma = estimate_noise(tracks);
-    if (recordings[r].position_noise_m) {
-      result.notes.push_back(fmt::format("{}: the lab states {:.3g} mm of noise; the tracks show {:.3g} mm (used)",
-                                         names[r], *recordings[r].position_noise_m * 1000.0, sigma * 1000.0));
-      if (!std::isfinite(sigma)) sigma = *recordings[r].position_noise_m;
-    }
-    // Residuals are weighed against the camera noise and the particle model's own accuracy
-    // together: no clump reproduces a real particle to a tenth of a millimetre, and a
-    // misfit within that accuracy is not evidence of missing physics.
-    camera_noise.push_back(sigma);
-    c.ev.sigma.push_back(std::hypot(sigma, options.model_accuracy_m));
-    if (!tracks.empty()) result.noise_m.emplace_back(names[r], sigma);
-  }
-  // The trials that can be used.
-  std::vector<std::string> too_short;
-  for (std::size_t r = 0; r < recordings.size(); ++r) {
-    const Recording& rec = recordings[r];
-    int used = 0;
-    for (std::size_t i = 0; i < rec.trials.size(); ++i) {
-      const auto& track = rec.trials[i].track;
-      if (!track) continue;
-      int frames = 0;
-      for (std::size_t k = 0; k < track->size(); ++k)
-        frames += std::isfinite(track->x[k]) && std::isfinite(track->z[k]);
-      if (frames < 30 || !std::isfinite(c.ev.sigma[r])) {
-        too_short.push_back(fmt::format("{} trial {} ({} usable frames)", names[r], rec.trials[i].id, frames));
-        continue;
-      }
-      TrackedTrial tt;
-      tt.recording = r;
-      tt.trial = i;
-      tt.training = used % 2 == 0;
-      const double rate = rec.tilt_rate_deg_per_s.value_or(options.lab.tilt_rate_deg_per_s);
-      tt.shift_guess = guess_shift(*track, rec.test, rate, rec.incline_deg);
-      const double last = track->t.back() - tt.shift_guess;
-      tt.duration = std::clamp(last + 0.05, 0.05, rec.test == LabTest::Tilt ? 89.0 / rate : 6.0);
-      if (rec.test == LabTest::Tilt) tt.record_from = std::max(0.0, track->t.front() - tt.shift_guess - 0.05);
-      (tt.training ? c.training : c.heldout).push_back(c.ev.trials.size());
-      c.all.push_back(c.ev.trials.size());
-      c.ev.trials.push_back(tt);
-      ++used;
-    }
-  }
-  result.tracked_trials = static_cast<int>(c.ev.trials.size());
-  result.training_trials = static_cast<int>(c.training.size());
-  if (!too_short.empty())
-    result.notes.push_back(fmt::format("left out (too short or no noise estimate): {}", fmt::join(too_short, ", ")));
+  const std::vector<double> camera_noise = load_tracks(c, result, recordings, names, options);
   double worst_sigma = 0.0;
   for (double s : camera_noise) {
     if (std::isfinite(s)) worst_sigma = std::max(worst_sigma, s);
@@ -1295,172 +1654,26 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
         "library move the tracked point by 0.1 to a few mm; track with sub-pixel centroids (0.02 to 0.1 mm)",
         worst_sigma * 1000.0));
   }
-  // Base coefficients: the materials table's, per surface.
-  Model baseline;
-  for (const auto& rec : recordings) {
-    if (std::any_of(baseline.base.begin(), baseline.base.end(),
-                    [&](const auto& b) { return b.surface == rec.surface; }))
-      continue;
-    auto pair = table.interaction(options.lab.particle_material, rec.surface);
-    if (!pair) return std::unexpected(pair.error());
-    baseline.base.push_back({rec.surface, *pair});
-    c.table_values.push_back({rec.surface, *pair});
-  }
-  run.report("release state", 0.02);
-  auto release_notes = settle_release_state(c, baseline, options);
-  if (!release_notes) return std::unexpected(release_notes.error());
-  result.notes.insert(result.notes.end(), release_notes->begin(), release_notes->end());
-  if (auto ok = initialise_shifts(c.ev, baseline); !ok) return std::unexpected(ok.error());
-  if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
-  run.report("baseline", 0.05);
-  auto fitted = fit_baseline(c, baseline, false, c.training);
+  auto start = starting_model(c, table, recordings, options);
+  if (!start) return std::unexpected(start.error());
+  if (auto ok = release_stage(c, result, *start, options); !ok) return std::unexpected(ok.error());
+  auto fitted = baseline_stage(c, result, *start, options);
   if (!fitted) return std::unexpected(fitted.error());
-  baseline = *fitted;
-  c.ev.shift.clear();
-  if (auto ok = initialise_shifts(c.ev, baseline); !ok) return std::unexpected(ok.error());
-  if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
-  // Again: each coefficient now fitted with the others near their values.
-  auto polished = fit_coefficients(c, baseline, c.training, options.max_evaluations);
-  if (!polished) return std::unexpected(polished.error());
-  baseline = polished->model;
-  result.baseline = baseline.base;
-  for (const auto& [surface, coefficient] : c.unpinned) {
-    const auto it =
-        std::find_if(baseline.base.begin(), baseline.base.end(), [&](const auto& b) { return b.surface == surface; });
-    result.notes.push_back(
-        fmt::format("{} on {} is not pinned by the fitted parts of the tracks (its chi^2 moves by less than {:g} over "
-                    "its range): the materials table's {:.4g} is kept, uncalibrated",
-                    coefficient_name(coefficient), surface, kUnpinned, coefficient_of(it->interaction, coefficient)));
-    result.uncalibrated.push_back(fmt::format("{}:{}", surface, coefficient_name(coefficient)));
-  }
-  for (std::size_t r = 0; r < recordings.size(); ++r) {
-    std::vector<std::string> horizons;
-    for (const auto& tt : c.ev.trials) {
-      if (tt.recording == r)
-        horizons.push_back(std::isfinite(tt.horizon) ? fmt::format("{:.3f}", tt.horizon) : std::string("end"));
-    }
-    if (!horizons.empty())
-      result.notes.push_back(
-          fmt::format("{}: fitted up to {} s after release (per trial)", names[r], fmt::join(horizons, ", ")));
-  }
+  const Model baseline = std::move(*fitted);
   run.report("locating", 0.2);
 
-  auto base_scores = score(c, baseline, c.all, true);
-  if (!base_scores) return std::unexpected(base_scores.error());
-  std::vector<double> base_chi2(c.ev.trials.size(), 0.0);
-  for (std::size_t k = 0; k < c.all.size(); ++k) base_chi2[c.all[k]] = (*base_scores)[k].alignment.chi_squared;
-  auto sum_over = [&](const std::vector<std::size_t>& which, const std::vector<double>& chi2) {
-    double sum = 0.0;
-    for (std::size_t i : which) sum += chi2[i];
-    return sum;
-  };
-  const Groups all_groups = phase_groups(c, c.all, *base_scores);
-  result.phases = locate(c, all_groups);
-  // The training trials' groups, and the flagged ones, for the signature check.
-  std::vector<TrialScore> train_scores;
-  for (std::size_t k = 0; k < c.all.size(); ++k) {
-    if (c.ev.trials[c.all[k]].training) train_scores.push_back((*base_scores)[k]);
-  }
-  const Groups base_train_groups = phase_groups(c, c.training, train_scores);
-  std::vector<GroupKey> flagged;
-  for (const auto& [key, g] : all_groups) {
-    if (key.phase == Phase::Hold || key.phase == Phase::LaterBounces || g.values < 10) continue;
-    if (beyond_noise(g.chi2, g.values, all_groups.size())) flagged.push_back(key);
-  }
-
+  auto located = locate_stage(c, result, baseline);
+  if (!located) return std::unexpected(located.error());
+  const auto& base_scores = located->base_scores;
   // Name: every candidate, on the tests it acts in.
   const auto library = effect_library();
   std::vector<Effect> effects = options.effects;
   if (effects.empty()) {
     for (const auto& spec : library) effects.push_back(spec.effect);
   }
-  std::vector<Fitted> fits;
-  std::vector<std::vector<std::size_t>> fit_train, fit_held;
-  for (std::size_t h = 0; h < effects.size(); ++h) {
-    const EffectSpec& spec = effect_spec(library, effects[h]);
-    run.report("fitting effects", 0.2 + 0.65 * static_cast<double>(h) / static_cast<double>(effects.size()));
-    if (run.should_stop()) return fail(ErrorCode::Cancelled, "cancelled");
-    // Judged on every test: an effect acts wherever the particle moves (drag on a roll,
-    // kinetic friction at an impact), and its fit must not spoil the other tests.
-    const auto& train = c.training;
-    const auto& held = c.heldout;
-    if (train.empty()) {
-      result.notes.push_back(fmt::format("{} not tested: no recordings of the tests it shows in", spec.name));
-      continue;
-    }
-    // Every coefficient stays free: the fair null is the baseline itself, polished the same way.
-    auto fit = fit_hypothesis(c, baseline, spec, train, options.max_evaluations);
-    if (!fit) return std::unexpected(fit.error());
-    HypothesisReport report;
-    report.name = spec.name;
-    report.evaluations = fit->evaluations;
-    for (std::size_t k = 0; k < spec.parameters.size(); ++k)
-      report.values.push_back({spec.parameters[k].name, fit->model.values[k], NAN, NAN});
-    report.base = fit->model.base;
-    const double chi2_0 = sum_over(train, base_chi2);
-    report.delta_chi2 = chi2_0 - fit->chi2;
-    auto train_scores_k = score(c, fit->model, train, true);
-    if (!train_scores_k) return std::unexpected(train_scores_k.error());
-    report.values_used = total_values(*train_scores_k);
-    report.delta_bic =
-        report.delta_chi2 - static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
-    if (!held.empty()) {
-      auto held_scores = score(c, fit->model, held, false);
-      if (!held_scores) return std::unexpected(held_scores.error());
-      report.heldout_delta_chi2 = sum_over(held, base_chi2) - total_chi_squared(*held_scores);
-    }
-    report.improves_heldout = !held.empty() && report.heldout_delta_chi2 > 0.0;
-    report.plausible = true;
-    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
-      const double v = fit->model.values[k];
-      const auto& p = spec.parameters[k];
-      report.plausible = report.plausible && v >= p.plausible_low && v <= p.plausible_high;
-    }
-    if (spec.effect == Effect::ComOffset) {
-      const double offset = std::hypot(fit->model.values[0], fit->model.values[1]);
-      report.plausible = offset >= 2e-4 && offset <= 3e-3;
-    }
-    // Signature: the flagged phases of its tests, on the training trials.
-    std::vector<GroupKey> own;
-    for (const auto& key : flagged) {
-      if (std::find(spec.tests.begin(), spec.tests.end(), recordings[key.recording].test) != spec.tests.end())
-        own.push_back(key);
-    }
-    const Groups after = phase_groups(c, train, *train_scores_k);
-    report.flagged_excess_before = flagged_excess(base_train_groups, own);
-    report.flagged_excess_after = flagged_excess(after, own);
-    // It removes its signature: the flagged phases' excess falls by half or more, and none of
-    // them gets worse (beyond the chi^2 per value's own scatter).
-    bool none_worse = true;
-    for (const auto& key : own) {
-      const auto b = base_train_groups.find(key), a = after.find(key);
-      if (b == base_train_groups.end() || a == after.end() || b->second.values == 0 || a->second.values == 0) continue;
-      const double before_per_value = b->second.chi2 / b->second.values,
-                   after_per_value = a->second.chi2 / a->second.values;
-      if (after_per_value > before_per_value + 3.0 * std::sqrt(2.0 / b->second.values)) {
-        none_worse = false;
-        report.worsened_phases.push_back(fmt::format("{} phases of {}: chi^2/value {:.2f} -> {:.2f}",
-                                                     phase_name(key.phase), c.names[key.recording], before_per_value,
-                                                     after_per_value));
-      }
-    }
-    report.clears_signature = none_worse && (report.flagged_excess_before <= 0.0 ||
-                                             report.flagged_excess_after <= 0.5 * report.flagged_excess_before);
-    // It explains a misfit no particle model's inaccuracy could: a flagged phase three times
-    // hypot(noise, model accuracy) or more (RMS) whose chi^2 it at least halves.
-    for (const auto& key : own) {
-      const auto b = base_train_groups.find(key), a = after.find(key);
-      if (b == base_train_groups.end() || a == after.end() || b->second.values == 0) continue;
-      report.clears_large_misfit = report.clears_large_misfit || (b->second.chi2 >= kLargeMisfit * b->second.values &&
-                                                                  a->second.chi2 <= 0.5 * b->second.chi2);
-    }
-    report.passes = report.delta_bic >= options.min_delta_bic && report.improves_heldout && report.plausible &&
-                    report.clears_signature && report.clears_large_misfit;
-    result.hypotheses.push_back(std::move(report));
-    fits.push_back(std::move(*fit));
-    fit_train.push_back(train);
-    fit_held.push_back(held);
-  }
+  auto candidate_fits = candidates_stage(c, result, baseline, *located, effects, options);
+  if (!candidate_fits) return std::unexpected(candidate_fits.error());
+  const std::vector<Fitted>& fits = *candidate_fits;
 
   // A second null: the coefficients refitted on every trial, the held-out ones included. When
   // the training trials pin a coefficient poorly (a roll fitted only up to its short horizon),
@@ -1492,7 +1705,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     from_null.effect = fits[h].model.effect;
     from_null.values = fits[h].model.values;
     double chi2_all = null_all->chi2;
-    for (const Model* start : {&fits[h].model, &from_null}) {
+    for (const Model* start : {&fits[h].model, static_cast<const Model*>(&from_null)}) {
       auto on_all = refit(c, *start, &spec, c.all, options.max_evaluations);
       if (!on_all) return std::unexpected(on_all.error());
       report.evaluations += on_all->evaluations;
@@ -1527,7 +1740,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   }
 
   Model improved = baseline;
-  std::vector<TrialScore> improved_scores = *base_scores;
+  std::vector<TrialScore> improved_scores = base_scores;
   if (named) {
     const std::size_t h = *named;
     HypothesisReport& report = result.hypotheses[h];
@@ -1543,7 +1756,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
       auto chi2_at = [&](double value) -> Result<double> {
         Model m = improved;
         m.values[k] = value;
-        auto s = score(c, m, fit_train[h], false);
+        auto s = score(c, m, c.training, false);
         if (!s) return std::unexpected(s.error());
         return total_chi_squared(*s);
       };
@@ -1662,72 +1875,9 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
       result.experiment = "look at the residual plots of these phases; add set-ups that isolate them";
     } else {
       result.verdict = Verdict::None;
-      // The smallest effect the data could have shown: an effect's signal (its replays minus
-      // the baseline's at a fifth of its realistic magnitude) with the part the coefficients
-      // could absorb projected out (their own finite-difference directions), scaled
-      // quadratically to the delta-BIC margin.
-      auto cells = [&](const Model& m) -> Result<Eigen::VectorXd> {
-        auto scores = evaluate(c.ev, m, c.training, false, true);
-        c.evaluations += static_cast<int>(c.training.size());
-        if (!scores) return std::unexpected(scores.error());
-        std::vector<double> all_cells;
-        for (const auto& sc : *scores) all_cells.insert(all_cells.end(), sc.residuals.begin(), sc.residuals.end());
-        return Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));
-      };
-      auto base_cells = cells(baseline);
-      if (!base_cells) return std::unexpected(base_cells.error());
-      std::vector<Eigen::VectorXd> directions;
-      for (std::size_t b = 0; b < baseline.base.size(); ++b) {
-        for (Coefficient k : {Coefficient::Restitution, Coefficient::StaticFriction, Coefficient::RollingFriction}) {
-          Model moved = baseline;
-          double& v = coefficient_of(moved.base[b].interaction, k);
-          v = k == Coefficient::RollingFriction && v < 1e-3 ? v + 1e-5 : v * 1.002;
-          auto moved_cells = cells(moved);
-          if (!moved_cells) return std::unexpected(moved_cells.error());
-          if (moved_cells->size() == base_cells->size()) directions.push_back(*moved_cells - *base_cells);
-        }
-      }
-      Eigen::MatrixXd absorb(base_cells->size(), static_cast<Eigen::Index>(directions.size()));
-      for (std::size_t k = 0; k < directions.size(); ++k) absorb.col(static_cast<Eigen::Index>(k)) = directions[k];
-      std::vector<std::string> limits, untestable;
-      for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
-        auto& report = result.hypotheses[h];
-        const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
-        Model probe = baseline;
-        probe.effect = spec.effect;
-        for (const auto& p : spec.parameters) probe.values.push_back(p.log_scale ? p.realistic : 0.2 * p.realistic);
-        auto probe_cells = cells(probe);
-        if (!probe_cells) return std::unexpected(probe_cells.error());
-        double signal = 0.0;
-        if (probe_cells->size() == base_cells->size()) {
-          const Eigen::VectorXd d = *base_cells - *probe_cells;
-          const Eigen::VectorXd kept =
-              absorb.cols() > 0 ? Eigen::VectorXd(d - absorb * absorb.colPivHouseholderQr().solve(d)) : d;
-          signal = kept.squaredNorm();
-        }
-        const double needed = options.min_delta_bic +
-                              static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
-        const auto& first = spec.parameters[0];
-        if (first.log_scale) {
-          report.smallest_detectable = signal >= needed ? first.realistic : NAN;
-          limits.push_back(
-              signal >= needed
-                  ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.realistic)
-                  : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.realistic));
-        } else {
-          const double null_value = spec.effect == Effect::ComOffset ? 0.0 : first.lower;
-          const double probed = 0.2 * first.realistic;
-          report.smallest_detectable =
-              signal > 0.0 ? null_value + (probed - null_value) * std::sqrt(needed / signal) : kNever;
-          limits.push_back(fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable));
-        }
-        // Beyond its strong magnitude (or never): the predictable parts of these tracks cannot
-        // decide it; said, not counted as absent.
-        const bool testable =
-            first.log_scale ? std::isfinite(report.smallest_detectable)
-                            : std::isfinite(report.smallest_detectable) && report.smallest_detectable <= first.strong;
-        if (!testable) untestable.push_back(spec.name);
-      }
+      auto detection = detection_limits(c, result, baseline, fits, options);
+      if (!detection) return std::unexpected(detection.error());
+      const auto& [limits, untestable] = *detection;
       // Phases still beyond the noise, but by less than kLargeMisfit and with no shape the
       // trials share: said, not hidden.
       std::vector<std::string> slight, outliers;
@@ -1786,42 +1936,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     if (auto ok = judge_ensembles(c, result, baseline, *full_base, effects, options); !ok)
       return std::unexpected(ok.error());
   }
-  // Plots: each recording's first trial against both models.
-  for (std::size_t r = 0; r < recordings.size(); ++r) {
-    for (std::size_t k = 0; k < c.all.size(); ++k) {
-      const TrackedTrial& tt = c.ev.trials[c.all[k]];
-      if (tt.recording != r) continue;
-      TrackComparison cmp;
-      cmp.recording = names[r];
-      cmp.horizon = tt.horizon;
-      const Track& track = *recordings[r].trials[tt.trial].track;
-      const Alignment& a = (*full_base)[k].alignment;
-      for (std::size_t f = 0; f < track.size(); ++f) {
-        cmp.t.push_back(track.t[f] - a.shift);
-        cmp.x.push_back(track.x[f] - a.x_offset);
-        cmp.z.push_back(track.z[f] - a.z_offset);
-      }
-      const double end = cmp.t.back();
-      auto sampled = [&](const std::vector<ReplaySample>& replay, std::vector<double>& t, std::vector<double>& x,
-                         std::vector<double>& z) {
-        for (std::size_t s = 0; s < replay.size(); s += 10) {
-          if (replay[s].t < cmp.t.front() || replay[s].t > end) continue;
-          t.push_back(replay[s].t);
-          x.push_back(replay[s].x);
-          z.push_back(replay[s].z);
-        }
-      };
-      sampled((*full_base)[k].replay, cmp.baseline_t, cmp.baseline_x, cmp.baseline_z);
-      sampled((*full_improved)[k].replay, cmp.improved_t, cmp.improved_x, cmp.improved_z);
-      // The improved model's own x origin differs slightly: shift its curve onto the recording's frame.
-      const double dx = (*full_improved)[k].alignment.x_offset - a.x_offset,
-                   dz = (*full_improved)[k].alignment.z_offset - a.z_offset;
-      for (double& x : cmp.improved_x) x += dx;
-      for (double& z : cmp.improved_z) z += dz;
-      result.tracks.push_back(std::move(cmp));
-      break;
-    }
-  }
+  track_plots(c, result, *full_base, *full_improved);
   result.evaluations = c.evaluations;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   run.report("done", 1.0);
