@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 
+#include "calibrate/stats.hpp"
 #include "diagnose/release.hpp"
 #include "diagnose/tracks.hpp"
 
@@ -92,20 +93,15 @@ OutcomeComparison compare_outcome(const std::vector<double>& recorded, const std
                                   double floor) {
   OutcomeComparison c;
   c.floor = floor;
-  auto moments = [](const std::vector<double>& v, double& mean, double& ss) {
-    mean = 0.0;
-    for (double x : v) mean += x;
-    mean /= static_cast<double>(std::max<std::size_t>(1, v.size()));
-    ss = 0.0;
-    for (double x : v) ss += (x - mean) * (x - mean);
-  };
-  double ss_r = 0.0, ss_e = 0.0;
-  moments(recorded, c.recorded_mean, ss_r);
-  moments(ensemble, c.ensemble_mean, ss_e);
+  const SampleSpread r = sample_spread(recorded), e = sample_spread(ensemble);
+  c.recorded_mean = r.mean;
+  c.recorded_sd = r.sd;
+  c.ensemble_mean = e.mean;
+  c.ensemble_sd = e.sd;
   c.recorded_n = static_cast<int>(recorded.size());
   c.ensemble_n = static_cast<int>(ensemble.size());
-  c.recorded_sd = c.recorded_n > 1 ? std::sqrt(ss_r / (c.recorded_n - 1)) : 0.0;
-  c.ensemble_sd = c.ensemble_n > 1 ? std::sqrt(ss_e / (c.ensemble_n - 1)) : 0.0;
+  // Sums of squares about each sample's own mean, pooled.
+  const double ss_r = r.sd * r.sd * std::max(0, c.recorded_n - 1), ss_e = e.sd * e.sd * std::max(0, c.ensemble_n - 1);
   const int dof = c.recorded_n + c.ensemble_n - 2;
   const double pooled = dof > 0 ? (ss_r + ss_e) / dof : 0.0;
   const double se2 = c.recorded_n > 0 && c.ensemble_n > 0
@@ -236,9 +232,7 @@ std::vector<OutcomeComparison> compare_all(const std::vector<Plan>& plans, const
   for (std::size_t p = 0; p < plans.size(); ++p) {
     for (std::size_t o = 0; o < plans[p].outcomes.size(); ++o) {
       const auto& rec = plans[p].recorded[o];
-      double mean = 0.0;
-      for (double v : rec) mean += v;
-      mean /= static_cast<double>(std::max<std::size_t>(1, rec.size()));
+      const double mean = sample_spread(rec).mean;
       OutcomeComparison c =
           compare_outcome(rec, sample[p][o], floor_for(plans[p], plans[p].outcomes[o], mean, impact_accuracy));
       c.recording = plans[p].recording;
