@@ -71,18 +71,6 @@ struct FitParameter {
   }
 };
 
-std::pair<double, double> coefficient_range(Coefficient c) {
-  switch (c) {
-    case Coefficient::Restitution:
-      return {0.1, 0.97};
-    case Coefficient::StaticFriction:
-      return {0.05, 1.3};
-    case Coefficient::RollingFriction:
-      return {0.0, 0.12};
-  }
-  return {0.0, 1.0};
-}
-
 /// Grid points of the first (wide) search: the chi^2 of an irregular body has several dips,
 /// a roll's in mu_r most of all, so the grid is fine enough to land in the right one.
 int wide_grid(Coefficient c) {

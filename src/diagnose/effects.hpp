@@ -5,6 +5,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
@@ -67,6 +68,19 @@ inline double coefficient_of(const Interaction& i, Coefficient c) {
          : c == Coefficient::StaticFriction ? i.static_friction
                                             : i.rolling_friction;
 }
+/// The range a fit searches a coefficient in (diagnose's frame fits and its ensemble stage).
+inline std::pair<double, double> coefficient_range(Coefficient c) {
+  switch (c) {
+    case Coefficient::Restitution:
+      return {0.1, 0.97};
+    case Coefficient::StaticFriction:
+      return {0.05, 1.3};
+    case Coefficient::RollingFriction:
+      return {0.0, 0.12};
+  }
+  return {0.0, 1.0};
+}
+
 /// The report's name of a coefficient (as the materials table's keys).
 inline std::string_view coefficient_name(Coefficient c) {
   return c == Coefficient::Restitution      ? "restitution"

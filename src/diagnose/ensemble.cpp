@@ -173,7 +173,7 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
   return plans;
 }
 
-/// The outcomes of every plan's replays under `model`; plans in `skip` keep `reuse`'s values.
+/// The outcomes of every plan's replays under `model`; plans not in `run` keep `reuse`'s values.
 Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const std::vector<Plan>& plans,
                                const std::vector<bool>& run, const Sample* reuse, int& replays) {
   const auto& recs = *ev.recordings;
@@ -277,12 +277,6 @@ double coefficient_step(Coefficient c, double value) {
                                              : 0.05;
 }
 
-std::pair<double, double> free_range(Coefficient c) {
-  return c == Coefficient::Restitution       ? std::pair{0.1, 0.97}
-         : c == Coefficient::RollingFriction ? std::pair{0.0, 0.12}
-                                             : std::pair{0.05, 1.3};
-}
-
 /// The surrogate's best coefficient changes for ensemble means `target_shift` away:
 /// weighted least squares of (recorded - mean - J dc) / se, within the coefficients' ranges.
 Eigen::VectorXd solve_coefficients(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residual,
@@ -297,7 +291,7 @@ Model with_coefficients(const Model& start, const std::vector<FreeCoefficient>& 
   Model m = start;
   for (std::size_t k = 0; k < free.size(); ++k) {
     double& v = coefficient_of(m.base[free[k].surface].interaction, free[k].coefficient);
-    const auto [low, high] = free_range(free[k].coefficient);
+    const auto [low, high] = coefficient_range(free[k].coefficient);
     v = std::clamp(v + delta(static_cast<Eigen::Index>(k)), low, high);
   }
   return m;

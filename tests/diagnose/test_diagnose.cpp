@@ -314,4 +314,26 @@ TEST(DiagnoseBlind, TooShortOrTooNoisyIsUndecidable) {
   EXPECT_NE(result->statement.find("usable tracked trial"), std::string::npos) << result->statement;
 }
 
+TEST(DiagnoseOptions, AbsurdImpactAccuracyOrEnsembleSizeIsRefusedByName) {
+  const Clump clump = diagnosis_clump();
+  const MaterialTable table = default_material_table();
+  Recording rec;
+  rec.test = LabTest::Drop;
+  rec.surface = "Q235";
+  const std::vector<Recording> recordings{rec};
+  const std::vector<std::string> names{"drop"};
+  DiagnoseOptions options;
+  options.impact_accuracy = 0.5;  // 50 %: no replay is that far off
+  auto result = diagnose(clump, table, recordings, names, options);
+  ASSERT_FALSE(result);
+  EXPECT_EQ(result.error().code, ErrorCode::InvalidArgument);
+  EXPECT_NE(result.error().message.find("impact"), std::string::npos) << result.error().message;
+  options = {};
+  options.ensemble_replays = 2;  // too few to have a spread
+  result = diagnose(clump, table, recordings, names, options);
+  ASSERT_FALSE(result);
+  EXPECT_EQ(result.error().code, ErrorCode::InvalidArgument);
+  EXPECT_NE(result.error().message.find("ensemble"), std::string::npos) << result.error().message;
+}
+
 }  // namespace clumpforge
