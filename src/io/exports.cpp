@@ -11,6 +11,7 @@
 #include "core/text.hpp"
 #include "core/version.hpp"
 #include "io/centring_weights.hpp"
+#include "io/export_detail.hpp"
 
 namespace clumpforge {
 namespace fs = std::filesystem;
@@ -24,8 +25,9 @@ constexpr std::array<std::pair<std::string_view, ExportFormat>, 8> kFormats{{{"l
                                                                              {"chrono", ExportFormat::Chrono},
                                                                              {"vtk", ExportFormat::Vtk},
                                                                              {"csv", ExportFormat::Csv}}};
+}  // namespace
 
-using Files = std::vector<std::pair<fs::path, std::string>>;
+namespace export_detail {
 
 // Scalars (mass, inertia, volume) keep every bit; sphere coordinates keep 10 digits,
 // a tenth of a nanometre on a 10 mm particle, and half the file size.
@@ -36,7 +38,6 @@ std::string coordinate(double value) {
   return fmt::format("{:.10g}", value);
 }
 
-// A name usable as a LIGGGHTS fix ID or a Python identifier.
 std::string identifier(const std::string& name) {
   std::string id;
   for (char c : name) id += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
@@ -55,24 +56,30 @@ std::string provenance(const Clump& c) {
       kVersion, c.name, to_string(c.method), c.spheres.size(), c.source_sha256.empty() ? "unknown" : c.source_sha256);
 }
 
-Files liggghts(const Clump& c, const fs::path& output) {
+std::string liggghts_fix(const Clump& c, const std::string& sphere_file, const LiggghtsTemplate& ids) {
+  const Eigen::Matrix3d& I = c.inertia;
+  return fmt::format(
+      "fix pts_{} all particletemplate/multisphere {} atom_type {} density constant {} nspheres {} ntry 1000000 "
+      "spheres file {} scale 1.0 type {} mass {} inertia_tensor {} {} {} {} {} {} use_density\n",
+      identifier(c.name), ids.seed, ids.atom_type, number(c.density), c.spheres.size(), sphere_file, ids.type,
+      number(c.mass), number(I(0, 0)), number(I(0, 1)), number(I(0, 2)), number(I(1, 1)), number(I(1, 2)),
+      number(I(2, 2)));
+}
+
+Files liggghts(const Clump& c, const fs::path& output, const LiggghtsTemplate& ids) {
   // LIGGGHTS-PUBLIC fix particletemplate/multisphere: one "x y z r" line per sphere, '#'
   // comments allowed, as many lines as nspheres; `scale` is mandatory after `file`.
   std::string spheres = "# " + provenance(c) + "\n";
   for (const auto& s : c.spheres)
     spheres += fmt::format("{} {} {} {}\n", coordinate(s.centre.x()), coordinate(s.centre.y()),
                            coordinate(s.centre.z()), coordinate(s.radius));
-  const std::string id = identifier(c.name);
-  const Eigen::Matrix3d& I = c.inertia;
   std::string snippet = fmt::format(
       "# {}\n"
       "# The body's true mass and inertia tensor (about the centre of mass, in the file's frame) override\n"
       "# LIGGGHTS' Monte-Carlo estimate; with use_density the volume is mass / density and the spheres are\n"
-      "# taken as already centred on the centre of mass, as they are.\n"
-      "fix pts_{} all particletemplate/multisphere 15485863 atom_type 1 density constant {} nspheres {} ntry 1000000 "
-      "spheres file {} scale 1.0 type 1 mass {} inertia_tensor {} {} {} {} {} {} use_density\n",
-      provenance(c), id, number(c.density), c.spheres.size(), output.filename().string(), number(c.mass),
-      number(I(0, 0)), number(I(0, 1)), number(I(0, 2)), number(I(1, 1)), number(I(1, 2)), number(I(2, 2)));
+      "# taken as already centred on the centre of mass, as they are.\n",
+      provenance(c));
+  snippet += liggghts_fix(c, output.filename().string(), ids);
   return {{output, spheres}, {fs::path(output.string() + ".in"), snippet}};
 }
 
@@ -102,7 +109,7 @@ Result<Files> yade(const Clump& c, const fs::path& output) {
       "# {}\n"
       "# Builds the clump in YADE with the body's centre of mass, principal axes, mass and inertia. In a YADE script:\n"
       "#   exec(open('{}').read()); clump_id = add_clump(material=my_material, position=Vector3(0, 0, 0.1))\n"
-      "# `position` is where the body's centre of mass goes; the clump keeps the file's orientation.\n"
+      "# `position` is where the body's centre of mass goes; `orientation` (a Quaternion) turns the file's frame.\n"
       "# YADE places a clump at its members' volume centroid (overlaps counted twice) with axes along their\n"
       "# principal axes. The members are therefore clumped with the weighting radii below, whose volumes put\n"
       "# that centroid on the body's centre of mass and those axes on the body's principal axes (computed by\n"
@@ -111,7 +118,7 @@ Result<Files> yade(const Clump& c, const fs::path& output) {
       "import os\n"
       "from math import pi\n"
       "from yade import utils\n"
-      "from yade.minieigenHP import Vector3, Matrix3\n"
+      "from yade.minieigenHP import Vector3, Matrix3, Quaternion\n"
       "CF_SPHERES_FILE = os.path.join(os.path.dirname(os.path.abspath(globals().get('__file__', '{}'))), '{}')\n"
       "CF_MASS = {}  # kg\n"
       "CF_INERTIA = Matrix3({}, {}, {},\n                     {}, {}, {},\n                     {}, {}, {})  # kg m^2, "
@@ -119,7 +126,8 @@ Result<Files> yade(const Clump& c, const fs::path& output) {
       "CF_DENSITY = {}  # kg/m^3\n"
       "CF_WEIGHTING_RADII = [{}\n]  # m, one per sphere in file order\n"
       "\n"
-      "def add_clump(material=None, position=Vector3(0, 0, 0), spheres_file=None):\n"
+      "def add_clump(material=None, position=Vector3(0, 0, 0), orientation=None, spheres_file=None):\n"
+      "    # orientation: a Quaternion turning the file's frame into the world's (None: the file's).\n"
       "    kw = {{}} if material is None else {{'material': material}}\n"
       "    path = spheres_file or CF_SPHERES_FILE\n"
       "    if not os.path.exists(path):\n"
@@ -128,7 +136,8 @@ Result<Files> yade(const Clump& c, const fs::path& output) {
       "    if len(rows) != len(CF_WEIGHTING_RADII):\n"
       "        raise ValueError('%s has %d spheres, this script expects %d' % (path, len(rows), "
       "len(CF_WEIGHTING_RADII)))\n"
-      "    centres = [Vector3(float(r[0]), float(r[1]), float(r[2])) for r in rows]\n"
+      "    turn = Matrix3.Identity if orientation is None else orientation.toRotationMatrix()\n"
+      "    centres = [turn * Vector3(float(r[0]), float(r[1]), float(r[2])) for r in rows]\n"
       "    members = [utils.sphere(position + x, w, **kw) for x, w in zip(centres, CF_WEIGHTING_RADII)]\n"
       "    clump_id, member_ids = O.bodies.appendClumped(members)\n"
       "    for member_id, row in zip(member_ids, rows):\n"
@@ -139,7 +148,7 @@ Result<Files> yade(const Clump& c, const fs::path& output) {
       "        member.state.inertia = Vector3(1, 1, 1) * 0.4 * member.state.mass * radius ** 2\n"
       "    state = O.bodies[clump_id].state\n"
       "    rotation = state.ori.toRotationMatrix()\n"
-      "    local = rotation.transpose() * CF_INERTIA * rotation\n"
+      "    local = rotation.transpose() * (turn * CF_INERTIA * turn.transpose()) * rotation\n"
       "    state.mass = CF_MASS\n"
       "    state.inertia = Vector3(local[0, 0], local[1, 1], local[2, 2])\n"
       "    return clump_id\n",
@@ -274,7 +283,7 @@ Files csv(const Clump& c, const fs::path& output) {
                         coordinate(s.radius));
   return {{output, text}};
 }
-}  // namespace
+}  // namespace export_detail
 
 Result<ExportFormat> parse_export_format(std::string_view name) {
   for (const auto& [key, format] : kFormats) {
@@ -297,7 +306,8 @@ Result<ExportResult> export_clump(const Clump& clump, ExportFormat format, const
   return export_clump(clump, ExportOptions{.format = format}, output);
 }
 
-Result<ExportResult> export_clump(const Clump& clump, const ExportOptions& options, const fs::path& output) {
+namespace export_detail {
+Result<Files> format_files(const Clump& clump, const ExportOptions& options, const fs::path& output) {
   const ExportFormat format = options.format;
   if (clump.spheres.empty() || !(clump.mass > 0.0) || !(clump.density > 0.0)) {
     return fail(ErrorCode::InvalidArgument, fmt::format("clump '{}' has no spheres or no mass", clump.name));
@@ -305,7 +315,7 @@ Result<ExportResult> export_clump(const Clump& clump, const ExportOptions& optio
   Files files;
   switch (format) {
     case ExportFormat::Liggghts:
-      files = liggghts(clump, output);
+      files = liggghts(clump, output, {});
       break;
     case ExportFormat::Yade: {
       auto built = yade(clump, output);
@@ -342,9 +352,16 @@ Result<ExportResult> export_clump(const Clump& clump, const ExportOptions& optio
       files = csv(clump, output);
       break;
   }
-  if (auto ok = write_files_atomically(files); !ok) return std::unexpected(ok.error());
+  return files;
+}
+}  // namespace export_detail
+
+Result<ExportResult> export_clump(const Clump& clump, const ExportOptions& options, const fs::path& output) {
+  auto files = export_detail::format_files(clump, options, output);
+  if (!files) return std::unexpected(files.error());
+  if (auto ok = write_files_atomically(*files); !ok) return std::unexpected(ok.error());
   ExportResult result;
-  for (const auto& [path, content] : files) result.files.push_back(path);
+  for (const auto& [path, content] : *files) result.files.push_back(path);
   return result;
 }
 

@@ -230,6 +230,57 @@ TEST(Exports, ChronoCsvReadsByItsHeaderNames) {
   EXPECT_EQ(rows, c.spheres.size());
 }
 
+TEST(Exports, APopulationHasEveryClumpsFilesAndItsFractionsInEveryFormat) {
+  const Clump a = clump_for_export();
+  Clump b = clump_for_export();
+  b.name = "other-2mm";
+  b.mass *= 3.0;
+  for (auto format : {ExportFormat::Liggghts, ExportFormat::Yade, ExportFormat::Edem, ExportFormat::Pfc,
+                      ExportFormat::MercuryDpm, ExportFormat::Chrono, ExportFormat::Vtk, ExportFormat::Csv}) {
+    test::ScratchDir dir("population");
+    const auto out = dir / "mix";
+    const auto written =
+        export_population({a, b}, {.format = format, .fractions = {1.0, 1.0}, .basis = FractionBasis::Number}, out);
+    ASSERT_TRUE(written) << to_string(format) << ": " << written.error().message;
+    // Equal numbers, the second three times as heavy: mass fractions 1/4 and 3/4.
+    EXPECT_NEAR(written->number_fractions[0], 0.5, 1e-15);
+    EXPECT_NEAR(written->mass_fractions[0], 0.25, 1e-15);
+    EXPECT_NEAR(written->mass_fractions[1], 0.75, 1e-15);
+    const std::string csv = test::read_text(out / "population.csv");
+    EXPECT_NE(csv.find("lattice-2mm,lattice_2mm,"), std::string::npos) << csv;
+    EXPECT_NE(csv.find("other-2mm,other_2mm,"), std::string::npos) << csv;
+    EXPECT_GE(written->files.size(), 3u) << to_string(format);
+    for (const auto& f : written->files) EXPECT_TRUE(std::filesystem::exists(f)) << f;
+    if (format == ExportFormat::MercuryDpm) {
+      EXPECT_EQ(read_as_mercurydpm(out).size(), 2u);
+    }
+    if (format == ExportFormat::Liggghts) {
+      const std::string in = test::read_text(out / "population.in");
+      EXPECT_NE(in.find("particletemplate/multisphere 15485867 atom_type 1"), std::string::npos) << in;
+      EXPECT_NE(in.find("particletemplate/multisphere 15485917 atom_type 1"), std::string::npos) << in;
+      EXPECT_NE(in.find("type 2 mass"), std::string::npos);
+      EXPECT_NE(in.find("particledistribution/discrete/numberbased 15485927 2 pts_lattice_2mm 0.5 pts_other_2mm 0.5"),
+                std::string::npos)
+          << in;
+    }
+  }
+}
+
+TEST(Exports, APopulationRefusesClashingNamesAndWrongFractionsAndWritesNothing) {
+  test::ScratchDir dir("population");
+  const Clump a = clump_for_export();
+  const auto same = export_population({a, a}, {.format = ExportFormat::Csv}, dir / "mix");
+  ASSERT_FALSE(same);
+  EXPECT_EQ(same.error().code, ErrorCode::InvalidArgument);
+  Clump b = a;
+  b.name = "b";
+  EXPECT_FALSE(export_population({a, b}, {.format = ExportFormat::Csv, .fractions = {1.0}}, dir / "mix"));
+  EXPECT_FALSE(export_population({a, b}, {.format = ExportFormat::Csv, .fractions = {1.0, -2.0}}, dir / "mix"));
+  EXPECT_FALSE(export_population({a}, {.format = ExportFormat::Csv}, dir / "mix"));
+  EXPECT_EQ(test::count_files(dir.path()), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "mix"));
+}
+
 TEST(Exports, UnknownFormatGetsASuggestion) {
   const auto bad = parse_export_format("liggghs");
   ASSERT_FALSE(bad);
