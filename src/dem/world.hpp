@@ -6,27 +6,27 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/clump.hpp"
 #include "dem/contact_state.hpp"
 #include "dem/materials.hpp"
 #include "dem/terms/terms.hpp"
-#include "core/clump.hpp"
 
 namespace clumpforge {
 
 /// A rigid clump: spheres fixed in its body frame (principal axes, centre of mass at the
 /// origin), diagonal inertia in that frame.
 struct RigidBody {
-  std::vector<Sphere> spheres;                                  ///< body frame [m]
-  double mass = 0.0;                                            ///< [kg]
-  Eigen::Vector3d inertia = Eigen::Vector3d::Ones();            ///< principal moments [kg m^2]
-  int material = 0;                                             ///< index into World::materials
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();           ///< centre of mass, world [m]
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();           ///< [m/s]
+  std::vector<Sphere> spheres;                                      ///< body frame [m]
+  double mass = 0.0;                                                ///< [kg]
+  Eigen::Vector3d inertia = Eigen::Vector3d::Ones();                ///< principal moments [kg m^2]
+  int material = 0;                                                 ///< index into World::materials
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();               ///< centre of mass, world [m]
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();               ///< [m/s]
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< body -> world
-  Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();   ///< world frame [kg m^2/s]
-  double bounding_radius = 0.0;                                 ///< max |centre| + radius [m]
+  Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();       ///< world frame [kg m^2/s]
+  double bounding_radius = 0.0;                                     ///< max |centre| + radius [m]
 
-  Eigen::Vector3d angular_velocity() const;                     ///< world frame [rad/s]
+  Eigen::Vector3d angular_velocity() const;  ///< world frame [rad/s]
   Eigen::Vector3d sphere_position(std::size_t k) const { return position + orientation * spheres[k].centre; }
   double kinetic_energy() const;
 };
@@ -46,8 +46,8 @@ struct Wall {
   Eigen::Vector3d u_axis = Eigen::Vector3d::UnitX();  ///< in-plane axes of a finite plate
   double half_u = 0.0, half_v = 0.0;                  ///< [m]; 0 = infinite in that direction
   int material = 0;
-  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();    ///< tilting axis point [m]
-  Eigen::Vector3d spin = Eigen::Vector3d::Zero();     ///< angular velocity of the wall [rad/s]
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  ///< tilting axis point [m]
+  Eigen::Vector3d spin = Eigen::Vector3d::Zero();   ///< angular velocity of the wall [rad/s]
 
   Eigen::Vector3d v_axis() const { return normal.cross(u_axis); }
   /// Velocity of the wall's material point at p.
@@ -61,8 +61,8 @@ enum class RollingArm {
 };
 
 struct ContactSettings {
-  bool limit_force = false;          ///< LIGGGHTS `limitForce`: clip attractive damped Fn (default off, as LIGGGHTS)
-  bool tangential_damping = true;    ///< LIGGGHTS default
+  bool limit_force = false;        ///< LIGGGHTS `limitForce`: clip attractive damped Fn (default off, as LIGGGHTS)
+  bool tangential_damping = true;  ///< LIGGGHTS default
   /// Coulomb limit on the whole tangential force (spring + dashpot). LIGGGHTS checks the
   /// spring alone and adds the dashpot after, which can exceed mu_s |Fn| when a fast-sliding
   /// contact's normal force grows (false reproduces LIGGGHTS exactly).
@@ -70,8 +70,23 @@ struct ContactSettings {
   RollingModel rolling = RollingModel::ConstantTorque;
   /// EDEM's standard model (the convention of the study's mu_r values); LIGGGHTS uses the sphere radius.
   RollingArm rolling_arm = RollingArm::ContactToCentre;
-  double rolling_damping = 0.3;      ///< eta_r of EPSD (Ai et al. suggest 0.3)
+  double rolling_damping = 0.3;  ///< eta_r of EPSD (Ai et al. suggest 0.3)
 };
+
+/// Whose conventions the contact law follows where engines differ: EDEM's (clumpforge's
+/// default: the rolling lever from the contact point to the centre of mass, the Coulomb limit
+/// on spring + dashpot) or LIGGGHTS' (the lever the sphere's radius, the limit on the spring
+/// alone). Coefficients calibrated under one set carry over to that engine unchanged.
+enum class ContactConventions { Edem, Liggghts };
+
+inline ContactSettings contact_settings(ContactConventions conventions) {
+  ContactSettings s;
+  if (conventions == ContactConventions::Liggghts) {
+    s.coulomb_on_total = false;
+    s.rolling_arm = RollingArm::SphereRadius;
+  }
+  return s;
+}
 
 struct World {
   std::vector<RigidBody> bodies;
@@ -81,13 +96,13 @@ struct World {
   std::vector<std::vector<Interaction>> interactions;
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};
   ContactSettings contact;
-  std::vector<PhysicsTerm> terms;   ///< extra physics (air drag, ...)
-  double time = 0.0;                ///< [s]
+  std::vector<PhysicsTerm> terms;  ///< extra physics (air drag, ...)
+  double time = 0.0;               ///< [s]
   std::uint64_t steps = 0;
   std::unordered_map<std::uint64_t, ContactState> history;  ///< key: contact id
   /// Per (body, wall): spheres that may touch the wall before the next refresh.
   std::vector<std::vector<std::vector<int>>> wall_candidates;
-  std::vector<double> candidate_travel;  ///< per body: motion since its candidates were refreshed [m]
+  std::vector<double> candidate_travel;        ///< per body: motion since its candidates were refreshed [m]
   std::vector<Eigen::Vector3d> force, torque;  ///< per body, at the current state (world frame)
   bool forces_current = false;
 };

@@ -17,25 +17,9 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The apex of the lowest point after the first impact and before the second (or the end).
-double first_rebound(const std::vector<double>& lowest) {
-  bool impacted = false, airborne = false;
-  double apex = 0.0;
-  for (double h : lowest) {
-    const bool touching = h <= 0.0;
-    if (!impacted) {
-      impacted = touching;
-      continue;
-    }
-    if (!touching) airborne = true;
-    if (airborne && touching) break;
-    apex = std::max(apex, h);
-  }
-  return apex;
-}
-
-std::string liggghts_input(const Clump& c, const Eigen::Quaterniond& q, const Eigen::Vector3d& start, const Material& tuber,
-                           const Material& steel, const Interaction& i, double dt, int steps, int every) {
+std::string liggghts_input(const Clump& c, const Eigen::Quaterniond& q, const Eigen::Vector3d& start,
+                           const Material& tuber, const Material& steel, const Interaction& i, double dt, int steps,
+                           int every) {
   const Eigen::Matrix3d r = q.toRotationMatrix();
   const Eigen::Matrix3d inertia = r * c.principal_moments.asDiagonal() * r.transpose();
   const double radius = c.spheres[0].radius;
@@ -45,7 +29,8 @@ std::string liggghts_input(const Clump& c, const Eigen::Quaterniond& q, const Ei
     spheres += fmt::format("{:.12g} {:.12g} {:.12g} {:.12g}\n", p.x(), p.y(), p.z(), s.radius);
   }
   write_text("rotated.multisphere", spheres);
-  return fmt::format(R"(atom_style sphere
+  return fmt::format(
+      R"(atom_style sphere
 atom_modify map array
 boundary f f f
 newton off
@@ -79,13 +64,33 @@ thermo_modify norm no
 thermo {every}
 run {steps}
 )",
-                     tuber.youngs_modulus, steel.youngs_modulus, tuber.poisson_ratio, steel.poisson_ratio, fmt::arg("e", i.restitution),
-                     fmt::arg("mu", i.static_friction), fmt::arg("mr", i.rolling_friction), fmt::arg("dt", dt), fmt::arg("rho", c.density),
-                     fmt::arg("n", c.spheres.size()), fmt::arg("m", c.mass), fmt::arg("ixx", inertia(0, 0)), fmt::arg("ixy", inertia(0, 1)),
-                     fmt::arg("ixz", inertia(0, 2)), fmt::arg("iyy", inertia(1, 1)), fmt::arg("iyz", inertia(1, 2)),
-                     fmt::arg("izz", inertia(2, 2)), fmt::arg("x0", start.x() - 1e-6), fmt::arg("x1", start.x() + 1e-6),
-                     fmt::arg("y0", start.y() - 1e-6), fmt::arg("y1", start.y() + 1e-6), fmt::arg("z0", start.z() - 1e-6),
-                     fmt::arg("z1", start.z() + 1e-6), fmt::arg("radius", radius), fmt::arg("every", every), fmt::arg("steps", steps));
+      tuber.youngs_modulus, steel.youngs_modulus, tuber.poisson_ratio, steel.poisson_ratio,
+      fmt::arg("e", i.restitution), fmt::arg("mu", i.static_friction), fmt::arg("mr", i.rolling_friction),
+      fmt::arg("dt", dt), fmt::arg("rho", c.density), fmt::arg("n", c.spheres.size()), fmt::arg("m", c.mass),
+      fmt::arg("ixx", inertia(0, 0)), fmt::arg("ixy", inertia(0, 1)), fmt::arg("ixz", inertia(0, 2)),
+      fmt::arg("iyy", inertia(1, 1)), fmt::arg("iyz", inertia(1, 2)), fmt::arg("izz", inertia(2, 2)),
+      fmt::arg("x0", start.x() - 1e-6), fmt::arg("x1", start.x() + 1e-6), fmt::arg("y0", start.y() - 1e-6),
+      fmt::arg("y1", start.y() + 1e-6), fmt::arg("z0", start.z() - 1e-6), fmt::arg("z1", start.z() + 1e-6),
+      fmt::arg("radius", radius), fmt::arg("every", every), fmt::arg("steps", steps));
+}
+
+}  // namespace
+
+// The apex of the lowest point after the first impact and before the second (or the end).
+double first_rebound(const std::vector<double>& lowest) {
+  bool impacted = false, airborne = false;
+  double apex = 0.0;
+  for (double h : lowest) {
+    const bool touching = h <= 0.0;
+    if (!impacted) {
+      impacted = touching;
+      continue;
+    }
+    if (!touching) airborne = true;
+    if (airborne && touching) break;
+    apex = std::max(apex, h);
+  }
+  return apex;
 }
 
 std::vector<double> thermo_column(const std::string& log) {
@@ -108,10 +113,9 @@ std::vector<double> thermo_column(const std::string& log) {
   }
   return values;
 }
-}  // namespace
 
-Result<DropComparison> compare_drop(const Clump& clump, const Eigen::Quaterniond& q, double height, const Interaction& interaction,
-                                    const fs::path& dir) {
+Result<DropComparison> compare_drop(const Clump& clump, const Eigen::Quaterniond& q, double height,
+                                    const Interaction& interaction, const fs::path& dir) {
   const MaterialTable table = default_material_table();
   const Material& tuber = **table.find("tuber");
   const Material& steel = **table.find("Q235");
@@ -120,7 +124,7 @@ Result<DropComparison> compare_drop(const Clump& clump, const Eigen::Quaterniond
   const int s = add_material(world, steel);
   set_interaction(world, p, s, interaction);
   world.contact.rolling = RollingModel::ConstantTorque;
-  world.contact.coulomb_on_total = false;  // LIGGGHTS checks the spring alone
+  world.contact.coulomb_on_total = false;                // LIGGGHTS checks the spring alone
   world.contact.rolling_arm = RollingArm::SphereRadius;  // LIGGGHTS cdt's lever
   world.bodies.push_back(make_body(clump, p));
   Wall floor;
@@ -144,7 +148,8 @@ Result<DropComparison> compare_drop(const Clump& clump, const Eigen::Quaterniond
     step(world, result.time_step);
     if ((i + 1) % every == 0) {
       double low = std::numeric_limits<double>::infinity();
-      for (std::size_t k = 0; k < body.spheres.size(); ++k) low = std::min(low, world.bodies[0].sphere_position(k).z() - body.spheres[k].radius);
+      for (std::size_t k = 0; k < body.spheres.size(); ++k)
+        low = std::min(low, world.bodies[0].sphere_position(k).z() - body.spheres[k].radius);
       ours.push_back(low);
     }
   }
@@ -158,9 +163,12 @@ Result<DropComparison> compare_drop(const Clump& clump, const Eigen::Quaterniond
   const auto run = run_command("liggghts -in in.drop -log none");
   result.seconds_liggghts = seconds_since(started);
   fs::current_path(previous);
-  if (run.exit_code != 0) return fail(ErrorCode::IoError, "liggghts failed: " + run.out.substr(run.out.size() > 2000 ? run.out.size() - 2000 : 0) + run.err);
+  if (run.exit_code != 0)
+    return fail(ErrorCode::IoError,
+                "liggghts failed: " + run.out.substr(run.out.size() > 2000 ? run.out.size() - 2000 : 0) + run.err);
   const auto theirs = thermo_column(run.out);
-  if (theirs.size() < 100) return fail(ErrorCode::ParseError, "liggghts printed no thermo table: " + run.out.substr(0, 3000));
+  if (theirs.size() < 100)
+    return fail(ErrorCode::ParseError, "liggghts printed no thermo table: " + run.out.substr(0, 3000));
   result.rebound_liggghts = first_rebound(theirs);
   return result;
 }

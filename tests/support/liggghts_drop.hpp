@@ -4,6 +4,8 @@
 /// orientation; used by the cross-check test and bench/bench_liggghts.
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "core/clump.hpp"
 #include "core/error.hpp"
@@ -16,8 +18,14 @@ struct DropComparison {
   double rebound_liggghts = 0.0;    ///< [m]
   double seconds_clumpforge = 0.0;  ///< wall time of the run
   double seconds_liggghts = 0.0;
-  double time_step = 0.0;           ///< [s], the same in both
+  double time_step = 0.0;  ///< [s], the same in both
 };
+
+/// The apex of the lowest point after the first impact and before the second (or the end),
+/// from a series of lowest-point heights [m].
+double first_rebound(const std::vector<double>& lowest);
+/// The "v_low" column of the last thermo table (`thermo_style custom step v_low`) in a LIGGGHTS log.
+std::vector<double> thermo_column(const std::string& log);
 
 /// Drops `clump` (all spheres of one radius) from `height` with orientation `q` onto Q235 in
 /// both engines; LIGGGHTS works in `dir`.
