@@ -25,48 +25,18 @@ constexpr const char* kCalibration = R"({"method": "joint", "conventions": "%s",
   {"surface": "Q235", "restitution": {"value": 0.70}, "static_friction": {"value": 0.45}, "rolling_friction": {"value": 0.025}},
   {"surface": "soil", "restitution": {"value": 0.47}, "static_friction": {"value": 0.72}, "rolling_friction": {"value": 0.03}}]})";
 
-struct Drop {
-  Eigen::Vector3d start;
-  double dt = 0.0;
-  int steps = 0;
-  int every = 0;
-  double rebound = 0.0;
-};
-
 // clumpforge's DEM under the conventions the calibration ran under.
-Drop clumpforge_drop(const Clump& clump, const StoredCalibration& calibration, const std::string& surface,
-                     const Eigen::Quaterniond& q) {
-  const MaterialTable& table = calibration.table;
+test::DemDrop clumpforge_drop(const Clump& clump, const StoredCalibration& calibration, const std::string& surface,
+                              const Eigen::Quaterniond& q) {
   World world;
   world.contact = contact_settings(calibration.conventions);
-  const int p = add_material(world, **table.find("tuber"));
-  const int s = add_material(world, **table.find(surface));
-  set_interaction(world, p, s, *table.interaction("tuber", surface));
-  world.bodies.push_back(make_body(clump, p));
+  const int p = add_material(world, **calibration.table.find("tuber"));
+  const int s = add_material(world, **calibration.table.find(surface));
+  set_interaction(world, p, s, *calibration.table.interaction("tuber", surface));
   Wall floor;
   floor.material = s;
   world.walls.push_back(floor);
-  RigidBody& body = world.bodies[0];
-  body.orientation = q;
-  double lowest = 1e9;
-  for (const auto& sphere : body.spheres) lowest = std::min(lowest, (q * sphere.centre).z() - sphere.radius);
-  body.position = {0, 0, 0.2 - lowest};  // the study's drop: the lowest point 0.2 m up
-  Drop d;
-  d.start = body.position;
-  d.dt = estimate_time_step(world, std::sqrt(2 * 9.81 * 0.2)).chosen;
-  d.steps = static_cast<int>((std::sqrt(2 * 0.2 / 9.81) + 0.45) / d.dt);
-  d.every = std::max(1, static_cast<int>(1e-4 / d.dt));
-  std::vector<double> low;
-  for (int i = 0; i < d.steps; ++i) {
-    step(world, d.dt);
-    if ((i + 1) % d.every != 0) continue;
-    double z = 1e9;
-    for (std::size_t k = 0; k < body.spheres.size(); ++k)
-      z = std::min(z, world.bodies[0].sphere_position(k).z() - body.spheres[k].radius);
-    low.push_back(z);
-  }
-  d.rebound = test::first_rebound(low);
-  return d;
+  return test::dem_drop(world, clump, p, q, 0.2);  // the study's drop: the lowest point 0.2 m up
 }
 
 // Mean first rebound over `drops` orientations of the study's drop, clumpforge's DEM under the
@@ -96,7 +66,7 @@ std::vector<double> compare_means(const std::string& conventions, int drops) {
     for (int trial = 0; trial < drops; ++trial) {
       const Eigen::Quaterniond q =
           Eigen::Quaterniond(rng.normal(), rng.normal(), rng.normal(), rng.normal()).normalized();
-      const Drop ours = clumpforge_drop(clump, *calibration, surface, q);
+      const test::DemDrop ours = clumpforge_drop(clump, *calibration, surface, q);
       const auto run = test::run_command(
           fmt::format("cd '{}' && liggghts -log none -in '{}' -var template tuber.multisphere.in -var fixid "
                       "pts_lattice_4mm -var materials "
@@ -104,8 +74,8 @@ std::vector<double> compare_means(const std::string& conventions, int drops) {
                       "-var y {:.17g} -var z {:.17g} "
                       "-var qw {:.17g} -var qx {:.17g} -var qy {:.17g} -var qz {:.17g} -var radius {:.17g}",
                       dir.path().string(), (test::source_dir() / "tests/engines/data/drop_exported.liggghts").string(),
-                      surface, ours.dt, ours.steps, ours.every, ours.start.x(), ours.start.y(), ours.start.z(), q.w(),
-                      q.x(), q.y(), q.z(), clump.spheres[0].radius));
+                      surface, ours.time_step, ours.steps, ours.every, ours.start.x(), ours.start.y(), ours.start.z(),
+                      q.w(), q.x(), q.y(), q.z(), clump.spheres[0].radius));
       EXPECT_EQ(run.exit_code, 0) << run.out.substr(run.out.size() > 3000 ? run.out.size() - 3000 : 0) << run.err;
       ours_sum += ours.rebound;
       theirs_sum += test::first_rebound(test::thermo_column(run.out));

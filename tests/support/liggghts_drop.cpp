@@ -114,6 +114,33 @@ std::vector<double> thermo_column(const std::string& log) {
   return values;
 }
 
+DemDrop dem_drop(World world, const Clump& clump, int particle, const Eigen::Quaterniond& q, double height) {
+  world.bodies.push_back(make_body(clump, particle));
+  RigidBody& body = world.bodies.back();
+  body.orientation = q;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const auto& sphere : body.spheres) lowest = std::min(lowest, (q * sphere.centre).z() - sphere.radius);
+  body.position = {0, 0, height - lowest};
+  DemDrop d;
+  d.start = body.position;
+  d.time_step = estimate_time_step(world, std::sqrt(2 * 9.81 * height)).chosen;
+  d.steps = static_cast<int>((std::sqrt(2 * height / 9.81) + 0.45) / d.time_step);
+  d.every = std::max(1, static_cast<int>(1e-4 / d.time_step));  // 10 kHz samples
+  const auto started = std::chrono::steady_clock::now();
+  std::vector<double> low;
+  for (int i = 0; i < d.steps; ++i) {
+    step(world, d.time_step);
+    if ((i + 1) % d.every != 0) continue;
+    double z = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < body.spheres.size(); ++k)
+      z = std::min(z, world.bodies.back().sphere_position(k).z() - body.spheres[k].radius);
+    low.push_back(z);
+  }
+  d.seconds = seconds_since(started);
+  d.rebound = first_rebound(low);
+  return d;
+}
+
 Result<DropComparison> compare_drop(const Clump& clump, const Eigen::Quaterniond& q, double height,
                                     const Interaction& interaction, const fs::path& dir) {
   const MaterialTable table = default_material_table();
@@ -123,43 +150,23 @@ Result<DropComparison> compare_drop(const Clump& clump, const Eigen::Quaterniond
   const int p = add_material(world, tuber);
   const int s = add_material(world, steel);
   set_interaction(world, p, s, interaction);
-  world.contact.rolling = RollingModel::ConstantTorque;
-  world.contact.coulomb_on_total = false;                // LIGGGHTS checks the spring alone
-  world.contact.rolling_arm = RollingArm::SphereRadius;  // LIGGGHTS cdt's lever
-  world.bodies.push_back(make_body(clump, p));
+  world.contact = contact_settings(ContactConventions::Liggghts);  // the spring-only Coulomb limit, cdt's sphere lever
   Wall floor;
   floor.material = s;
   world.walls.push_back(floor);
-  RigidBody& body = world.bodies[0];
-  body.orientation = q;
-  double lowest = std::numeric_limits<double>::infinity();
-  for (const auto& sphere : body.spheres) lowest = std::min(lowest, (q * sphere.centre).z() - sphere.radius);
-  body.position = {0, 0, height - lowest};
-  const Eigen::Vector3d start = body.position;
+  const DemDrop ours = dem_drop(world, clump, p, q, height);
   DropComparison result;
-  result.time_step = estimate_time_step(world, std::sqrt(2 * 9.81 * height)).chosen;
-  const double duration = std::sqrt(2 * height / 9.81) + 0.45;
-  const int steps = static_cast<int>(duration / result.time_step);
-  const int every = std::max(1, static_cast<int>(1e-4 / result.time_step));  // 10 kHz samples in both
-
-  auto started = std::chrono::steady_clock::now();
-  std::vector<double> ours;
-  for (int i = 0; i < steps; ++i) {
-    step(world, result.time_step);
-    if ((i + 1) % every == 0) {
-      double low = std::numeric_limits<double>::infinity();
-      for (std::size_t k = 0; k < body.spheres.size(); ++k)
-        low = std::min(low, world.bodies[0].sphere_position(k).z() - body.spheres[k].radius);
-      ours.push_back(low);
-    }
-  }
-  result.seconds_clumpforge = seconds_since(started);
-  result.rebound_clumpforge = first_rebound(ours);
+  result.time_step = ours.time_step;
+  result.seconds_clumpforge = ours.seconds;
+  result.rebound_clumpforge = ours.rebound;
+  const Eigen::Vector3d start = ours.start;
+  const int steps = ours.steps;
+  const int every = ours.every;
 
   const fs::path previous = fs::current_path();
   fs::current_path(dir);
   write_text("in.drop", liggghts_input(clump, q, start, tuber, steel, interaction, result.time_step, steps, every));
-  started = std::chrono::steady_clock::now();
+  const auto started = std::chrono::steady_clock::now();
   const auto run = run_command("liggghts -in in.drop -log none");
   result.seconds_liggghts = seconds_since(started);
   fs::current_path(previous);

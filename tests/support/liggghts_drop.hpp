@@ -10,6 +10,7 @@
 #include "core/clump.hpp"
 #include "core/error.hpp"
 #include "dem/materials.hpp"
+#include "dem/world.hpp"
 
 namespace clumpforge::test {
 
@@ -20,6 +21,19 @@ struct DropComparison {
   double seconds_liggghts = 0.0;
   double time_step = 0.0;  ///< [s], the same in both
 };
+
+/// The drop in clumpforge's DEM: `world` holds the materials, interactions, contact settings
+/// and the floor; the clump (material `particle`) is released from rest in orientation `q`
+/// with its lowest point `height` above the floor, and stepped at the estimate's time step.
+struct DemDrop {
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();  ///< centre of mass at release [m]
+  double time_step = 0.0;                           ///< [s]
+  int steps = 0;                                    ///< to the first rebound's end and after
+  int every = 0;                                    ///< steps between samples (10 kHz)
+  double rebound = 0.0;                             ///< apex of the first rebound [m]
+  double seconds = 0.0;                             ///< wall time
+};
+DemDrop dem_drop(World world, const Clump& clump, int particle, const Eigen::Quaterniond& q, double height);
 
 /// The apex of the lowest point after the first impact and before the second (or the end),
 /// from a series of lowest-point heights [m].
