@@ -1,14 +1,17 @@
 #include "calibrate/joint.hpp"
 
-#include <Eigen/Dense>
 #include <fmt/format.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include "calibrate/paper.hpp"
 #include "core/rng.hpp"
+#include "numerics/least_squares.hpp"
+#include "numerics/statistics.hpp"
 
 namespace clumpforge {
 namespace {
@@ -16,13 +19,8 @@ namespace {
 constexpr std::array<LabTest, 3> kTests{LabTest::Drop, LabTest::Tilt, LabTest::Roll};
 const Eigen::Vector3d kLower(0.05, 0.05, 0.0), kUpper(0.95, 1.2, 0.2);  // e, mu_s, mu_r
 
-double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); }
-double standard_error(const std::vector<double>& v) {
-  if (v.size() < 2) return 0.0;
-  const double m = mean(v);
-  double s = 0.0;
-  for (double x : v) s += (x - m) * (x - m);
-  return std::sqrt(s / static_cast<double>(v.size() - 1) / static_cast<double>(v.size()));
+double mean(const std::vector<double>& v) {
+  return sample_spread(v).mean;
 }
 
 struct Model {
@@ -52,14 +50,17 @@ struct Model {
   }
 };
 
-Eigen::Vector3d clamp(const Eigen::Vector3d& theta) { return theta.cwiseMax(kLower).cwiseMin(kUpper); }
+Eigen::Vector3d clamp(const Eigen::Vector3d& theta) {
+  return theta.cwiseMax(kLower).cwiseMin(kUpper);
+}
 }  // namespace
 
 Result<std::vector<JointSurfaceResult>> calibrate_joint(const Clump& clump, const MaterialTable& table,
-                                                        const std::vector<Recording>& recordings, const JointOptions& options,
-                                                        const RunContext& context) {
+                                                        const std::vector<Recording>& recordings,
+                                                        const JointOptions& options, const RunContext& context) {
   if (options.trials < 2 || options.tilt_trials < 1 || options.iterations < 1 || options.bootstrap < 10) {
-    return fail(ErrorCode::InvalidArgument, "joint calibration needs >= 2 trials, >= 1 tilt trial, >= 1 iteration, >= 10 resamples");
+    return fail(ErrorCode::InvalidArgument,
+                "joint calibration needs >= 2 trials, >= 1 tilt trial, >= 1 iteration, >= 10 resamples");
   }
   std::vector<std::string> surfaces;
   for (const auto& r : recordings) {
@@ -79,9 +80,10 @@ Result<std::vector<JointSurfaceResult>> calibrate_joint(const Clump& clump, cons
       for (double v : setups[k]->summaries()) measured[k].push_back(study_units(kTests[k], v));
     }
     if (std::find(setups.begin(), setups.end(), nullptr) != setups.end()) {
-      return fail(ErrorCode::InvalidArgument, fmt::format("joint calibration on {} needs drop, tilt and roll recordings with at least two "
-                                                          "trials each",
-                                                          surface));
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("joint calibration on {} needs drop, tilt and roll recordings with at least two "
+                              "trials each",
+                              surface));
     }
     Eigen::Vector3d target, target_error;
     for (int k = 0; k < 3; ++k) {
@@ -89,11 +91,8 @@ Result<std::vector<JointSurfaceResult>> calibrate_joint(const Clump& clump, cons
       target_error[k] = standard_error(measured[k]);
     }
     Model model{clump, table, setups, options};
-    const Interaction start = table.interaction(options.lab.particle_material, surface).value_or(Interaction{0.5, 0.5, 0.02});
-    Eigen::Vector3d theta = clamp(Eigen::Vector3d(start.restitution, start.static_friction, start.rolling_friction));
-    auto evaluated = model(theta);
-    if (!evaluated) return std::unexpected(evaluated.error());
-    auto [prediction, sim_error] = *evaluated;
+    const Interaction start =
+        table.interaction(options.lab.particle_material, surface).value_or(Interaction{0.5, 0.5, 0.02});
     // Each mean's uncertainty: its standard error and the simulation's, but never below the
     // instrument's resolution (the study's angle meter: +-0.2 deg; a ruler or video frame
     // read to 0.5 mm), so near-identical trials cannot claim infinite precision.
@@ -101,55 +100,42 @@ Result<std::vector<JointSurfaceResult>> calibrate_joint(const Clump& clump, cons
     auto weights = [&](const Eigen::Vector3d& sim) {
       return (target_error.array().square() + sim.array().square()).sqrt().max(resolution.array()).matrix().eval();
     };
-    auto chi2 = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& sim) {
-      return ((p - target).array() / weights(sim).array()).square().sum();
+    // The residuals (simulated - measured) / uncertainty; every evaluation is kept, so the
+    // best point's prediction and simulation error need no extra DEM run.
+    std::map<std::array<double, 3>, std::pair<Eigen::Vector3d, Eigen::Vector3d>> evaluated;
+    const ResidualFunction residuals = [&](const Eigen::VectorXd& theta) -> Result<Eigen::VectorXd> {
+      auto predicted = model(theta);
+      if (!predicted) return std::unexpected(predicted.error());
+      evaluated[{theta[0], theta[1], theta[2]}] = *predicted;
+      return Eigen::VectorXd((predicted->first - target).cwiseQuotient(weights(predicted->second)));
     };
-    double best = chi2(prediction, sim_error);
-    double lambda = 1e-2;
-    Eigen::Matrix3d jacobian = Eigen::Matrix3d::Zero();  // d prediction / d theta
-    const Eigen::Vector3d step = 0.04 * (kUpper - kLower);
-    for (int iteration = 0; iteration < options.iterations; ++iteration) {
-      context.report(fmt::format("joint calibration on {}", surface), static_cast<double>(iteration) / options.iterations);
-      for (int j = 0; j < 3; ++j) {
-        Eigen::Vector3d shifted = theta;
-        const double h = theta[j] + step[j] <= kUpper[j] ? step[j] : -step[j];
-        shifted[j] += h;
-        auto column = model(shifted);
-        if (!column) return std::unexpected(column.error());
-        jacobian.col(j) = (column->first - prediction) / h;
-      }
-      const Eigen::Vector3d w = weights(sim_error);
-      const Eigen::Matrix3d a = w.cwiseInverse().asDiagonal() * jacobian;
-      const Eigen::Vector3d r = (prediction - target).cwiseQuotient(w);
-      bool improved = false;
-      for (int attempt = 0; attempt < 4 && !improved; ++attempt) {
-        Eigen::Matrix3d normal = a.transpose() * a;
-        normal.diagonal() += lambda * normal.diagonal().cwiseMax(1e-12);
-        const Eigen::Vector3d delta = normal.ldlt().solve(-a.transpose() * r);
-        const Eigen::Vector3d candidate = clamp(theta + delta);
-        auto trial = model(candidate);
-        if (!trial) return std::unexpected(trial.error());
-        const double value = chi2(trial->first, trial->second);
-        if (value < best) {
-          improved = true;
-          best = value;
-          theta = candidate;
-          prediction = trial->first;
-          sim_error = trial->second;
-          lambda = std::max(lambda / 4.0, 1e-6);
-        } else {
-          lambda *= 8.0;
-        }
-      }
-      if (!improved || best < 1e-3) break;
-    }
-    out.chi_squared = best;
+    LeastSquaresOptions fit{.lower = kLower,
+                            .upper = kUpper,
+                            .step = 0.04 * (kUpper - kLower),
+                            .iterations = options.iterations,
+                            .attempts = 4,
+                            .lambda = 1e-2,
+                            .lambda_floor = 1e-6,
+                            .converged_gain = 0.0,
+                            .converged_value = 1e-3,
+                            .on_iteration = [&](int iteration) {
+                              context.report(fmt::format("joint calibration on {}", surface),
+                                             static_cast<double>(iteration) / options.iterations);
+                            }};
+    auto minimum = levenberg_marquardt(
+        residuals, Eigen::Vector3d(start.restitution, start.static_friction, start.rolling_friction), fit);
+    if (!minimum) return std::unexpected(minimum.error());
+    const Eigen::Vector3d theta = minimum->x;
+    const auto& [prediction, sim_error] = evaluated.at({theta[0], theta[1], theta[2]});
+    out.chi_squared = minimum->value;
     out.evaluations = model.evaluations;
     // Bootstrap over the lab's trials, through the linearised fit: theta_b = theta +
     // (A^T A)^-1 A^T (y_b - y) / w, clamped to the bounds.
     const Eigen::Vector3d w = weights(sim_error);
-    const Eigen::Matrix3d a = w.cwiseInverse().asDiagonal() * jacobian;
-    const Eigen::Matrix3d pseudo = (a.transpose() * a + 1e-12 * Eigen::Matrix3d::Identity()).ldlt().solve(a.transpose());
+    const Eigen::Matrix3d a =
+        minimum->jacobian.rows() == 3 ? Eigen::Matrix3d(minimum->jacobian) : Eigen::Matrix3d::Zero();
+    const Eigen::Matrix3d pseudo =
+        (a.transpose() * a + 1e-12 * Eigen::Matrix3d::Identity()).ldlt().solve(a.transpose());
     Rng rng(options.seed, 0x626f6f74ULL);  // "boot"
     std::array<std::vector<double>, 3> samples;
     for (int b = 0; b < options.bootstrap; ++b) {
@@ -165,7 +151,9 @@ Result<std::vector<JointSurfaceResult>> calibrate_joint(const Clump& clump, cons
     auto estimate = [&](int j) {
       auto& s = samples[j];
       std::sort(s.begin(), s.end());
-      const auto at = [&](double q) { return s[static_cast<std::size_t>(std::clamp(q * (s.size() - 1), 0.0, s.size() - 1.0))]; };
+      const auto at = [&](double q) {
+        return s[static_cast<std::size_t>(std::clamp(q * (s.size() - 1), 0.0, s.size() - 1.0))];
+      };
       return Estimate{theta[j], at(0.025), at(0.975)};
     };
     out.restitution = estimate(0);
@@ -174,14 +162,16 @@ Result<std::vector<JointSurfaceResult>> calibrate_joint(const Clump& clump, cons
     for (int k = 0; k < 3; ++k) {
       out.residuals.push_back({kTests[k], target[k], w[k], prediction[k]});
       if (std::abs(out.residuals.back().z()) > 2.0) {
-        out.notes.push_back(fmt::format("{} on {}: the model misses the measured mean by {:.1f} standard errors at the best fit", to_string(kTests[k]),
-                                        surface, out.residuals.back().z()));
+        out.notes.push_back(
+            fmt::format("{} on {}: the model misses the measured mean by {:.1f} standard errors at the best fit",
+                        to_string(kTests[k]), surface, out.residuals.back().z()));
       }
     }
     for (int j = 0; j < 3; ++j) {
       if (theta[j] <= kLower[j] + 1e-9 || theta[j] >= kUpper[j] - 1e-9) {
         out.notes.push_back(fmt::format("{} on {} sits at its bound {:g}: the data want a value outside [{:g}, {:g}]",
-                                        std::array{"restitution", "static friction", "rolling friction"}[j], surface, theta[j], kLower[j], kUpper[j]));
+                                        std::array{"restitution", "static friction", "rolling friction"}[j], surface,
+                                        theta[j], kLower[j], kUpper[j]));
       }
     }
     results.push_back(std::move(out));

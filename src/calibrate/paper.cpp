@@ -14,7 +14,9 @@ std::vector<double> steps(double low, double high, double step) {
   return values;
 }
 
-double mean(const std::vector<double>& v) { return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); }
+double mean(const std::vector<double>& v) {
+  return sample_spread(v).mean;
+}
 
 std::optional<double> study_value(const std::string& parameter, const std::string& surface) {
   // The seed study's calibrated values (../shared/reference/seed-facts.md).
@@ -43,8 +45,8 @@ struct Responses {
   double contacts = 0;              // drop: mean spheres touching at the first impact
 };
 
-Result<Responses> run_responses(const Clump& clump, const MaterialTable& table, const Recording& setup, const Interaction& interaction,
-                                const PaperOptions& options, int trials) {
+Result<Responses> run_responses(const Clump& clump, const MaterialTable& table, const Recording& setup,
+                                const Interaction& interaction, const PaperOptions& options, int trials) {
   LabOptions lab = options.lab;
   lab.trials = trials;
   lab.interaction = interaction;
@@ -74,30 +76,38 @@ void choose(ParameterCalibration& p) {
     // The root on the branch whose slope follows the sweep's trend.
     const double slope0 = 2 * p.fit.a * p.roots[0] + p.fit.b;
     p.calibrated = (slope0 >= 0) == rising ? p.roots[0] : p.roots[1];
-    p.flag = fmt::format("two roots in range ({:.4g} and {:.4g}); took {:.4g}, on the branch following the sweep's trend", p.roots[0],
-                         p.roots[1], p.calibrated);
+    p.flag =
+        fmt::format("two roots in range ({:.4g} and {:.4g}); took {:.4g}, on the branch following the sweep's trend",
+                    p.roots[0], p.roots[1], p.calibrated);
     return;
   }
   // None: the measured mean is outside what the swept range produces; take the nearer end.
   const double at_low = std::abs(p.fit(low) - p.measured_mean), at_high = std::abs(p.fit(high) - p.measured_mean);
   p.calibrated = at_low < at_high ? low : high;
-  p.flag = fmt::format("no root in [{:g}, {:g}]: the fitted curve spans {:.4g} to {:.4g}, the measured mean is {:.4g}; took the nearer end "
-                       "{:g}",
-                       low, high, p.fit(low), p.fit(high), p.measured_mean, p.calibrated);
+  p.flag = fmt::format(
+      "no root in [{:g}, {:g}]: the fitted curve spans {:.4g} to {:.4g}, the measured mean is {:.4g}; took the nearer "
+      "end "
+      "{:g}",
+      low, high, p.fit(low), p.fit(high), p.measured_mean, p.calibrated);
 }
 }  // namespace
 
-double study_units(LabTest test, double value) { return test == LabTest::Tilt ? value : value * 1e3; }
+double study_units(LabTest test, double value) {
+  return test == LabTest::Tilt ? value : value * 1e3;
+}
 
 std::vector<double> paper_levels(const std::string& parameter, const std::string& surface) {
   const bool steel = surface == "Q235", soil = surface == "soil";
-  if (parameter == "restitution") return steel ? steps(0.1, 0.8, 0.1) : soil ? steps(0.05, 0.65, 0.1) : steps(0.05, 0.85, 0.1);
-  if (parameter == "static_friction") return steel ? steps(0.1, 0.7, 0.1) : soil ? steps(0.3, 0.9, 0.1) : steps(0.1, 0.9, 0.1);
+  if (parameter == "restitution")
+    return steel ? steps(0.1, 0.8, 0.1) : soil ? steps(0.05, 0.65, 0.1) : steps(0.05, 0.85, 0.1);
+  if (parameter == "static_friction")
+    return steel ? steps(0.1, 0.7, 0.1) : soil ? steps(0.3, 0.9, 0.1) : steps(0.1, 0.9, 0.1);
   return steel ? steps(0.01, 0.07, 0.01) : soil ? steps(0.01, 0.05, 0.01) : steps(0.01, 0.07, 0.01);
 }
 
-Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable& table, const std::vector<Recording>& recordings,
-                                         const PaperOptions& options, const RunContext& context) {
+Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable& table,
+                                         const std::vector<Recording>& recordings, const PaperOptions& options,
+                                         const RunContext& context) {
   if (options.trials_per_level < 1) return fail(ErrorCode::InvalidArgument, "trials per level must be at least 1");
   std::vector<std::string> surfaces;
   for (const auto& r : recordings) {
@@ -109,17 +119,19 @@ Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable
     std::string parameter;
     LabTest test;
   };
-  const std::vector<Step> order{{"restitution", LabTest::Drop}, {"static_friction", LabTest::Tilt}, {"rolling_friction", LabTest::Roll}};
+  const std::vector<Step> order{
+      {"restitution", LabTest::Drop}, {"static_friction", LabTest::Tilt}, {"rolling_friction", LabTest::Roll}};
   std::size_t done = 0;
   for (const auto& surface : surfaces) {
     if (auto known = table.find(surface); !known) return std::unexpected(known.error());
     Interaction current = table.interaction(options.lab.particle_material, surface).value_or(Interaction{});
     for (const auto& [parameter, test] : order) {
-      context.report(fmt::format("{} on {}", parameter, surface), static_cast<double>(done++) / (3.0 * surfaces.size()));
+      context.report(fmt::format("{} on {}", parameter, surface),
+                     static_cast<double>(done++) / (3.0 * surfaces.size()));
       const Recording* recording = find_recording(recordings, surface, test);
       if (!recording) {
-        calibration.notes.push_back(fmt::format("{}: no {} recording; {} kept at {}", surface, to_string(test), parameter,
-                                                coefficient(current, parameter)));
+        calibration.notes.push_back(fmt::format("{}: no {} recording; {} kept at {}", surface, to_string(test),
+                                                parameter, coefficient(current, parameter)));
         continue;
       }
       ParameterCalibration p;

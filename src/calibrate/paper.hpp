@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "calibrate/stats.hpp"
+#include "numerics/statistics.hpp"
 #include "core/clump.hpp"
 #include "core/recording.hpp"
 #include "dem/lab.hpp"

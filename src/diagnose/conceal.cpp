@@ -8,7 +8,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "calibrate/stats.hpp"
+#include "numerics/statistics.hpp"
 #include "core/rng.hpp"
 #include "diagnose/model.hpp"
 #include "diagnose/tracks.hpp"

@@ -17,9 +17,11 @@
 
 #include "core/rng.hpp"
 #include "diagnose/model.hpp"
-#include "diagnose/optimize.hpp"
 #include "diagnose/phases.hpp"
 #include "diagnose/release.hpp"
+#include "numerics/least_squares.hpp"
+#include "numerics/minimize.hpp"
+#include "numerics/statistics.hpp"
 
 namespace clumpforge {
 namespace {
@@ -31,14 +33,6 @@ constexpr double kNever = std::numeric_limits<double>::infinity();
 /// significant 0.02 mm is not a physics question.
 constexpr double kPracticalExcess = 1.5;
 
-/// Upper tail of chi^2 with n degrees of freedom (Wilson-Hilferty).
-double chi2_tail(double chi2, double n) {
-  if (n <= 0.0) return 1.0;
-  const double a = 2.0 / (9.0 * n);
-  const double z = (std::cbrt(chi2 / n) - (1.0 - a)) / std::sqrt(a);
-  return 0.5 * std::erfc(z / std::sqrt(2.0));
-}
-
 /// A phase's residual beyond the noise: significant after a Bonferroni correction over the
 /// `groups` phases, and large (kPracticalExcess).
 /// chi^2 per value of a misfit three times the noise (RMS): a mismatch whatever its shape.
@@ -48,7 +42,7 @@ constexpr double kLargeMisfit = 10.0;
 constexpr double kUnpinned = 10.0;
 
 bool beyond_noise(double chi2, int values, std::size_t groups) {
-  return values > 0 && chi2_tail(chi2, values) < 1e-3 / std::max<std::size_t>(1, groups) &&
+  return values > 0 && chi2_upper_tail(chi2, values) < 1e-3 / std::max<std::size_t>(1, groups) &&
          chi2 / values > kPracticalExcess;
 }
 
@@ -167,8 +161,7 @@ Growth growth_law(const Group& g, bool z_axis) {
     if (!s.tau.empty()) ends.push_back(s.tau.back());
   }
   if (ends.empty()) return {};
-  std::nth_element(ends.begin(), ends.begin() + static_cast<std::ptrdiff_t>(ends.size() / 2), ends.end());
-  const double tau_end = std::max(ends[ends.size() / 2], 1e-3);
+  const double tau_end = std::max(median(std::move(ends)), 1e-3);
   Growth best;
   double total = 0.0;
   for (const auto& s : g.segments) {
@@ -495,8 +488,10 @@ struct Fitted {
 /// simplex or coordinate search stalls in.
 Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::vector<FitParameter>& parameters,
                                     const std::vector<std::size_t>& which, std::vector<double> unit, int iterations) {
-  auto residual_vector = [&](const std::vector<double>& u) -> Result<Eigen::VectorXd> {
-    auto scores = evaluate(c.ev, apply_parameters(start, parameters, u), which, false, true);
+  const ResidualFunction residuals = [&](const Eigen::VectorXd& x) -> Result<Eigen::VectorXd> {
+    auto scores =
+        evaluate(c.ev, apply_parameters(start, parameters, std::vector<double>(x.data(), x.data() + x.size())), which,
+                 false, true);
     c.evaluations += static_cast<int>(which.size());
     if (!scores) return std::unexpected(scores.error());
     std::size_t n = 0;
@@ -509,89 +504,22 @@ Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::v
     return r;
   };
   const auto p = static_cast<Eigen::Index>(parameters.size());
-  Minimum out;
-  auto r0 = residual_vector(unit);
-  if (!r0) return std::unexpected(r0.error());
-  Eigen::VectorXd r = *r0;
-  double value = r.squaredNorm();
-  double lambda = 1e-3;
-  out.evaluations = 1;
-  for (int iteration = 0; iteration < iterations; ++iteration) {
-    // The Jacobian of the residuals with the track origins refitted (profiled): the origins
-    // absorb part of a change (a later fall is partly a later release), and the step must
-    // know it. The origin search is a golden section in a single bowl, smooth to 1 us.
-    const Eigen::VectorXd* held = &r;
-    Eigen::MatrixXd jacobian(held->size(), p);
-    bool same_size = held->size() == r.size();
-    for (Eigen::Index k = 0; k < p && same_size; ++k) {
-      std::vector<double> u = unit;
-      const double h = u[static_cast<std::size_t>(k)] + 2e-3 <= 1.0 ? 2e-3 : -2e-3;
-      u[static_cast<std::size_t>(k)] += h;
-      auto rk = residual_vector(u);
-      ++out.evaluations;
-      if (!rk) return std::unexpected(rk.error());
-      if (rk->size() != held->size()) {
-        same_size = false;
-        break;
-      }
-      jacobian.col(k) = (*rk - *held) / h;
-    }
-    if (!same_size) break;
-    const Eigen::MatrixXd jtj = jacobian.transpose() * jacobian;
-    const Eigen::VectorXd jtr = jacobian.transpose() * r;
-    bool improved = false;
-    for (int attempt = 0; attempt < 6 && !improved; ++attempt) {
-      Eigen::MatrixXd a = jtj;
-      a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-12);
-      // Projected step: a parameter at its bound that the step would push outwards is held
-      // there (else clamping it would break the balance of correlated parameters).
-      Eigen::VectorXd delta = a.ldlt().solve(-jtr);
-      std::vector<bool> held_at_bound(static_cast<std::size_t>(p), false);
-      for (int pass = 0; pass < 3; ++pass) {
-        bool changed = false;
-        for (Eigen::Index k = 0; k < p; ++k) {
-          const double u = unit[static_cast<std::size_t>(k)];
-          if (!held_at_bound[static_cast<std::size_t>(k)] &&
-              ((u <= 1e-9 && delta(k) < 0.0) || (u >= 1.0 - 1e-9 && delta(k) > 0.0))) {
-            held_at_bound[static_cast<std::size_t>(k)] = true;
-            changed = true;
-          }
-        }
-        if (!changed) break;
-        Eigen::MatrixXd reduced = a;
-        Eigen::VectorXd rhs = -jtr;
-        for (Eigen::Index k = 0; k < p; ++k) {
-          if (!held_at_bound[static_cast<std::size_t>(k)]) continue;
-          reduced.row(k).setZero();
-          reduced.col(k).setZero();
-          reduced(k, k) = 1.0;
-          rhs(k) = 0.0;
-        }
-        delta = reduced.ldlt().solve(rhs);
-      }
-      std::vector<double> u = unit;
-      for (Eigen::Index k = 0; k < p; ++k)
-        u[static_cast<std::size_t>(k)] = std::clamp(u[static_cast<std::size_t>(k)] + delta(k), 0.0, 1.0);
-      auto rt = residual_vector(u);
-      ++out.evaluations;
-      if (!rt) return std::unexpected(rt.error());
-      if (rt->size() == r.size() && rt->squaredNorm() < value) {
-        const double gain = value - rt->squaredNorm();
-        unit = u;
-        r = *rt;
-        value = r.squaredNorm();
-        lambda = std::max(1e-7, lambda / 4.0);
-        improved = true;
-        if (gain < 0.5) iteration = iterations;  // converged
-      } else {
-        lambda *= 8.0;
-      }
-    }
-    if (!improved) break;
-  }
-  out.x = unit;
-  out.value = value;
-  return out;
+  // The unit box; the residuals are profiled over the track origins (a later fall is partly
+  // a later release), which a golden section fits smoothly to 1 us, so differences of 2e-3
+  // of a parameter's range see the coefficients' effect and not the origin search's steps.
+  LeastSquaresOptions options{.lower = Eigen::VectorXd::Zero(p),
+                              .upper = Eigen::VectorXd::Ones(p),
+                              .step = Eigen::VectorXd::Constant(p, 2e-3),
+                              .iterations = iterations,
+                              .attempts = 6,
+                              .lambda = 1e-3,
+                              .lambda_floor = 1e-7,
+                              .converged_gain = 0.5,
+                              .converged_value = 0.0,
+                              .on_iteration = {}};
+  auto fit = clumpforge::levenberg_marquardt(residuals, Eigen::Map<const Eigen::VectorXd>(unit.data(), p), options);
+  if (!fit) return std::unexpected(fit.error());
+  return Minimum{std::vector<double>(fit->x.data(), fit->x.data() + p), fit->value, fit->evaluations};
 }
 
 /// The free parameters of a fit: the effect's (when `spec` is set) and the base coefficients
@@ -917,7 +845,7 @@ std::vector<PhaseReport> locate(const Context& c, const Groups& groups) {
     p.phase = std::string(phase_name(key.phase));
     p.values = g.values;
     p.chi2_per_value = g.chi2 / g.values;
-    p.p_value = chi2_tail(g.chi2, g.values);
+    p.p_value = chi2_upper_tail(g.chi2, g.values);
     p.significant = beyond_noise(g.chi2, g.values, groups.size());
     const double sigma_mm = c.ev.sigma[key.recording] * 1000.0;
     p.bias_x_mm = g.count_x ? sigma_mm * g.sum_x / g.count_x : 0.0;
@@ -1543,7 +1471,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   std::vector<const EnsembleHypothesis*> passing;
   for (const auto& h : ens->hypotheses) {
     const double dof = ens->outcomes - static_cast<double>(h.values.size());
-    const bool consistent = chi2_tail(h.chi2, dof) >= 1e-4;
+    const bool consistent = chi2_upper_tail(h.chi2, dof) >= 1e-4;
     if (h.plausible && h.delta_bic >= options.min_delta_bic && consistent) passing.push_back(&h);
     if (h.plausible && h.delta_bic >= options.min_delta_bic && !consistent) {
       result.notes.push_back(fmt::format(

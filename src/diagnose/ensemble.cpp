@@ -8,9 +8,9 @@
 #include <limits>
 #include <numbers>
 
-#include "calibrate/stats.hpp"
 #include "diagnose/release.hpp"
 #include "diagnose/tracks.hpp"
+#include "numerics/statistics.hpp"
 
 namespace clumpforge {
 
@@ -29,12 +29,6 @@ std::string_view outcome_name(Outcome outcome) {
 }
 
 namespace {
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 std::vector<Outcome> outcomes_of(LabTest test) {
   if (test == LabTest::Drop) return {Outcome::ReboundHeight, Outcome::Drift};
@@ -56,7 +50,7 @@ std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const Pat
     xs.push_back(path.x[valid[k]]);
     zs.push_back(path.z[valid[k]]);
   }
-  const double x_rest = median_of(xs), z_rest = median_of(zs);
+  const double x_rest = median(xs), z_rest = median(zs);
   // Time to rest: the last frame farther than `moved` from the rest point.
   double rest_time = 0.0;
   for (std::size_t i : valid) {

@@ -5,9 +5,9 @@
 #include <cmath>
 #include <numeric>
 
-#include "calibrate/stats.hpp"
+#include "numerics/statistics.hpp"
 #include "diagnose/diagnose.hpp"
-#include "diagnose/optimize.hpp"
+#include "numerics/minimize.hpp"
 
 namespace clumpforge {
 

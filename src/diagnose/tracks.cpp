@@ -6,14 +6,15 @@
 #include <numbers>
 #include <vector>
 
+#include "numerics/statistics.hpp"
+
 namespace clumpforge {
 
 double frame_interval(const Track& track) {
   std::vector<double> gaps;
   for (std::size_t i = 1; i < track.size(); ++i) gaps.push_back(track.t[i] - track.t[i - 1]);
   if (gaps.empty()) return 0.0;
-  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
-  return gaps[gaps.size() / 2];
+  return median(std::move(gaps));
 }
 
 double estimate_noise(const std::vector<const Track*>& tracks) {
@@ -33,10 +34,8 @@ double estimate_noise(const std::vector<const Track*>& tracks) {
     }
   }
   if (differences.size() < 10) return std::numeric_limits<double>::quiet_NaN();
-  std::nth_element(differences.begin(), differences.begin() + static_cast<std::ptrdiff_t>(differences.size() / 2),
-                   differences.end());
   // For Gaussian noise the median |d| is 0.6745 sd(d), sd(d) = sqrt(20) sigma.
-  return differences[differences.size() / 2] / (0.6744897501960817 * std::sqrt(20.0));
+  return median(std::move(differences)) / (0.6744897501960817 * std::sqrt(20.0));
 }
 
 ReplayPoint interpolate(const std::vector<ReplaySample>& replay, double t) {

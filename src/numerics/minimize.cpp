@@ -1,11 +1,12 @@
-#include "diagnose/optimize.hpp"
+#include "numerics/minimize.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace clumpforge {
 
-Minimum golden_section(const std::function<double(double)>& f, double low, double high, double tolerance, int max_evaluations) {
+Minimum golden_section(const std::function<double(double)>& f, double low, double high, double tolerance,
+                       int max_evaluations) {
   constexpr double kGolden = 0.6180339887498949;
   Minimum result;
   double c = high - kGolden * (high - low), d = low + kGolden * (high - low);

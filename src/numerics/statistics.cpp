@@ -1,7 +1,9 @@
-#include "calibrate/stats.hpp"
+#include "numerics/statistics.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace clumpforge {
 
@@ -90,7 +92,8 @@ double beta_fraction(double a, double b, double x) {
 double incomplete_beta(double a, double b, double x) {
   if (x <= 0.0) return 0.0;
   if (x >= 1.0) return 1.0;
-  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x));
+  const double front =
+      std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x));
   if (x < (a + 1.0) / (a + b + 2.0)) return front * beta_fraction(a, b, x) / a;
   return 1.0 - front * beta_fraction(b, a, 1.0 - x) / b;
 }
@@ -110,6 +113,24 @@ SampleSpread sample_spread(const std::vector<double>& values) {
   for (double v : values) squares += (v - s.mean) * (v - s.mean);
   s.sd = values.size() > 1 ? std::sqrt(squares / static_cast<double>(values.size() - 1)) : 0.0;
   return s;
+}
+
+double standard_error(const std::vector<double>& values) {
+  if (values.size() < 2) return 0.0;
+  return sample_spread(values).sd / std::sqrt(static_cast<double>(values.size()));
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
+
+double chi2_upper_tail(double chi2, double n) {
+  if (n <= 0.0) return 1.0;
+  const double a = 2.0 / (9.0 * n);
+  const double z = (std::cbrt(chi2 / n) - (1.0 - a)) / std::sqrt(a);
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
 }
 
 }  // namespace clumpforge
