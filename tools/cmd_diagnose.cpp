@@ -90,6 +90,7 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
   j["format"] = "clumpforge-diagnosis/1";
   j["clump"] = clump_name;
   j["verdict"] = verdict_name(r);
+  j["basis"] = std::string(basis_name(r.basis));
   j["statement"] = r.statement;
   j["candidates"] = r.candidates;
   j["experiment"] = r.experiment;
@@ -160,14 +161,14 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
   j["phases"] = nlohmann::json::array();
   for (const auto& p : r.phases) {
     j["phases"].push_back({{"recording", p.recording},
-                           {"phase", p.phase},
+                           {"phase", std::string(phase_name(p.phase))},
                            {"values", p.values},
                            {"chi2_per_value", p.chi2_per_value},
                            {"p_value", p.p_value},
                            {"significant", p.significant},
                            {"bias_x_mm", p.bias_x_mm},
                            {"bias_z_mm", p.bias_z_mm},
-                           {"axis", p.axis},
+                           {"axis", p.axis == Axis::Z ? "z" : "x"},
                            {"growth_power", p.growth_power},
                            {"end_residual_mm", p.end_residual_mm},
                            {"improved_chi2_per_value", p.improved_chi2_per_value},
@@ -200,7 +201,18 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
          {"smallest_detectable",
           std::isfinite(h.smallest_detectable) ? nlohmann::json(h.smallest_detectable) : nlohmann::json()}});
   }
-  j["unexplained"] = r.unexplained;
+  auto phases_of = [](const std::vector<PhaseOf>& list) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& u : list) {
+      out.push_back({{"recording", u.recording},
+                     {"phase", std::string(phase_name(u.phase))},
+                     {"chi2_per_value", u.chi2_per_value},
+                     {"where", u.where}});
+    }
+    return out;
+  };
+  j["unexplained"] = phases_of(r.unexplained);
+  j["outliers"] = phases_of(r.outliers);
   j["notes"] = r.notes;
   j["tracked_trials"] = r.tracked_trials;
   j["training_trials"] = r.training_trials;

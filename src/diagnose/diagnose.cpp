@@ -842,7 +842,7 @@ std::vector<PhaseReport> locate(const Context& c, const Groups& groups) {
     if (key.phase == Phase::Hold || key.phase == Phase::LaterBounces || g.values < 10) continue;
     PhaseReport p;
     p.recording = c.names[key.recording];
-    p.phase = std::string(phase_name(key.phase));
+    p.phase = key.phase;
     p.values = g.values;
     p.chi2_per_value = g.chi2 / g.values;
     p.p_value = chi2_upper_tail(g.chi2, g.values);
@@ -851,12 +851,12 @@ std::vector<PhaseReport> locate(const Context& c, const Groups& groups) {
     p.bias_x_mm = g.count_x ? sigma_mm * g.sum_x / g.count_x : 0.0;
     p.bias_z_mm = g.count_z ? sigma_mm * g.sum_z / g.count_z : 0.0;
     const bool z_axis = g.sq_z >= g.sq_x;
-    p.axis = z_axis ? "z" : "x";
+    p.axis = z_axis ? Axis::Z : Axis::X;
     const Growth growth = growth_law(g, z_axis);
     p.growth_power = growth.explained > 0.3 ? growth.power : 0;
     p.end_residual_mm = sigma_mm * growth.at_end;
     const std::string where =
-        fmt::format("{} phases of {}", p.phase, recording_label(recs[key.recording], p.recording));
+        fmt::format("{} phases of {}", phase_name(p.phase), recording_label(recs[key.recording], p.recording));
     if (!p.significant) {
       p.statement = fmt::format("{}: consistent with the noise (chi^2/value {:.2f}, p = {:.2g})", where,
                                 p.chi2_per_value, p.p_value);
@@ -868,7 +868,7 @@ std::vector<PhaseReport> locate(const Context& c, const Groups& groups) {
       p.statement = fmt::format(
           "{}: the recording lies {:+.2f} mm from the model in {} by the phase's end, {}; chi^2/value {:.2f} (p = "
           "{:.2g})",
-          where, p.end_residual_mm, p.axis, shape, p.chi2_per_value, p.p_value);
+          where, p.end_residual_mm, p.axis == Axis::Z ? "z" : "x", shape, p.chi2_per_value, p.p_value);
     }
     out.push_back(std::move(p));
   }
@@ -913,6 +913,28 @@ std::string experiment_for(const std::string& a, const std::string& b) {
 }
 
 }  // namespace
+
+std::string_view basis_name(Basis basis) {
+  switch (basis) {
+    case Basis::Consistent:
+      return "consistent";
+    case Basis::SlightMisfit:
+      return "slight_misfit";
+    case Basis::FrameByFrame:
+      return "frame_by_frame";
+    case Basis::Ensemble:
+      return "ensemble";
+    case Basis::UnexplainedPhases:
+      return "unexplained_phases";
+    case Basis::TooFewTrials:
+      return "too_few_trials";
+    case Basis::TooNoisy:
+      return "too_noisy";
+    case Basis::SummariesOnly:
+      return "summaries_only";
+  }
+  return "?";
+}
 
 std::string verdict_name(const DiagnoseResult& result) {
   switch (result.verdict) {
@@ -1487,6 +1509,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   const EnsembleHypothesis& best = *passing.front();
   const EffectSpec& spec = effect_spec(library, best.effect);
   const bool close = passing.size() > 1 && best.delta_bic - passing[1]->delta_bic < options.min_delta_bic;
+  result.basis = Basis::Ensemble;
   if (close) {
     result.verdict = Verdict::Ambiguous;
     result.effect.reset();
@@ -1552,23 +1575,26 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   for (double s : camera_noise) {
     if (std::isfinite(s)) worst_sigma = std::max(worst_sigma, s);
   }
-  auto undecidable = [&](std::string why) {
+  auto undecidable = [&](Basis basis, std::string why) {
     result.verdict = Verdict::Undecidable;
+    result.basis = basis;
     result.statement = std::move(why);
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     return result;
   };
   if (c.ev.trials.size() < 2 || c.training.empty() || c.heldout.empty()) {
-    return undecidable(fmt::format(
-        "only {} usable tracked trial(s): at least two (one to fit, one held out), each with 30 or more frames, are "
-        "needed to decide anything",
-        c.ev.trials.size()));
+    return undecidable(Basis::TooFewTrials, fmt::format("only {} usable tracked trial(s): at least two (one to fit, "
+                                                        "one held out), each with 30 or more frames, are "
+                                                        "needed to decide anything",
+                                                        c.ev.trials.size()));
   }
   if (worst_sigma > 1e-3) {
-    return undecidable(fmt::format(
-        "the tracks are too noisy to decide anything: {:.2f} mm of camera noise, where the effects in the "
-        "library move the tracked point by 0.1 to a few mm; track with sub-pixel centroids (0.02 to 0.1 mm)",
-        worst_sigma * 1000.0));
+    return undecidable(
+        Basis::TooNoisy,
+        fmt::format(
+            "the tracks are too noisy to decide anything: {:.2f} mm of camera noise, where the effects in the "
+            "library move the tracked point by 0.1 to a few mm; track with sub-pixel centroids (0.02 to 0.1 mm)",
+            worst_sigma * 1000.0));
   }
   auto start = starting_model(c, table, recordings, options);
   if (!start) return std::unexpected(start.error());
@@ -1642,6 +1668,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     const auto& best = result.hypotheses[*decision.best];
     const auto& other = result.hypotheses[decision.close.front()];
     result.verdict = Verdict::Ambiguous;
+    result.basis = Basis::FrameByFrame;
     result.candidates.push_back(best.name);
     for (std::size_t k : decision.close) result.candidates.push_back(result.hypotheses[k].name);
     result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
@@ -1662,6 +1689,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     HypothesisReport& report = result.hypotheses[h];
     improved = fits[h].model;
     result.verdict = Verdict::Named;
+    result.basis = Basis::FrameByFrame;
     result.effect = *improved.effect;
     // 95 % intervals of the effect's parameters from the chi^2 curvature (others held).
     const EffectSpec& spec = effect_spec(library, *improved.effect);
@@ -1712,7 +1740,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   }
   // A smooth discrepancy the named effect (or the baseline) leaves, phase by phase.
   auto smooth_misfits = [&](const Groups& groups) {
-    std::vector<std::string> found;
+    std::vector<PhaseOf> found;
     for (const auto& [key, g] : groups) {
       if (key.phase == Phase::Hold || key.phase == Phase::LaterBounces || g.values < 20) continue;
       if (!beyond_noise(g.chi2, g.values, groups.size())) continue;
@@ -1728,10 +1756,11 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
       if (g.chi2 < kLargeMisfit * g.values) continue;
       if (d.parameters > 0 && d.gain - d.parameters * std::log(g.values) >= options.min_delta_bic &&
           d.heldout_gain > 0.0) {
-        found.push_back(where);
+        found.push_back({c.names[key.recording], key.phase, g.chi2 / g.values, where});
       } else if (g.chi2 / g.values >= kLargeMisfit && !outlier_trial(g, trial_spread(g))) {
         found.push_back(
-            fmt::format("{} (chi^2/value {:.0f}, not one shape shared by the trials)", where, g.chi2 / g.values));
+            {c.names[key.recording], key.phase, g.chi2 / g.values,
+             fmt::format("{} (chi^2/value {:.0f}, not one shape shared by the trials)", where, g.chi2 / g.values)});
       }
     }
     return found;
@@ -1774,20 +1803,22 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   result.after = quality(c, *full_improved);
   for (auto& p : result.phases) {
     for (const auto& [key, g] : improved_groups) {
-      if (c.names[key.recording] == p.recording && phase_name(key.phase) == p.phase && g.values > 0)
+      if (c.names[key.recording] == p.recording && key.phase == p.phase && g.values > 0)
         p.improved_chi2_per_value = g.chi2 / g.values;
     }
   }
   if (!named && result.verdict != Verdict::Ambiguous) {
     if (!result.unexplained.empty()) {
       result.verdict = Verdict::Unexplained;
+      result.basis = Basis::UnexplainedPhases;
       result.statement = fmt::format(
           "Mismatch not explained by any known effect in: {}. Each is beyond the noise after the coefficients are "
           "refitted "
           "on every trial: a smooth per-phase shape shared by the trials removes it (delta-BIC >= {:g}, "
           "cross-validated), "
           "or it is three times the noise or more; none of the {} candidate effects passes every check.",
-          fmt::join(result.unexplained, "; "), options.min_delta_bic, result.hypotheses.size());
+          fmt::join(result.unexplained | std::views::transform([](const PhaseOf& u) { return u.where; }), "; "),
+          options.min_delta_bic, result.hypotheses.size());
       result.experiment = "look at the residual plots of these phases; add set-ups that isolate them";
     } else {
       result.verdict = Verdict::None;
@@ -1805,6 +1836,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
           outliers.push_back(fmt::format("{} phases of {} (one trial at chi^2/value {:.0f}, the other {} at {:.2f})",
                                          phase_name(key.phase), c.names[key.recording], spread.worst, spread.trials - 1,
                                          spread.rest));
+          result.outliers.push_back({c.names[key.recording], key.phase, spread.worst, outliers.back()});
         } else {
           slight.push_back(fmt::format("{} phases of {} (chi^2/value {:.2f})", phase_name(key.phase),
                                        c.names[key.recording], g.chi2 / g.values));
@@ -1826,6 +1858,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
             fmt::join(outliers, ", "));
         result.notes.push_back(fmt::format("outlier trials, not counted as a mismatch: {}", fmt::join(outliers, ", ")));
       }
+      result.basis = slight.empty() ? Basis::Consistent : Basis::SlightMisfit;
       result.statement = fmt::format(
           "No missing physics found: no candidate passes every check and {}. Smallest effects these recordings would "
           "have revealed (at delta-BIC {:g}, "

@@ -25,6 +25,7 @@
 #include "dem/lab.hpp"
 #include "diagnose/effects.hpp"
 #include "diagnose/ensemble.hpp"
+#include "diagnose/phases.hpp"
 
 namespace clumpforge {
 
@@ -50,9 +51,11 @@ struct DiagnoseOptions {
   std::uint64_t seed = 1;
 };
 
+enum class Axis { X, Z };
+
 struct PhaseReport {
   std::string recording;  ///< recording name
-  std::string phase;
+  Phase phase = Phase::Flight;
   int values = 0;  ///< residual cells (x and z)
   double chi2_per_value = 0.0;
   double p_value = 1.0;                     ///< chi^2 against the noise level (Wilson-Hilferty)
@@ -60,7 +63,7 @@ struct PhaseReport {
   double bias_x_mm = 0.0, bias_z_mm = 0.0;  ///< mean residual, recorded - model
   int growth_power = 0;                     ///< residual grows like t^k within the phase (0: no trend)
   double end_residual_mm = 0.0;             ///< the fitted growth law at the phase's typical end (z, or x when larger)
-  std::string axis = "z";
+  Axis axis = Axis::Z;
   std::string statement;
   double improved_chi2_per_value = 0.0;  ///< under the improved model (= baseline when none)
 };
@@ -127,8 +130,30 @@ struct EnsembleReport {
   double trials = 0.0;                              ///< recorded trials per recording (mean)
 };
 
+/// A phase of one recording (the phases of all its trials), where a finding is.
+struct PhaseOf {
+  std::string recording;  ///< recording name
+  Phase phase = Phase::Flight;
+  double chi2_per_value = 0.0;
+  std::string where;  ///< as reports say it, e.g. "flight phases of drop-1m (drop from 1 m)"
+};
+
+/// What a verdict rests on, beside the verdict itself.
+enum class Basis {
+  Consistent,         ///< none: every phase at the noise level once the coefficients are fitted
+  SlightMisfit,       ///< none: a small misfit with no shape the trials share remains
+  FrameByFrame,       ///< named or ambiguous from the trials' tracks within the release horizon
+  Ensemble,           ///< named or ambiguous from the recorded outcomes against replays over the release
+  UnexplainedPhases,  ///< unexplained: phases beyond the noise no candidate explains
+  TooFewTrials,       ///< undecidable: fewer than two usable tracked trials
+  TooNoisy,           ///< undecidable: the tracks' noise hides what the effects would do
+  SummariesOnly,      ///< no tracks: what the summaries decide
+};
+std::string_view basis_name(Basis basis);
+
 struct DiagnoseResult {
   Verdict verdict = Verdict::None;
+  Basis basis = Basis::Consistent;
   std::optional<Effect> effect;         ///< the named effect (verdict Named)
   std::string statement;                ///< one paragraph for a person
   std::vector<std::string> candidates;  ///< ambiguous: the effects it could be
@@ -142,7 +167,8 @@ struct DiagnoseResult {
   FitQuality before, after;
   std::vector<PhaseReport> phases;
   std::vector<HypothesisReport> hypotheses;
-  std::vector<std::string> unexplained;  ///< phases a smooth discrepancy explains and no effect does
+  std::vector<PhaseOf> unexplained;  ///< phases beyond the noise that no effect explains (verdict Unexplained)
+  std::vector<PhaseOf> outliers;     ///< phases where one trial alone misfits (not counted as a mismatch)
   std::vector<TrackComparison> tracks;
   std::vector<std::string> notes;
   bool summaries_only = false;  ///< no tracks: what summaries can and cannot decide (in `decidable`, `undecidable`)

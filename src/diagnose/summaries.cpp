@@ -5,9 +5,9 @@
 #include <cmath>
 #include <numeric>
 
-#include "numerics/statistics.hpp"
 #include "diagnose/diagnose.hpp"
 #include "numerics/minimize.hpp"
+#include "numerics/statistics.hpp"
 
 namespace clumpforge {
 
@@ -18,6 +18,7 @@ Result<DiagnoseResult> diagnose_summaries(const Clump& clump, const MaterialTabl
   const auto started = std::chrono::steady_clock::now();
   DiagnoseResult result;
   result.summaries_only = true;
+  result.basis = Basis::SummariesOnly;
   result.verdict = Verdict::None;
   std::vector<std::string> drop_heights, starts;
   std::vector<std::string> gap_statements;
