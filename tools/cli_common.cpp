@@ -1,11 +1,11 @@
 #include "cli_common.hpp"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
-#include <cstdio>
-#include <fmt/format.h>
-
 #include <chrono>
+#include <csignal>
+#include <cstdio>
 
 #include "core/sha256.hpp"
 #include "core/units.hpp"
@@ -14,15 +14,43 @@
 namespace clumpforge::cli {
 
 int report_error(std::string_view command, const Error& error) {
+  if (error.code == ErrorCode::Cancelled && interrupted()) {
+    fmt::print(stderr, "\nclumpforge {}: interrupted; nothing was written\n", command);
+    return kExitInterrupted;
+  }
   fmt::print(stderr, "clumpforge {}: error: {}\n", command, error.message);
   return kExitFailure;
+}
+
+namespace {
+// The one piece of process-wide state of the command line: a signal handler can only talk to
+// the program through a lock-free flag. The library never sees it, only RunContext::cancelled.
+volatile std::sig_atomic_t interrupt_flag = 0;
+
+extern "C" void on_interrupt(int) {
+  interrupt_flag = 1;
+  std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends the process at once
+}
+}  // namespace
+
+void install_interrupt_handler() {
+  struct sigaction action {};
+  action.sa_handler = on_interrupt;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+}
+
+bool interrupted() {
+  return interrupt_flag != 0;
 }
 
 void report_warning(std::string_view command, const std::string& message) {
   fmt::print(stderr, "clumpforge {}: warning: {}\n", command, message);
 }
 
-nlohmann::json to_json(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+nlohmann::json to_json(const Eigen::Vector3d& v) {
+  return nlohmann::json::array({v.x(), v.y(), v.z()});
+}
 
 nlohmann::json to_json(const Eigen::Matrix3d& m) {
   nlohmann::json rows = nlohmann::json::array();
@@ -47,7 +75,8 @@ nlohmann::json to_json(const MeshStats& stats) {
   j["closed"] = stats.closed;
   j["volume_m3"] = stats.closed ? nlohmann::json(stats.volume) : nlohmann::json(nullptr);
   j["area_m2"] = stats.area;
-  j["bbox_m"] = {{"min", to_json(stats.bbox.min)}, {"max", to_json(stats.bbox.max)}, {"size", to_json(stats.bbox.size())}};
+  j["bbox_m"] = {
+      {"min", to_json(stats.bbox.min)}, {"max", to_json(stats.bbox.max)}, {"size", to_json(stats.bbox.size())}};
   return j;
 }
 
@@ -61,8 +90,8 @@ nlohmann::json to_json(const MassProperties& props) {
           {"principal_axes", to_json(props.principal_axes)}};
 }
 
-Result<LoadedBody> load_closed_body(const std::string& path, const std::string& units, double density, const SdfOptions& sdf,
-                                    const RunContext& context) {
+Result<LoadedBody> load_closed_body(const std::string& path, const std::string& units, double density,
+                                    const SdfOptions& sdf, const RunContext& context) {
   auto unit = parse_length_unit(units);
   if (!unit) return std::unexpected(unit.error());
   if (!(density > 0.0) || density > 1e5) {
@@ -81,6 +110,7 @@ Result<LoadedBody> load_closed_body(const std::string& path, const std::string& 
 
 RunContext progress_context(bool json) {
   RunContext context;
+  context.cancelled = interrupted;
   if (!json && stderr_is_terminal()) {
     const auto started = std::chrono::steady_clock::now();
     context.progress = [started](std::string_view stage, double fraction) {
@@ -90,7 +120,9 @@ RunContext progress_context(bool json) {
   return context;
 }
 
-bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
+bool stderr_is_terminal() {
+  return ::isatty(STDERR_FILENO) == 1;
+}
 
 void print_progress(std::string_view stage, double fraction) {
   fmt::print(stderr, "\r  [{:>3.0f} %] {:<40}", 100.0 * fraction, stage);

@@ -1,22 +1,28 @@
 #pragma once
 /// Helpers shared by the subcommands: exit codes, error printing, JSON of library types.
+#include <nlohmann/json.hpp>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "core/error.hpp"
+#include "fill/body.hpp"
 #include "mesh/mass_properties.hpp"
 #include "mesh/topology.hpp"
-#include "fill/body.hpp"
 
 namespace clumpforge::cli {
 
 /// Documented exit codes (README.md).
 inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;  ///< bad input or a step that could not be done
-inline constexpr int kExitUsage = 2;    ///< the command line itself is wrong
+inline constexpr int kExitFailure = 1;        ///< bad input or a step that could not be done
+inline constexpr int kExitUsage = 2;          ///< the command line itself is wrong
+inline constexpr int kExitInterrupted = 130;  ///< Ctrl-C: stopped, nothing written (128 + SIGINT)
 
-/// Prints "clumpforge <command>: error: <message>" to stderr and returns kExitFailure.
+/// Ctrl-C (SIGINT): the first asks the running command to stop (RunContext::cancelled of
+/// every context progress_context makes); a second ends the process at once.
+void install_interrupt_handler();
+bool interrupted();
+
+/// Prints "clumpforge <command>: error: <message>" to stderr and returns kExitFailure; a
+/// cancellation after Ctrl-C prints "interrupted" and returns kExitInterrupted.
 int report_error(std::string_view command, const Error& error);
 void report_warning(std::string_view command, const std::string& message);
 
@@ -31,8 +37,8 @@ struct LoadedBody {
   PreparedBody body;
   std::string sha256;
 };
-Result<LoadedBody> load_closed_body(const std::string& path, const std::string& units, double density, const SdfOptions& sdf,
-                                    const RunContext& context);
+Result<LoadedBody> load_closed_body(const std::string& path, const std::string& units, double density,
+                                    const SdfOptions& sdf, const RunContext& context);
 
 /// Progress on stderr after the first second, when stderr is a terminal and not --json.
 RunContext progress_context(bool json);

@@ -7,8 +7,8 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "core/atomic_file.hpp"
-#include "mesh/mesh_writer.hpp"
 #include "mesh/load.hpp"
+#include "mesh/mesh_writer.hpp"
 #include "mesh/repair.hpp"
 
 namespace clumpforge::cli {
@@ -27,10 +27,11 @@ void print_human(const RepairArgs& args, const LoadResult& loaded, const MeshSta
   fmt::print("  read {} triangles, {} vertices; welded {} (tolerance {:.3g} m)\n", loaded.file_triangles,
              loaded.file_vertices, loaded.welded_vertices, loaded.weld_tolerance);
   auto line = [](const char* label, const MeshStats& s) {
-    fmt::print("  {:<7} {:>7} faces {:>7} vertices {:>3} components {:>3} holes {:>4} non-manifold edges "
-               "{:>4} self-intersecting pairs  closed: {}\n",
-               label, s.faces, s.vertices, s.components, s.boundary_loops, s.non_manifold_edges,
-               s.self_intersecting_pairs, s.closed ? "yes" : "no");
+    fmt::print(
+        "  {:<7} {:>7} faces {:>7} vertices {:>3} components {:>3} holes {:>4} non-manifold edges "
+        "{:>4} self-intersecting pairs  closed: {}\n",
+        label, s.faces, s.vertices, s.components, s.boundary_loops, s.non_manifold_edges, s.self_intersecting_pairs,
+        s.closed ? "yes" : "no");
   };
   line("before", before);
   for (const auto& step : repaired.steps) {
@@ -56,10 +57,12 @@ int run_repair(const RepairArgs& args) {
   const MeshStats before = analyze_mesh(loaded->soup);
 
   RunContext context;
+  context.cancelled = interrupted;
   if (!args.json && stderr_is_terminal()) context.progress = print_progress;
   auto repaired = repair_mesh(loaded->soup, {}, context);
   if (!repaired) {
-    return report_error(kCommand, Error{repaired.error().code, fmt::format("'{}': {}", args.input, repaired.error().message)});
+    return report_error(kCommand,
+                        Error{repaired.error().code, fmt::format("'{}': {}", args.input, repaired.error().message)});
   }
   const MeshStats& after = repaired->after;
   if (auto ok = write_mesh(args.output, repaired->soup, *unit); !ok) return report_error(kCommand, ok.error());

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;
   }
+  install_interrupt_handler();
   // A dependency's exception (CGAL, JSON, HDF5) that no module edge caught still ends in a
   // clean message and exit 1, never an abort.
   try {

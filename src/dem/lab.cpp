@@ -100,10 +100,16 @@ void place_tilt(RigidBody& body, const Eigen::Quaterniond& q) {
   body.position = {0, 0, 1e-7 - lowest_offset(body, q, Eigen::Vector3d::UnitZ())};
 }
 
+// Whether the caller asked to stop, looked at every 1024 steps (well under a millisecond of
+// work each time), so an interrupt stops a trial at once.
+bool stop_requested(const World& world, const RunContext& context) {
+  return (world.steps & 1023U) == 0 && context.should_stop();
+}
+
 // Drop: released from rest with its lowest point `H` above the plate; the summary is the
 // apex of the first rebound, measured as the rise of the lowest point above the plate.
 TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked,
-                        double dt, Rng& rng) {
+                        double dt, Rng& rng, const RunContext& context) {
   RigidBody& body = world.bodies[0];
   place_drop(body, setup, random_orientation(rng));
   TrackSampler sampler(options.frame_rate_hz, tracked);
@@ -112,7 +118,7 @@ TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& o
   bool impacted = false, airborne_after = false;
   double apex = 0.0, impact_time = 0.0;  // apex of the lowest point, >= 0 once it touched
   double energy_before = 0.0;
-  while (world.time < options.max_time) {
+  while (world.time < options.max_time && !stop_requested(world, context)) {
     const double kinetic_before = world.bodies[0].kinetic_energy();
     step(world, dt);
     sampler.sample(world);
@@ -147,14 +153,14 @@ TrialOutcome drop_trial(World world, const Recording& setup, const LabOptions& o
 // Roll: released from rest on the incline with its contact point `L` up the slope from the
 // foot; the summary is the horizontal distance on the flat from the foot where it stops.
 TrialOutcome roll_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked,
-                        double dt, Rng& rng) {
+                        double dt, Rng& rng, const RunContext& context) {
   RigidBody& body = world.bodies[0];
   place_roll(body, setup, random_orientation(rng));
   TrackSampler sampler(options.frame_rate_hz, tracked);
   TrialOutcome out;
   out.orientation = body.orientation;
   double still_since = -1.0;
-  while (world.time < options.max_time) {
+  while (world.time < options.max_time && !stop_requested(world, context)) {
     step(world, dt);
     sampler.sample(world);
     const RigidBody& b = world.bodies[0];
@@ -175,7 +181,7 @@ TrialOutcome roll_trial(World world, const Recording& setup, const LabOptions& o
 // Tilt: resting flat on a plate tilted at a steady rate about y; the summary is the plate
 // angle at which sliding starts (1 mm of motion along the plate); 90 when it never slid by 89.
 TrialOutcome tilt_trial(World world, const Recording& setup, const LabOptions& options, const Eigen::Vector3d& tracked,
-                        double dt, Rng& rng) {
+                        double dt, Rng& rng, const RunContext& context) {
   RigidBody& body = world.bodies[0];
   const double yaw = rng.uniform(0.0, 2.0 * kPi);
   place_tilt(body, Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())));
@@ -193,7 +199,7 @@ TrialOutcome tilt_trial(World world, const Recording& setup, const LabOptions& o
   const double start = plate_coordinate();
   double slip_angle = std::numeric_limits<double>::quiet_NaN();
   // The plate keeps tilting until the body slides or the plate stands at 89 degrees.
-  for (;;) {
+  while (!stop_requested(world, context)) {
     step(world, dt);
     const double angle = rate * (world.time - start_time) * 180.0 / kPi;
     sampler.sample(world, angle);
@@ -393,17 +399,18 @@ Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, c
     Rng rng(options.seed, static_cast<std::uint64_t>(i));
     switch (setup.test) {
       case LabTest::Drop:
-        outcomes[i] = drop_trial(world, setup, options, tracked, result.time_step, rng);
+        outcomes[i] = drop_trial(world, setup, options, tracked, result.time_step, rng, context);
         break;
       case LabTest::Roll:
-        outcomes[i] = roll_trial(world, setup, options, tracked, result.time_step, rng);
+        outcomes[i] = roll_trial(world, setup, options, tracked, result.time_step, rng, context);
         break;
       case LabTest::Tilt:
-        outcomes[i] = tilt_trial(world, setup, options, tracked, result.time_step, rng);
+        outcomes[i] = tilt_trial(world, setup, options, tracked, result.time_step, rng, context);
         break;
     }
     context.report(fmt::format("{} trials", to_string(setup.test)), static_cast<double>(++done) / options.trials);
   });
+  if (context.should_stop()) return fail(ErrorCode::Cancelled, fmt::format("{} test cancelled", to_string(setup.test)));
   result.recording = setup;
   result.recording.trials.clear();
   result.recording.frame_rate_hz = options.frame_rate_hz;

@@ -343,6 +343,7 @@ Result<void> set_horizons(Context& c, const Model& model, double perturbation) {
   std::vector<std::vector<std::optional<LabWorld>>> worlds(variants.size(),
                                                            std::vector<std::optional<LabWorld>>(recs.size()));
   std::vector<std::vector<LabOptions>> options(variants.size(), std::vector<LabOptions>(recs.size()));
+  if (auto ok = check_cancelled(c.ev); !ok) return std::unexpected(ok.error());
   for (std::size_t v = 0; v < variants.size(); ++v) {
     for (std::size_t r = 0; r < recs.size(); ++r) {
       options[v][r] = lab_options_for(c.ev, variants[v], recs[r]);
@@ -724,6 +725,7 @@ Result<std::vector<std::string>> settle_release_state(Context& c, const Model& m
       }
     }
     if (groups.empty()) continue;
+    if (auto ok = check_cancelled(c.ev); !ok) return std::unexpected(ok.error());
     const LabOptions lab = lab_options_for(c.ev, model, rec);
     auto world = make_lab_world(*c.ev.clump, *c.ev.table, rec, lab);
     if (!world) return std::unexpected(world.error());
@@ -1567,6 +1569,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   c.run = &run;
   c.ev.clump = &clump;
   c.ev.table = &table;
+  c.ev.cancelled = run.cancelled;
   c.ev.recordings = &recordings;
   c.ev.lab = options.lab;
   c.ev.impact_accuracy = options.impact_accuracy;

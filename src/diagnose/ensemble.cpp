@@ -178,6 +178,7 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
       out[p] = (*reuse)[p];
       continue;
     }
+    if (auto ok = check_cancelled(ev); !ok) return std::unexpected(ok.error());
     const Recording& rec = recs[plan.recording];
     const LabOptions lab = lab_options_for(ev, model, rec);
     auto world = make_lab_world(*ev.clump, *ev.table, rec, lab);

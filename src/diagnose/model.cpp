@@ -58,8 +58,14 @@ double replay_summary(const std::vector<ReplaySample>& replay, LabTest test) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+Result<void> check_cancelled(const Evaluator& evaluator) {
+  if (evaluator.cancelled && evaluator.cancelled()) return fail(ErrorCode::Cancelled, "diagnosis cancelled");
+  return {};
+}
+
 Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model, const std::vector<std::size_t>& which,
                                          bool keep_replays, bool keep_residuals) {
+  if (auto ok = check_cancelled(ev); !ok) return std::unexpected(ok.error());
   const auto& recordings = *ev.recordings;
   // One lab world per recording that is needed.
   std::vector<std::optional<LabWorld>> worlds(recordings.size());

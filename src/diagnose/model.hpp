@@ -1,4 +1,5 @@
 #pragma once
+#include <functional>
 /// Replaying every tracked trial under a candidate model and scoring it against the camera:
 /// the base parameters per surface, optionally one effect with its values, and the
 /// measurement nuisances (time shift and horizontal origin per track) fitted inside.
@@ -66,7 +67,12 @@ struct Evaluator {
   std::vector<double> shift;        ///< per trial, fixed by `initialise`
   std::vector<double> shift_range;  ///< per trial: half range of the first alignment [s]
   bool full_duration = false;       ///< replay whole tracks, not only up to each trial's horizon (plots, summaries)
+  /// True when the caller asked to stop (RunContext::cancelled): evaluations end with Cancelled.
+  std::function<bool()> cancelled;
 };
+
+/// Cancelled when the evaluator's caller asked to stop.
+Result<void> check_cancelled(const Evaluator& evaluator);
 
 /// Replays and scores the trials `which` (indices into evaluator.trials) under `model`,
 /// in parallel; results do not depend on the thread count.

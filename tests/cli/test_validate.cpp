@@ -1,7 +1,7 @@
 // End-to-end: validate runs the lab tests, writes recordings, reports the parameters.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "io/recording_io.hpp"
@@ -9,17 +9,21 @@
 
 namespace clumpforge {
 namespace {
-std::string library() { return (test::source_dir() / "clumps" / "tuber-default.h5").string(); }
+std::string library() {
+  return (test::source_dir() / "clumps" / "tuber-default.h5").string();
+}
 }  // namespace
 
 TEST(ValidateCli, DropJsonAndRecording) {
   test::ScratchDir dir("validate");
-  const auto run = test::run_clumpforge(fmt::format(
-      "validate '{}' --clump lattice-4mm --test drop --surface Q235 --trials 3 --seed 5 --out '{}' --restitution 0.6 --json",
-      library(), (dir / "rec").string()));
+  const auto run =
+      test::run_clumpforge(fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --trials 3 --seed "
+                                       "5 --out '{}' --restitution 0.6 --json",
+                                       library(), (dir / "rec").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
-  for (const char* key : {"restitution", "static_friction", "rolling_friction", "rolling_model", "time_step_s", "trials", "mean", "std"}) {
+  for (const char* key : {"restitution", "static_friction", "rolling_friction", "rolling_model", "time_step_s",
+                          "trials", "mean", "std"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["restitution"], 0.6);
@@ -33,20 +37,28 @@ TEST(ValidateCli, DropJsonAndRecording) {
   EXPECT_TRUE(recording->trials[0].track.has_value());
   // The same seed gives the same trials.
   const auto again = test::run_clumpforge(fmt::format(
-      "validate '{}' --clump lattice-4mm --test drop --surface Q235 --trials 3 --seed 5 --restitution 0.6 --json", library()));
+      "validate '{}' --clump lattice-4mm --test drop --surface Q235 --trials 3 --seed 5 --restitution 0.6 --json",
+      library()));
   EXPECT_EQ(nlohmann::json::parse(again.out)["trials"], j["trials"]);
 }
 
 TEST(ValidateCli, BadInputIsAClearError) {
   test::ScratchDir dir("validate");
   const std::vector<std::pair<std::string, std::string>> cases{
-      {fmt::format("validate '{}' --clump lattice-4mm --test bounce --surface Q235", library()), "unknown test 'bounce'"},
-      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface glass", library()), "unknown material 'glass'"},
-      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --restitution 1.5", library()), "outside (0, 1]"},
-      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --static-friction -0.1", library()), "must be in [0, 10]"},
-      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --time-step 0.01", library()), "stable limit"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test bounce --surface Q235", library()),
+       "unknown test 'bounce'"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface glass", library()),
+       "unknown material 'glass'"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --restitution 1.5", library()),
+       "outside (0, 1]"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --static-friction -0.1", library()),
+       "must be in [0, 10]"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --time-step 0.01", library()),
+       "stable limit"},
       {fmt::format("validate '{}' --test drop --surface Q235", library()), "choose one with --clump"},
-      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235", (test::source_dir() / "meshes" / "tuber-default.stl").string()), "not an HDF5 file"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235",
+                   (test::source_dir() / "meshes" / "tuber-default.stl").string()),
+       "not an HDF5 file"},
   };
   for (const auto& [arguments, expected] : cases) {
     SCOPED_TRACE(arguments);
@@ -64,10 +76,14 @@ TEST(CalibrateCli, BadInputIsAClearError) {
   const std::string lib = (test::source_dir() / "clumps" / "tuber-default.h5").string();
   const std::string drop = (test::shared_dir() / "data" / "paper" / "drop-Q235").string();
   const std::vector<std::pair<std::string, std::string>> cases{
-      {fmt::format("calibrate --recordings '{}' --clump '{}' --clump-name lattice-4mm --method bayes", drop, lib), "unknown method 'bayes'"},
-      {fmt::format("calibrate --recordings /nonexistent/rec --clump '{}' --clump-name lattice-4mm", lib), "no recording manifest"},
-      {fmt::format("calibrate --recordings '{}' --clump '{}' --clump-name lattice-4mm --method joint", drop, lib), "needs drop, tilt and roll"},
-      {fmt::format("calibrate --recordings '{}' --clump '{}' --clump-name lattice-4mm --trials-per-level 0", drop, lib), "between 1 and 1000"},
+      {fmt::format("calibrate --recordings '{}' --clump '{}' --clump-name lattice-4mm --method bayes", drop, lib),
+       "unknown method 'bayes'"},
+      {fmt::format("calibrate --recordings /nonexistent/rec --clump '{}' --clump-name lattice-4mm", lib),
+       "no recording manifest"},
+      {fmt::format("calibrate --recordings '{}' --clump '{}' --clump-name lattice-4mm --method joint", drop, lib),
+       "needs drop, tilt and roll"},
+      {fmt::format("calibrate --recordings '{}' --clump '{}' --clump-name lattice-4mm --trials-per-level 0", drop, lib),
+       "between 1 and 1000"},
   };
   for (const auto& [arguments, expected] : cases) {
     SCOPED_TRACE(arguments);
@@ -82,18 +98,47 @@ namespace clumpforge {
 TEST(MaterialsCli, ShippedFileIsTheBuiltInTableAndOverridesWork) {
   const auto printed = test::run_clumpforge("materials");
   ASSERT_EQ(printed.exit_code, 0) << printed.err;
-  EXPECT_EQ(printed.out, test::read_text(test::source_dir() / "docs" / "materials.json"));  // regenerate: clumpforge materials > docs/materials.json
+  EXPECT_EQ(printed.out, test::read_text(test::source_dir() / "docs" /
+                                         "materials.json"));  // regenerate: clumpforge materials > docs/materials.json
   test::ScratchDir dir("materials");
-  test::write_text(dir / "m.json", R"({"materials": [{"name": "rubber", "youngs_modulus_pa": 5e6, "poisson_ratio": 0.45, "density_kg_m3": 1100}],
+  test::write_text(
+      dir / "m.json",
+      R"({"materials": [{"name": "rubber", "youngs_modulus_pa": 5e6, "poisson_ratio": 0.45, "density_kg_m3": 1100}],
     "interactions": [{"a": "tuber", "b": "rubber", "restitution": 0.3, "static_friction": 0.9, "rolling_friction": 0.05}]})");
   const std::string lib = (test::source_dir() / "clumps" / "tuber-default.h5").string();
-  const auto run = test::run_clumpforge(fmt::format("validate '{}' --clump lattice-4mm --test drop --surface rubber --trials 2 --materials '{}' --json",
-                                                    lib, (dir / "m.json").string()));
+  const auto run = test::run_clumpforge(
+      fmt::format("validate '{}' --clump lattice-4mm --test drop --surface rubber --trials 2 --materials '{}' --json",
+                  lib, (dir / "m.json").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(nlohmann::json::parse(run.out)["restitution"], 0.3);
-  test::write_text(dir / "bad.json", R"({"materials": [{"name": "x", "youngs_modulus_pa": -1, "poisson_ratio": 0.3, "density_kg_m3": 1}]})");
+  test::write_text(
+      dir / "bad.json",
+      R"({"materials": [{"name": "x", "youngs_modulus_pa": -1, "poisson_ratio": 0.3, "density_kg_m3": 1}]})");
   const auto bad = test::run_clumpforge(fmt::format("materials --materials '{}'", (dir / "bad.json").string()));
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("bad.json"), std::string::npos);
+}
+}  // namespace clumpforge
+
+namespace clumpforge {
+// Ctrl-C during a long run (issue 15, item 4): the command stops within a second, writes
+// nothing and exits 130. The tilt test of a 2 mm lattice runs for many seconds.
+TEST(InterruptCli, SigintStopsAValidationWithinASecondWritingNothing) {
+  test::ScratchDir dir("interrupt");
+  const std::string out = (dir / "run").string();
+  const auto run = test::run_command(fmt::format(
+      "bash -c '\"{}\" validate \"{}\" --clump lattice-2mm --test tilt --surface Q235 --trials 10 --out \"{}\" & "
+      "pid=$!; "
+      "sleep 1.5; t0=$(date +%s%N); kill -INT $pid; wait $pid; rc=$?; t1=$(date +%s%N); echo \"CF_RC $rc\"; "
+      "echo \"CF_MS $(( (t1 - t0) / 1000000 ))\"'",
+      CLUMPFORGE_BINARY, (test::source_dir() / "clumps" / "tuber-01.h5").string(), out));
+  EXPECT_NE(run.out.find("CF_RC 130"), std::string::npos) << run.out << run.err;
+  const auto at = run.out.find("CF_MS ");
+  ASSERT_NE(at, std::string::npos) << run.out;
+  EXPECT_LT(std::stoi(run.out.substr(at + 6)), 1000)
+      << "stopped " << run.out.substr(at + 6) << " ms after the interrupt";
+  EXPECT_NE(run.err.find("interrupted; nothing was written"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out)) << "no partial output";
+  EXPECT_EQ(test::count_files(dir.path()), 0);
 }
 }  // namespace clumpforge
