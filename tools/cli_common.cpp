@@ -108,6 +108,10 @@ Result<LoadedBody> load_closed_body(const std::string& path, const std::string& 
   return LoadedBody{std::move(*body), *digest};
 }
 
+std::string density_source(bool given) {
+  return given ? "given" : "not given: the study's Corydalis tuber density (--density to set)";
+}
+
 RunContext progress_context(bool json) {
   RunContext context;
   context.cancelled = interrupted;

@@ -40,6 +40,12 @@ struct LoadedBody {
 Result<LoadedBody> load_closed_body(const std::string& path, const std::string& units, double density,
                                     const SdfOptions& sdf, const RunContext& context);
 
+/// The study's Corydalis tuber density, used when a command is given none [kg/m^3].
+inline constexpr double kStudyDensity = 1085.0;
+/// How a density came to be used, for the output and the report: "given" or the default said
+/// in full, never silent.
+std::string density_source(bool given);
+
 /// Progress on stderr after the first second, when stderr is a terminal and not --json.
 RunContext progress_context(bool json);
 

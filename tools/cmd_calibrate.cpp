@@ -402,6 +402,10 @@ Command add_calibrate_command(CLI::App& app) {
   sub->add_option("--export", args->export_format,
                   "Also write the calibrated materials for an engine: liggghts, yade or edem (into --out)");
   sub->add_flag("--json", args->json, "Print the report as JSON");
+  sub->footer(
+      "Example:\n  clumpforge calibrate --recordings ../shared/data/paper/drop-Q235 ../shared/data/paper/tilt-Q235 "
+      "\\\n      ../shared/data/paper/roll-Q235 --clump clumps/tuber-default.h5 --clump-name lattice-2mm --method "
+      "joint --out cal/");
   return {sub, [args] { return run_calibrate(*args); }};
 }
 

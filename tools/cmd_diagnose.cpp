@@ -443,6 +443,9 @@ Command add_diagnose_command(CLI::App& app) {
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   sub->add_option("--out", args->out, "Write report.json and SVG plots here");
   sub->add_flag("--json", args->json, "Print the report as JSON");
+  sub->footer(
+      "Example:\n  clumpforge diagnose --recordings clumps/tuber-default-diagnosis/recordings/* \\\n      --clump "
+      "clumps/tuber-default-diagnosis.h5 --out diagnosis/");
   return {sub, [args] { return run_diagnose(*args); }};
 }
 

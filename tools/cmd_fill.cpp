@@ -11,11 +11,11 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "core/atomic_file.hpp"
-#include "io/clump_library.hpp"
 #include "core/text.hpp"
 #include "core/units.hpp"
 #include "fill/fill.hpp"
 #include "fill_report.hpp"
+#include "io/clump_library.hpp"
 
 namespace clumpforge::cli {
 namespace {
@@ -31,7 +31,8 @@ struct FillArgs {
   std::string min_radius;
   std::string voxel;
   std::string units = "mm";
-  double density = 1085.0;
+  double density = kStudyDensity;
+  bool density_given = false;
   bool json = false;
   bool append = false;
 };
@@ -68,8 +69,9 @@ int run_fill(const FillArgs& args) {
   } else if (args.method == "adaptive") {
     base.method = FillMethod::Adaptive;
   } else {
-    return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("unknown method '{}'{} (lattice or adaptive)", args.method,
-                                                                            did_you_mean(args.method, {"lattice", "adaptive"}))});
+    return report_error(
+        kCommand, {ErrorCode::InvalidArgument, fmt::format("unknown method '{}'{} (lattice or adaptive)", args.method,
+                                                           did_you_mean(args.method, {"lattice", "adaptive"}))});
   }
   std::vector<double> diameters{2e-3};
   if (!args.diameter.empty() && !args.diameters.empty()) {
@@ -81,7 +83,8 @@ int run_fill(const FillArgs& args) {
     diameters = *parsed;
   }
   for (double d : diameters) {
-    if (!(d > 0.0)) return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("diameter {} m must be positive", d)});
+    if (!(d > 0.0))
+      return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("diameter {} m must be positive", d)});
   }
   if (!args.min_radius.empty()) {
     auto r = parse_length(args.min_radius);
@@ -90,7 +93,8 @@ int run_fill(const FillArgs& args) {
   }
   base.max_spheres = args.max_spheres;
   base.target_error = args.target_error;
-  if (args.max_spheres < 0) return report_error(kCommand, {ErrorCode::InvalidArgument, "--max-spheres must not be negative"});
+  if (args.max_spheres < 0)
+    return report_error(kCommand, {ErrorCode::InvalidArgument, "--max-spheres must not be negative"});
   if (auto ok = check_writable(args.output); !ok) return report_error(kCommand, ok.error());
   SdfOptions sdf;
   sdf.feature_size = base.method == FillMethod::Lattice ? *std::min_element(diameters.begin(), diameters.end()) : 1e-3;
@@ -109,6 +113,8 @@ int run_fill(const FillArgs& args) {
   report["input"] = args.input;
   report["output"] = args.output;
   report["sdf_voxel_m"] = body->sdf.voxel_size();
+  report["density_kg_m3"] = args.density;
+  report["density_source"] = density_source(args.density_given);
   report["clumps"] = nlohmann::json::array();
   std::vector<Clump> clumps;
   const auto runs = base.method == FillMethod::Lattice ? diameters.size() : 1;
@@ -117,7 +123,9 @@ int run_fill(const FillArgs& args) {
     options.diameter = diameters[i];
     const auto t0 = std::chrono::steady_clock::now();
     auto filled = fill_body(*body, options, context);
-    if (!filled) return report_error(kCommand, Error{filled.error().code, fmt::format("'{}': {}", args.input, filled.error().message)});
+    if (!filled)
+      return report_error(kCommand,
+                          Error{filled.error().code, fmt::format("'{}': {}", args.input, filled.error().message)});
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     filled->clump.name = options.method == FillMethod::Lattice
                              ? fmt::format("lattice-{:g}mm", options.diameter * 1e3)
@@ -134,7 +142,8 @@ int run_fill(const FillArgs& args) {
     for (const auto& c : clumps) {
       for (const auto& e : *existing) {
         if (e.name == c.name) {
-          return report_error(kCommand, {ErrorCode::InvalidArgument, fmt::format("'{}' already holds a clump '{}'", args.output, c.name)});
+          return report_error(kCommand, {ErrorCode::InvalidArgument,
+                                         fmt::format("'{}' already holds a clump '{}'", args.output, c.name)});
         }
       }
     }
@@ -146,16 +155,21 @@ int run_fill(const FillArgs& args) {
   if (args.json) {
     std::cout << report.dump(2) << "\n";
   } else {
-    fmt::print("fill {} -> {} (signed distance voxel {:.3g} mm)\n", args.input, args.output, body->sdf.voxel_size() * 1e3);
+    fmt::print("fill {} -> {} (signed distance voxel {:.3g} mm; density {:g} kg/m^3, {})\n", args.input, args.output,
+               body->sdf.voxel_size() * 1e3, args.density, density_source(args.density_given));
     fmt::print("  {:<16} {:>7} {:>9} {:>10} {:>28} {:>28} {:>8} {:>9} {:>9} {:>6}\n", "clump", "spheres", "mass err",
-               "COM [mm]", "moment err (density)", "moment err (mass-matched)", "axis deg", "surf RMS", "surf max", "dice");
+               "COM [mm]", "moment err (density)", "moment err (mass-matched)", "axis deg", "surf RMS", "surf max",
+               "dice");
     for (const auto& c : clumps) {
       const auto& e = c.error;
-      fmt::print("  {:<16} {:>7} {:>8.1f}% {:>10.3f} {:>8.1f}% {:>8.1f}% {:>8.1f}% {:>8.2f}% {:>8.2f}% {:>8.2f}% {:>8.2f} {:>6.3f}mm {:>6.3f}mm {:>6.3f}\n",
-                 c.name, e.sphere_count, 100 * e.mass_error, e.com_offset_norm * 1e3, 100 * e.principal_moment_errors[0],
-                 100 * e.principal_moment_errors[1], 100 * e.principal_moment_errors[2],
-                 100 * e.principal_moment_errors_mass_matched[0], 100 * e.principal_moment_errors_mass_matched[1],
-                 100 * e.principal_moment_errors_mass_matched[2], e.axis_error_deg, e.surface_rms * 1e3, e.surface_max * 1e3, e.dice);
+      fmt::print(
+          "  {:<16} {:>7} {:>8.1f}% {:>10.3f} {:>8.1f}% {:>8.1f}% {:>8.1f}% {:>8.2f}% {:>8.2f}% {:>8.2f}% {:>8.2f} "
+          "{:>6.3f}mm {:>6.3f}mm {:>6.3f}\n",
+          c.name, e.sphere_count, 100 * e.mass_error, e.com_offset_norm * 1e3, 100 * e.principal_moment_errors[0],
+          100 * e.principal_moment_errors[1], 100 * e.principal_moment_errors[2],
+          100 * e.principal_moment_errors_mass_matched[0], 100 * e.principal_moment_errors_mass_matched[1],
+          100 * e.principal_moment_errors_mass_matched[2], e.axis_error_deg, e.surface_rms * 1e3, e.surface_max * 1e3,
+          e.dice);
     }
   }
   return kExitOk;
@@ -167,18 +181,25 @@ Command add_fill_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("fill", "Fill a closed body with spheres and report the clump's error");
   sub->add_option("mesh", args->input, "A closed mesh (run 'repair' first on a raw scan)")->required();
   sub->add_option("-o,--output", args->output, "Output clump library (.h5)")->required();
-  sub->add_option("--method", args->method, "lattice (the study's fixed-diameter filling) or adaptive")->capture_default_str();
+  sub->add_option("--method", args->method, "lattice (the study's fixed-diameter filling) or adaptive")
+      ->capture_default_str();
   sub->add_option("--diameter", args->diameter, "Lattice sphere diameter, e.g. 2mm");
   sub->add_option("--diameters", args->diameters, "Several lattice diameters, e.g. 1,2,4mm (one clump each)");
   sub->add_option("--max-spheres", args->max_spheres, "Adaptive: sphere budget");
   sub->add_option("--target-error", args->target_error, "Adaptive: stop when this fraction of the volume is uncovered");
   sub->add_option("--min-radius", args->min_radius, "Adaptive: smallest sphere radius, e.g. 0.3mm");
   sub->add_option("--voxel", args->voxel, "Signed-distance voxel size, e.g. 0.1mm (default: smallest diameter / 8)");
-  sub->add_option("--density", args->density, "Bulk density [kg/m^3] (default: the Corydalis tuber's)")->capture_default_str();
+  CLI::Option* density = sub->add_option("--density", args->density,
+                                         "Bulk density [kg/m^3] (default: the Corydalis tuber's, said in the output)")
+                             ->capture_default_str();
   sub->add_option("--units", args->units, "Length unit of the mesh file: mm, cm or m")->capture_default_str();
   sub->add_flag("--append", args->append, "Add the clumps to an existing library file instead of replacing it");
   sub->add_flag("--json", args->json, "Print one JSON report on stdout");
-  return {sub, [args] { return run_fill(*args); }};
+  sub->footer("Example:\n  clumpforge fill tuber.stl -o tuber.h5 --diameters 1,2,4mm --density 1085");
+  return {sub, [args, density] {
+            args->density_given = density->count() > 0;
+            return run_fill(*args);
+          }};
 }
 
 }  // namespace clumpforge::cli

@@ -25,20 +25,22 @@ void print_human(const PropsArgs& args, const MassProperties& p) {
   fmt::print("  mass       {:.6g} kg   ({:.4f} g)\n", p.mass, p.mass * 1e3);
   fmt::print("  centroid   [{:.6g}, {:.6g}, {:.6g}] m\n", p.centroid.x(), p.centroid.y(), p.centroid.z());
   fmt::print("  inertia about the centroid [kg m^2]:\n");
-  for (int r = 0; r < 3; ++r) fmt::print("    [{:>13.6e} {:>13.6e} {:>13.6e}]\n", p.inertia(r, 0), p.inertia(r, 1), p.inertia(r, 2));
+  for (int r = 0; r < 3; ++r)
+    fmt::print("    [{:>13.6e} {:>13.6e} {:>13.6e}]\n", p.inertia(r, 0), p.inertia(r, 1), p.inertia(r, 2));
   fmt::print("  principal moments [kg m^2]: {:.6e} {:.6e} {:.6e}\n", p.principal_moments.x(), p.principal_moments.y(),
              p.principal_moments.z());
   for (int c = 0; c < 3; ++c) {
-    fmt::print("  principal axis {}: [{:+.4f}, {:+.4f}, {:+.4f}]\n", c + 1, p.principal_axes(0, c), p.principal_axes(1, c),
-               p.principal_axes(2, c));
+    fmt::print("  principal axis {}: [{:+.4f}, {:+.4f}, {:+.4f}]\n", c + 1, p.principal_axes(0, c),
+               p.principal_axes(1, c), p.principal_axes(2, c));
   }
 }
 
 int run_props(const PropsArgs& args) {
   constexpr std::string_view kCommand = "props";
   if (!(args.density > 0.0) || args.density > 1e5) {
-    return report_error(kCommand, {ErrorCode::InvalidArgument,
-                                   fmt::format("--density {} is not a plausible density (expected kg/m^3, e.g. 1085)", args.density)});
+    return report_error(
+        kCommand, {ErrorCode::InvalidArgument,
+                   fmt::format("--density {} is not a plausible density (expected kg/m^3, e.g. 1085)", args.density)});
   }
   auto unit = parse_length_unit(args.units);
   if (!unit) return report_error(kCommand, unit.error());
@@ -67,6 +69,7 @@ Command add_props_command(CLI::App& app) {
   sub->add_option("--density", args->density, "Bulk density [kg/m^3], e.g. 1085 for the Corydalis tuber")->required();
   sub->add_option("--units", args->units, "Length unit of the file: mm, cm or m")->capture_default_str();
   sub->add_flag("--json", args->json, "Print one JSON object on stdout");
+  sub->footer("Example:\n  clumpforge props tuber.stl --density 1085 --units mm");
   return {sub, [args] { return run_props(*args); }};
 }
 

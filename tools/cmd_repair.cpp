@@ -102,6 +102,7 @@ Command add_repair_command(CLI::App& app) {
   sub->add_option("--units", args->units, "Length unit of the input file (and of the output): mm, cm or m")
       ->capture_default_str();
   sub->add_flag("--json", args->json, "Print one JSON report on stdout");
+  sub->footer("Example:\n  clumpforge repair scan.stl -o tuber.stl --units mm");
   return {sub, [args] { return run_repair(*args); }};
 }
 

@@ -1,7 +1,7 @@
 // End-to-end: the repair and props commands, their exit codes, files and JSON.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "support/test_support.hpp"
@@ -10,7 +10,9 @@ namespace clumpforge {
 namespace fs = std::filesystem;
 
 namespace {
-std::string default_scan() { return (test::source_dir() / "meshes" / "tuber-default.stl").string(); }
+std::string default_scan() {
+  return (test::source_dir() / "meshes" / "tuber-default.stl").string();
+}
 }  // namespace
 
 TEST(Cli, RepairJsonReportsBeforeAfterAndSteps) {
@@ -20,8 +22,9 @@ TEST(Cli, RepairJsonReportsBeforeAfterAndSteps) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto report = nlohmann::json::parse(run.out);
   for (const char* block : {"before", "after"}) {
-    for (const char* key : {"vertices", "faces", "components", "boundary_loops", "non_manifold_edges",
-                            "self_intersecting_pairs", "degenerate_faces", "closed", "volume_m3", "area_m2", "bbox_m"}) {
+    for (const char* key :
+         {"vertices", "faces", "components", "boundary_loops", "non_manifold_edges", "self_intersecting_pairs",
+          "degenerate_faces", "closed", "volume_m3", "area_m2", "bbox_m"}) {
       EXPECT_TRUE(report[block].contains(key)) << block << "." << key;
     }
   }
@@ -30,8 +33,13 @@ TEST(Cli, RepairJsonReportsBeforeAfterAndSteps) {
   EXPECT_TRUE(report["before"]["volume_m3"].is_null());
   EXPECT_TRUE(report["after"]["closed"].get<bool>());
   EXPECT_EQ(report["after"]["self_intersecting_pairs"], 0);
-  const std::vector<std::string> order{"duplicate_and_degenerate_faces", "unused_vertices", "non_manifold", "debris",
-                                       "orientation", "holes", "self_intersections"};
+  const std::vector<std::string> order{"duplicate_and_degenerate_faces",
+                                       "unused_vertices",
+                                       "non_manifold",
+                                       "debris",
+                                       "orientation",
+                                       "holes",
+                                       "self_intersections"};
   ASSERT_EQ(report["steps"].size(), order.size());
   for (std::size_t i = 0; i < order.size(); ++i) EXPECT_EQ(report["steps"][i]["name"], order[i]);
   EXPECT_TRUE(fs::exists(out));
@@ -45,13 +53,16 @@ TEST(Cli, PropsJsonOfRepairedScanMatchesReference) {
   const auto run = test::run_clumpforge(fmt::format("props '{}' --density 1085 --json", out.string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto props = nlohmann::json::parse(run.out);
-  for (const char* key : {"volume_m3", "mass_kg", "centroid_m", "inertia_kg_m2", "principal_moments_kg_m2", "principal_axes"}) {
+  for (const char* key :
+       {"volume_m3", "mass_kg", "centroid_m", "inertia_kg_m2", "principal_moments_kg_m2", "principal_axes"}) {
     EXPECT_TRUE(props.contains(key)) << key;
   }
   EXPECT_EQ(props["centroid_m"].size(), 3u);
   EXPECT_EQ(props["inertia_kg_m2"].size(), 3u);
-  const auto reference = nlohmann::json::parse(test::read_text(test::source_dir() / "meshes" / "tuber-default.json"))["reference"];
-  EXPECT_NEAR(props["mass_kg"].get<double>(), reference["mass_kg"].get<double>(), 0.005 * reference["mass_kg"].get<double>());
+  const auto reference =
+      nlohmann::json::parse(test::read_text(test::source_dir() / "meshes" / "tuber-default.json"))["reference"];
+  EXPECT_NEAR(props["mass_kg"].get<double>(), reference["mass_kg"].get<double>(),
+              0.005 * reference["mass_kg"].get<double>());
   const auto moments = props["principal_moments_kg_m2"];
   EXPECT_LE(moments[0].get<double>(), moments[1].get<double>());
   EXPECT_LE(moments[1].get<double>(), moments[2].get<double>());
@@ -71,19 +82,22 @@ TEST(Cli, HumanOutputOfRepairAndProps) {
 TEST(Cli, UsageErrorsExitTwo) {
   EXPECT_EQ(test::run_clumpforge("").exit_code, 2);
   EXPECT_EQ(test::run_clumpforge("frobnicate").exit_code, 2);
-  EXPECT_EQ(test::run_clumpforge(fmt::format("props '{}'", default_scan())).exit_code, 2);  // no --density
+  EXPECT_EQ(test::run_clumpforge(fmt::format("props '{}'", default_scan())).exit_code, 2);   // no --density
   EXPECT_EQ(test::run_clumpforge(fmt::format("repair '{}'", default_scan())).exit_code, 2);  // no -o
 }
 
 TEST(Cli, BadOptionsAreClearErrorsAndWriteNothing) {
   test::ScratchDir dir("cli");
-  const auto units = test::run_clumpforge(fmt::format("repair '{}' -o '{}' --units mn", default_scan(), (dir / "a.stl").string()));
+  const auto units =
+      test::run_clumpforge(fmt::format("repair '{}' -o '{}' --units mn", default_scan(), (dir / "a.stl").string()));
   EXPECT_EQ(units.exit_code, 1);
   EXPECT_NE(units.err.find("did you mean 'mm'"), std::string::npos) << units.err;
-  const auto extension = test::run_clumpforge(fmt::format("repair '{}' -o '{}'", default_scan(), (dir / "a.xyz").string()));
+  const auto extension =
+      test::run_clumpforge(fmt::format("repair '{}' -o '{}'", default_scan(), (dir / "a.xyz").string()));
   EXPECT_EQ(extension.exit_code, 1);
   EXPECT_NE(extension.err.find(".xyz"), std::string::npos);
-  const auto missing_dir = test::run_clumpforge(fmt::format("repair '{}' -o '{}'", default_scan(), (dir / "no" / "a.stl").string()));
+  const auto missing_dir =
+      test::run_clumpforge(fmt::format("repair '{}' -o '{}'", default_scan(), (dir / "no" / "a.stl").string()));
   EXPECT_EQ(missing_dir.exit_code, 1);
   EXPECT_NE(missing_dir.err.find("does not exist"), std::string::npos);
   const auto density = test::run_clumpforge(fmt::format("props '{}' --density -5", default_scan()));
@@ -99,4 +113,38 @@ TEST(Cli, PropsRefusesOpenScanPointingAtRepair) {
   EXPECT_NE(run.err.find("clumpforge repair"), std::string::npos);
 }
 
+}  // namespace clumpforge
+
+namespace clumpforge {
+// Issue 15, item 4: every command's --help ends with an example of its use.
+TEST(Cli, EveryCommandsHelpEndsWithAnExample) {
+  for (const char* command :
+       {"repair", "props", "fill", "export", "study", "validate", "calibrate", "materials", "diagnose"}) {
+    const auto run = test::run_clumpforge(fmt::format("{} --help", command));
+    EXPECT_EQ(run.exit_code, 0) << command;
+    const auto example = run.out.rfind("Example");
+    ASSERT_NE(example, std::string::npos) << command << ":\n" << run.out;
+    EXPECT_NE(run.out.find(fmt::format("clumpforge {} ", command), example), std::string::npos) << command;
+  }
+}
+
+// A density that was not given is said, in the output and the report, never silent.
+TEST(Cli, ADefaultDensityIsSaidNotSilent) {
+  test::ScratchDir dir("density");
+  const auto body = dir / "tuber.stl";
+  ASSERT_EQ(test::run_clumpforge(fmt::format("repair '{}' -o '{}'", default_scan(), body.string())).exit_code, 0);
+  const auto silent = test::run_clumpforge(
+      fmt::format("fill '{}' -o '{}' --diameter 4mm --json", body.string(), (dir / "a.h5").string()));
+  ASSERT_EQ(silent.exit_code, 0) << silent.err;
+  const auto report = nlohmann::json::parse(silent.out);
+  EXPECT_EQ(report["density_kg_m3"], 1085.0);
+  EXPECT_EQ(report["density_source"].get<std::string>().rfind("not given", 0), 0u) << report["density_source"];
+  const auto text =
+      test::run_clumpforge(fmt::format("fill '{}' -o '{}' --diameter 4mm", body.string(), (dir / "b.h5").string()));
+  EXPECT_NE(text.out.find("density 1085 kg/m^3, not given"), std::string::npos) << text.out;
+  const auto given = test::run_clumpforge(
+      fmt::format("fill '{}' -o '{}' --diameter 4mm --density 1000 --json", body.string(), (dir / "c.h5").string()));
+  ASSERT_EQ(given.exit_code, 0) << given.err;
+  EXPECT_EQ(nlohmann::json::parse(given.out)["density_source"], "given");
+}
 }  // namespace clumpforge
