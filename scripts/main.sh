@@ -33,15 +33,15 @@ done
 echo
 echo "== 5. the study's drop, tilt and roll tests on the 2 mm lattice clump in the built-in DEM (study's coefficients)"
 for surface in Q235 soil; do
-  $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test drop --surface "$surface" --trials 10 --out "$out/dem/drop-$surface"
-  $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test tilt --surface "$surface" --trials 1 --out "$out/dem/tilt-$surface"
-  $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test roll --surface "$surface" --trials 10 --out "$out/dem/roll-$surface"
+  $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test drop --surface "$surface" --trials 10 --output "$out/dem/drop-$surface"
+  $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test tilt --surface "$surface" --trials 1 --output "$out/dem/tilt-$surface"
+  $cf validate "$out/tuber-default.h5" --clump lattice-2mm --test roll --surface "$surface" --trials 10 --output "$out/dem/roll-$surface"
 done
 echo
 echo "== 6. diagnosis of a bundled recording set with a concealed effect (clumps/tuber-default-diagnosis/recordings:"
 echo "      drops from 0.2 and 1 m, a roll from 100 mm, a tilt; 4 tracked trials each, made by clumpforge-conceal"
 echo "      from a 340-sphere clump of the scan, no release orientation recorded)"
-$cf diagnose --recordings clumps/tuber-default-diagnosis/recordings --clump clumps/tuber-default-diagnosis.h5 --out "$out/diagnosis"
+$cf diagnose --recordings clumps/tuber-default-diagnosis/recordings --clump clumps/tuber-default-diagnosis.h5 --output "$out/diagnosis"
 echo
 echo "   the generator's answer (read only now, after the diagnosis): $(python3 -c 'import json; a=json.load(open("clumps/tuber-default-diagnosis/answer.json")); print(a["effect"], a["effect_parameters"])')"
 echo

@@ -42,5 +42,5 @@ $cf fill "$work/diagnosis.stl" -o clumps/tuber-default-diagnosis.h5 --method ada
 # Made from a finer clump of the same scan (adaptive-340) with the generator's finer time step,
 # and, like a lab's, with no release orientation recorded.
 build/tools/clumpforge-conceal clumps/tuber-default.h5 --clump adaptive-340 --effect air_drag --magnitude realistic --small --trials 4 --seed 7 \
-  --out clumps/tuber-default-diagnosis/recordings --answer clumps/tuber-default-diagnosis/answer.json
+  --output clumps/tuber-default-diagnosis/recordings --answer clumps/tuber-default-diagnosis/answer.json
 echo "clumps/tuber-default-diagnosis.h5: adaptive-32; concealed-effect recordings (from adaptive-340) in clumps/tuber-default-diagnosis/"

@@ -108,6 +108,12 @@ Result<LoadedBody> load_closed_body(const std::string& path, const std::string& 
   return LoadedBody{std::move(*body), *digest};
 }
 
+CLI::Option* add_output_option(CLI::App& app, std::string& target, const std::string& description) {
+  CLI::Option* output = app.add_option("-o,--output", target, description);
+  app.add_option("--out", target, "same as --output")->group("");  // hidden, for scripts written before
+  return output;
+}
+
 std::string density_source(bool given) {
   return given ? "given" : "not given: the study's Corydalis tuber density (--density to set)";
 }

@@ -1,5 +1,6 @@
 #pragma once
 /// Helpers shared by the subcommands: exit codes, error printing, JSON of library types.
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -39,6 +40,10 @@ struct LoadedBody {
 };
 Result<LoadedBody> load_closed_body(const std::string& path, const std::string& units, double density,
                                     const SdfOptions& sdf, const RunContext& context);
+
+/// The output option every command spells the same: `-o, --output PATH` (the older `--out`
+/// is still read, hidden from the help).
+CLI::Option* add_output_option(CLI::App& app, std::string& target, const std::string& description);
 
 /// The study's Corydalis tuber density, used when a command is given none [kg/m^3].
 inline constexpr double kStudyDensity = 1085.0;

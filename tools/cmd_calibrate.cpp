@@ -1,5 +1,5 @@
 // clumpforge calibrate --recordings DIR... --clump CLUMP.h5 [--clump-name NAME] [--method paper]
-//                      [--trials-per-level N] [--seed S] [--out DIR] [--json]
+//                      [--trials-per-level N] [--seed S] [--output DIR] [--json]
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -288,7 +288,7 @@ int run_calibrate(const CalibrateArgs& args) {
   if (!args.export_format.empty()) {
     if (args.out.empty())
       return report_error(kCommand,
-                          {ErrorCode::InvalidArgument, "--export needs --out DIR (materials.<ext> goes there)"});
+                          {ErrorCode::InvalidArgument, "--export needs --output DIR (materials.<ext> goes there)"});
     if (auto f = parse_export_format(args.export_format); !f) return report_error(kCommand, f.error());
   }
   if (args.trials_per_level < 1 || args.trials_per_level > 1000) {
@@ -390,7 +390,7 @@ Command add_calibrate_command(CLI::App& app) {
                   "Trials per swept level (joint: orientations per evaluation)")
       ->capture_default_str();
   sub->add_option("--seed", args->seed, "Seed of the trial orientations")->capture_default_str();
-  sub->add_option("--out", args->out, "Directory for calibration.json, calibration.md and the plots");
+  add_output_option(*sub, args->out, "Directory for calibration.json, calibration.md and the plots");
   sub->add_option("--materials", args->materials,
                   "Materials file (JSON, see docs/materials.json) overriding the built-in table");
   sub->add_option(
@@ -400,12 +400,12 @@ Command add_calibrate_command(CLI::App& app) {
          "engine")
       ->capture_default_str();
   sub->add_option("--export", args->export_format,
-                  "Also write the calibrated materials for an engine: liggghts, yade or edem (into --out)");
+                  "Also write the calibrated materials for an engine: liggghts, yade or edem (into --output)");
   sub->add_flag("--json", args->json, "Print the report as JSON");
   sub->footer(
       "Example:\n  clumpforge calibrate --recordings ../shared/data/paper/drop-Q235 ../shared/data/paper/tilt-Q235 "
       "\\\n      ../shared/data/paper/roll-Q235 --clump clumps/tuber-default.h5 --clump-name lattice-2mm --method "
-      "joint --out cal/");
+      "joint --output cal/");
   return {sub, [args] { return run_calibrate(*args); }};
 }
 

@@ -1,4 +1,4 @@
-// clumpforge diagnose --recordings DIR... (--mesh MESH | --clump CLUMP.h5) [--out DIR] [--json]
+// clumpforge diagnose --recordings DIR... (--mesh MESH | --clump CLUMP.h5) [--output DIR] [--json]
 // Where the DEM and the recordings disagree, which physics is missing, and the fit once it is added.
 #include <fmt/format.h>
 
@@ -441,11 +441,11 @@ Command add_diagnose_command(CLI::App& app) {
                   "beyond the release horizon (0: skip)");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
-  sub->add_option("--out", args->out, "Write report.json and SVG plots here");
+  add_output_option(*sub, args->out, "Directory for report.json and the SVG plots");
   sub->add_flag("--json", args->json, "Print the report as JSON");
   sub->footer(
       "Example:\n  clumpforge diagnose --recordings clumps/tuber-default-diagnosis/recordings/* \\\n      --clump "
-      "clumps/tuber-default-diagnosis.h5 --out diagnosis/");
+      "clumps/tuber-default-diagnosis.h5 --output diagnosis/");
   return {sub, [args] { return run_diagnose(*args); }};
 }
 

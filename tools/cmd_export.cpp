@@ -155,7 +155,7 @@ Command add_export_command(CLI::App& app) {
          "population")
       ->required();
   sub->add_option("--format", args->format, "liggghts, yade, edem, pfc, mercurydpm, chrono, vtk or csv")->required();
-  sub->add_option("-o,--output", args->output, "Primary output file (a directory for mercurydpm and for a population)")
+  add_output_option(*sub, args->output, "Primary output file (a directory for mercurydpm and for a population)")
       ->required();
   sub->add_option("--clump", args->clump,
                   "Which clump of each library named without ':CLUMP' (needed when it holds several)");

@@ -180,7 +180,7 @@ Command add_fill_command(CLI::App& app) {
   auto args = std::make_shared<FillArgs>();
   CLI::App* sub = app.add_subcommand("fill", "Fill a closed body with spheres and report the clump's error");
   sub->add_option("mesh", args->input, "A closed mesh (run 'repair' first on a raw scan)")->required();
-  sub->add_option("-o,--output", args->output, "Output clump library (.h5)")->required();
+  add_output_option(*sub, args->output, "Output clump library (.h5)")->required();
   sub->add_option("--method", args->method, "lattice (the study's fixed-diameter filling) or adaptive")
       ->capture_default_str();
   sub->add_option("--diameter", args->diameter, "Lattice sphere diameter, e.g. 2mm");

@@ -80,7 +80,7 @@ Command add_materials_command(CLI::App& app) {
       "--clump", args->clump_file,
       "Clump library (.h5): LIGGGHTS' rolling friction scaled by the clump's lever ratio (docs/exports/materials.md)");
   sub->add_option("--clump-name", args->clump_name, "Which clump of the file (needed when it holds several)");
-  sub->add_option("-o,--output", args->output, "File to write (default: standard output)");
+  add_output_option(*sub, args->output, "File to write (default: standard output)");
   sub->footer(
       "Example:\n  clumpforge materials --calibration out/calibration.json --export liggghts -o materials.liggghts");
   return {sub, [args] { return run_materials(*args); }};

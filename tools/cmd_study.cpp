@@ -174,7 +174,7 @@ Command add_study_command(CLI::App& app) {
   CLI::App* sub =
       app.add_subcommand("study", "Resolution trade-off: lattice 1/2/4 mm and adaptive budgets, error against spheres");
   sub->add_option("mesh", args->input, "A closed mesh (run 'repair' first on a raw scan)")->required();
-  sub->add_option("-o,--output", args->output, "Directory for the tables and plots")->required();
+  add_output_option(*sub, args->output, "Directory for the tables and plots")->required();
   sub->add_option("--budgets", args->budgets, "Adaptive sphere budgets")->delimiter(',')->capture_default_str();
   CLI::Option* density = sub->add_option("--density", args->density,
                                          "Bulk density [kg/m^3] (default: the Corydalis tuber's, said in the output)")

@@ -1,5 +1,5 @@
 // clumpforge validate CLUMP.h5 --test drop|tilt|roll --surface Q235|soil [--trials N] [--seed S]
-//                    [--out DIR] [--json] [--restitution e] [--static-friction m] [--rolling-friction m] ...
+//                    [--output DIR] [--json] [--restitution e] [--static-friction m] [--rolling-friction m] ...
 #include <fmt/format.h>
 
 #include <cmath>
@@ -193,7 +193,7 @@ Command add_validate_command(CLI::App& app) {
   sub->add_option("--surface", args->surface, "Plate material: Q235 or soil")->required();
   sub->add_option("--trials", args->trials, "Trials (random orientations)")->capture_default_str();
   sub->add_option("--seed", args->seed, "Seed of the orientations")->capture_default_str();
-  sub->add_option("--out", args->out, "Write the run as a recording (recording.json + tracks) in this directory");
+  add_output_option(*sub, args->out, "Write the run as a recording (recording.json + tracks) in this directory");
   sub->add_option("--materials", args->materials,
                   "Materials file (JSON, see docs/materials.json) overriding the built-in table");
   sub->add_option("--restitution", args->restitution, "Override e (0, 1]");

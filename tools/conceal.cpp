@@ -2,7 +2,7 @@
 // proving `clumpforge diagnose` blind. The answer goes to a separate file, for the scorer.
 //   clumpforge-conceal CLUMP.h5 [--clump NAME] --effect air_drag|...|none [--magnitude realistic|strong|V[,V]]
 //                      [--surface Q235] [--trials 8] [--seed 1] [--orientation none|noisy:DEG|exact]
-//                      [--fps 1000] [--noise 1e-4] [--no-pre-roll] --out DIR [--answer FILE]
+//                      [--fps 1000] [--noise 1e-4] [--no-pre-roll] --output DIR [--answer FILE]
 #include "diagnose/conceal.hpp"
 
 #include <fmt/format.h>
@@ -78,7 +78,7 @@ int main(int argc, char** argv) {
   app.add_option("--rolling-friction", rolling_friction, "Baseline mu_r");
   app.add_flag("--no-conceal", no_conceal, "Keep the baseline coefficients (the summaries then show the effect)");
   app.add_flag("--small", small, "Four recordings (drops 0.2 and 1.0 m, roll 100 mm, tilt) instead of six");
-  app.add_option("--out", out, "Directory for the recordings (one sub-directory each)")->required();
+  cli::add_output_option(app, out, "Directory for the recordings (one sub-directory each)")->required();
   app.add_option("--answer", answer, "Write the answer (effect, values, true coefficients) here as JSON");
   CLI11_PARSE(app, argc, argv);
 

@@ -1,15 +1,16 @@
 // clumpforge-make-scans: writes the bundled synthetic tuber scans (damaged STL in mm)
 // and, beside each, the clean body's reference mass properties (JSON). Deterministic:
 // the same seed gives the same bytes.
+#include <fmt/format.h>
+
 #include <CLI/CLI.hpp>
 #include <filesystem>
-#include <fmt/format.h>
 
 #include "cli_common.hpp"
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
-#include "mesh/mesh_writer.hpp"
 #include "mesh/mass_properties.hpp"
+#include "mesh/mesh_writer.hpp"
 #include "synth/tuber.hpp"
 
 namespace {
@@ -41,10 +42,14 @@ Result<void> write_scan(const fs::path& dir, const ScanSpec& spec) {
   j["clean_faces"] = body.faces.size();
   j["reference"] = cli::to_json(reference);
   const auto& r = scan.report;
-  j["damage"] = {{"base_faces_removed", r.base_faces_removed},     {"hole_faces_removed", r.hole_faces_removed},
-                 {"faces_flipped", r.faces_flipped},               {"seam_vertices_duplicated", r.seam_vertices_duplicated},
-                 {"duplicate_faces", r.duplicate_faces},           {"degenerate_faces", r.degenerate_faces},
-                 {"debris_faces", r.debris_faces},                 {"noise_sigma_m", spec.damage.noise_sigma}};
+  j["damage"] = {{"base_faces_removed", r.base_faces_removed},
+                 {"hole_faces_removed", r.hole_faces_removed},
+                 {"faces_flipped", r.faces_flipped},
+                 {"seam_vertices_duplicated", r.seam_vertices_duplicated},
+                 {"duplicate_faces", r.duplicate_faces},
+                 {"degenerate_faces", r.degenerate_faces},
+                 {"debris_faces", r.debris_faces},
+                 {"noise_sigma_m", spec.damage.noise_sigma}};
   return write_file_atomically(dir / (spec.name + ".json"), [&](std::ostream& out) -> Result<void> {
     out << j.dump(2) << "\n";
     return {};
@@ -58,9 +63,12 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 2026;
   int count = 10;
   int large_faces = 0;
-  app.add_option("-o,--out", out_dir, "Output directory")->capture_default_str();
+  app.add_option("-o,--output", out_dir, "Output directory")->capture_default_str();
+  app.add_option("--out", out_dir, "same as --output")->group("");
   app.add_option("--seed", seed, "Batch seed")->capture_default_str();
-  app.add_option("--count", count, "Scans in the batch besides the default one")->capture_default_str()->check(CLI::Range(0, 1000));
+  app.add_option("--count", count, "Scans in the batch besides the default one")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
   app.add_option("--large", large_faces,
                  "Instead of the batch, write one benchmark scan 'tuber-large' with about this many triangles");
   CLI11_PARSE(app, argc, argv);

@@ -125,6 +125,11 @@ TEST(Cli, EveryCommandsHelpEndsWithAnExample) {
     const auto example = run.out.rfind("Example");
     ASSERT_NE(example, std::string::npos) << command << ":\n" << run.out;
     EXPECT_NE(run.out.find(fmt::format("clumpforge {} ", command), example), std::string::npos) << command;
+    // One spelling of the output option: -o, --output (the old --out is read but not offered).
+    if (std::string_view(command) != "props") {
+      EXPECT_NE(run.out.find("-o,--output"), std::string::npos) << command;
+    }
+    EXPECT_EQ(run.out.find(" --out "), std::string::npos) << command;
   }
 }
 

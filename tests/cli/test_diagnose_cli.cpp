@@ -35,7 +35,7 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   // A track whose time goes backwards: refused with the file and the line.
   write(dir / "rec" / "recording.json", kManifest);
   write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n0.0005,0,0.21\n");
-  auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --out '{}'",
+  auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --output '{}'",
                                               (dir / "rec").string(), clump(), (dir / "out").string()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("trial-01.csv:4"), std::string::npos) << run.err;
@@ -93,7 +93,7 @@ TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
     std::filesystem::remove_all(dir / "rec");
     write(dir / "rec" / "recording.json", m);
     if (!track.empty()) write(dir / "rec" / "trial-01.csv", track);
-    const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --out '{}' --json",
+    const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --output '{}' --json",
                                                       (dir / "rec").string(), clump(), (dir / "out").string()));
     EXPECT_EQ(run.exit_code, 1) << run.err;
     EXPECT_NE(run.err.find((dir / "rec").string()), std::string::npos) << run.err;  // names the file
@@ -110,7 +110,7 @@ TEST(ConcealCli, BadOptionsAreRefusedAndNothingIsWritten) {
   const auto out = dir / "recordings";
   const auto answer = dir / "answer.json";
   auto conceal = [&](const std::string& clump_file, const std::string& options) {
-    return test::run_command(fmt::format("'{}' '{}' --small --out '{}' --answer '{}' {}", CLUMPFORGE_CONCEAL,
+    return test::run_command(fmt::format("'{}' '{}' --small --output '{}' --answer '{}' {}", CLUMPFORGE_CONCEAL,
                                          clump_file, out.string(), answer.string(), options));
   };
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -144,7 +144,7 @@ TEST(DiagnoseCli, SummariesOnlySayWhatTheyCanDecide) {
   // by the impacts of an irregular body; drag and speed dependence are undecidable.
   test::ScratchDir dir("diagnose-paper");
   const auto paper = test::shared_dir() / "data" / "paper";
-  const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' '{}' --clump '{}' --json --out '{}'",
+  const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' '{}' --clump '{}' --json --output '{}'",
                                                     (paper / "drop-Q235").string(), (paper / "roll-Q235").string(),
                                                     clump(), (dir / "out").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;

@@ -1,7 +1,7 @@
 // End-to-end: fill and export, their JSON, files and bad-input paths.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "support/test_support.hpp"
@@ -28,8 +28,8 @@ TEST_F(FillCli, LatticeJsonHasTheErrorReportKeys) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   for (const char* key : {"sphere_count", "volume_error", "mass_error", "com_offset_m", "principal_moment_errors",
-                          "principal_moment_errors_mass_matched", "axis_error_deg", "surface_rms_m", "surface_max_m", "dice",
-                          "sdf_voxel_m", "corrected", "union"}) {
+                          "principal_moment_errors_mass_matched", "axis_error_deg", "surface_rms_m", "surface_max_m",
+                          "dice", "sdf_voxel_m", "corrected", "union"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["principal_moment_errors"].size(), 3u);
@@ -39,13 +39,15 @@ TEST_F(FillCli, LatticeJsonHasTheErrorReportKeys) {
 }
 
 TEST_F(FillCli, SeveralDiametersMakeOneFileOfSeveralClumps) {
-  const auto run = test::run_clumpforge(fmt::format("fill '{}' -o '{}' --diameters 2,4mm --json", body(), path("l24.h5")));
+  const auto run =
+      test::run_clumpforge(fmt::format("fill '{}' -o '{}' --diameters 2,4mm --json", body(), path("l24.h5")));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   ASSERT_EQ(j["clumps"].size(), 2u);
   EXPECT_EQ(j["clumps"][0]["name"], "lattice-2mm");
   EXPECT_EQ(j["clumps"][1]["name"], "lattice-4mm");
-  const auto ambiguous = test::run_clumpforge(fmt::format("export '{}' --format csv -o '{}'", path("l24.h5"), path("x.csv")));
+  const auto ambiguous =
+      test::run_clumpforge(fmt::format("export '{}' --format csv -o '{}'", path("l24.h5"), path("x.csv")));
   EXPECT_EQ(ambiguous.exit_code, 1);
   EXPECT_NE(ambiguous.err.find("--clump"), std::string::npos);
   const auto chosen = test::run_clumpforge(
@@ -54,12 +56,14 @@ TEST_F(FillCli, SeveralDiametersMakeOneFileOfSeveralClumps) {
 }
 
 TEST_F(FillCli, AdaptiveWithABudget) {
-  const auto run = test::run_clumpforge(fmt::format("fill '{}' -o '{}' --method adaptive --max-spheres 40 --json", body(), path("a.h5")));
+  const auto run = test::run_clumpforge(
+      fmt::format("fill '{}' -o '{}' --method adaptive --max-spheres 40 --json", body(), path("a.h5")));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   EXPECT_LE(j["sphere_count"].get<int>(), 40);
   EXPECT_LT(std::abs(j["mass_error"].get<double>()), 0.01);
-  const auto exported = test::run_clumpforge(fmt::format("export '{}' --format vtk -o '{}' --json", path("a.h5"), path("a.vtp")));
+  const auto exported =
+      test::run_clumpforge(fmt::format("export '{}' --format vtk -o '{}' --json", path("a.h5"), path("a.vtp")));
   ASSERT_EQ(exported.exit_code, 0) << exported.err;
   EXPECT_EQ(nlohmann::json::parse(exported.out)["files"].size(), 1u);
 }
@@ -79,7 +83,8 @@ TEST_F(FillCli, BadInputIsAClearErrorAndWritesNothing) {
       {fmt::format("fill '{}' -o '{}' --method adaptve", body(), h5), "did you mean 'adaptive'"},
       {fmt::format("fill '{}' -o '{}' --method adaptive --max-spheres -4", body(), h5), "must not be negative"},
       {fmt::format("fill '{}' -o '/nonexistent/dir/x.h5'", body()), "does not exist"},
-      {fmt::format("export '{}' --format liggghs -o '{}'", path("l2.h5"), (out / "t.txt").string()), "did you mean 'liggghts'"},
+      {fmt::format("export '{}' --format liggghs -o '{}'", path("l2.h5"), (out / "t.txt").string()),
+       "did you mean 'liggghts'"},
       {fmt::format("export '{}' --format csv -o '{}'", raw, (out / "t.csv").string()), "not an HDF5 file"},
       {fmt::format("export '{}' --format csv -o '/nonexistent/t.csv'", path("l2.h5")), "does not exist"},
   };
@@ -100,16 +105,19 @@ TEST(StudyCli, WritesTablesAndPlots) {
   const auto scan = (test::source_dir() / "meshes" / "tuber-default.stl").string();
   const auto body = (dir / "tuber.stl").string();
   ASSERT_EQ(test::run_clumpforge(fmt::format("repair '{}' -o '{}'", scan, body)).exit_code, 0);
-  const auto run = test::run_clumpforge(fmt::format("study '{}' -o '{}' --budgets 16,64 --json", body, (dir / "out").string()));
+  const auto run =
+      test::run_clumpforge(fmt::format("study '{}' -o '{}' --budgets 16,64 --json", body, (dir / "out").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   ASSERT_EQ(j["rows"].size(), 5u);  // lattice 1, 2, 4 mm and two budgets
-  for (const char* file : {"study.csv", "study.md", "study-mass.svg", "study-inertia.svg", "study-surface.svg", "study-time.svg"}) {
+  for (const char* file :
+       {"study.csv", "study.md", "study-mass.svg", "study-inertia.svg", "study-surface.svg", "study-time.svg"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / file)) << file;
   }
   EXPECT_NE(test::read_text(dir / "out" / "study-inertia.svg").find("<svg"), std::string::npos);
   const std::string csv = test::read_text(dir / "out" / "study.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 6);
-  EXPECT_EQ(test::run_clumpforge(fmt::format("study '{}' -o '{}' --budgets 0", body, (dir / "bad").string())).exit_code, 1);
+  EXPECT_EQ(test::run_clumpforge(fmt::format("study '{}' -o '{}' --budgets 0", body, (dir / "bad").string())).exit_code,
+            1);
 }
 }  // namespace clumpforge

@@ -18,7 +18,7 @@ TEST(ValidateCli, DropJsonAndRecording) {
   test::ScratchDir dir("validate");
   const auto run =
       test::run_clumpforge(fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --trials 3 --seed "
-                                       "5 --out '{}' --restitution 0.6 --json",
+                                       "5 --output '{}' --restitution 0.6 --json",
                                        library(), (dir / "rec").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
@@ -127,7 +127,7 @@ TEST(InterruptCli, SigintStopsAValidationWithinASecondWritingNothing) {
   test::ScratchDir dir("interrupt");
   const std::string out = (dir / "run").string();
   const auto run = test::run_command(fmt::format(
-      "bash -c '\"{}\" validate \"{}\" --clump lattice-2mm --test tilt --surface Q235 --trials 10 --out \"{}\" & "
+      "bash -c '\"{}\" validate \"{}\" --clump lattice-2mm --test tilt --surface Q235 --trials 10 --output \"{}\" & "
       "pid=$!; "
       "sleep 1.5; t0=$(date +%s%N); kill -INT $pid; wait $pid; rc=$?; t1=$(date +%s%N); echo \"CF_RC $rc\"; "
       "echo \"CF_MS $(( (t1 - t0) / 1000000 ))\"'",
