@@ -12,6 +12,8 @@ packages=(
   libeigen3-dev libhdf5-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
   hdf5-tools python3-h5py python3-numpy
+  python3-dev pybind11-dev python3-pytest python3-matplotlib
+  libopenmpi-dev openmpi-bin
   liggghts yade
 )
 missing=()

@@ -36,31 +36,11 @@ struct DiagnoseArgs {
 
 // A recording directory, or a directory of recording directories (sorted by name).
 Result<void> collect(const std::string& path, std::vector<Recording>& recordings, std::vector<std::string>& names) {
-  const fs::path p(path);
-  std::error_code ec;
-  if (fs::is_regular_file(p / "recording.json", ec) ||
-      (fs::is_regular_file(p, ec) && p.filename() == "recording.json")) {
-    auto r = read_recording(p);
-    if (!r) return std::unexpected(r.error());
-    recordings.push_back(std::move(*r));
-    names.push_back(fs::is_directory(p, ec) ? p.filename().string() : p.parent_path().filename().string());
-    if (names.back().empty()) names.back() = fs::absolute(p).filename().string();
-    return {};
-  }
-  if (!fs::is_directory(p, ec)) return fail(ErrorCode::NotFound, fmt::format("{}: no such recording directory", path));
-  std::vector<fs::path> children;
-  for (const auto& entry : fs::directory_iterator(p, ec)) {
-    if (entry.is_directory() && fs::is_regular_file(entry.path() / "recording.json")) children.push_back(entry.path());
-  }
-  if (children.empty())
-    return fail(ErrorCode::NotFound,
-                fmt::format("{}: neither a recording (recording.json) nor a directory of recordings", path));
-  std::sort(children.begin(), children.end());
-  for (const auto& child : children) {
-    auto r = read_recording(child);
-    if (!r) return std::unexpected(r.error());
-    recordings.push_back(std::move(*r));
-    names.push_back(child.filename().string());
+  auto set = read_recordings(path);
+  if (!set) return std::unexpected(set.error());
+  for (std::size_t i = 0; i < set->recordings.size(); ++i) {
+    recordings.push_back(std::move(set->recordings[i]));
+    names.push_back(std::move(set->names[i]));
   }
   return {};
 }
@@ -373,7 +353,6 @@ int run_diagnose(const DiagnoseArgs& args) {
       return report_error(kCommand,
                           Error{filled.error().code, fmt::format("'{}': {}", args.mesh, filled.error().message)});
     clump = std::move(filled->clump);
-    clump.name = fmt::format("adaptive-{}", clump.spheres.size());
   }
   auto result = diagnose(clump, *loaded_table, recordings, names, options, context);
   if (!result) return report_error(kCommand, result.error());

@@ -127,9 +127,6 @@ int run_fill(const FillArgs& args) {
       return report_error(kCommand,
                           Error{filled.error().code, fmt::format("'{}': {}", args.input, filled.error().message)});
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    filled->clump.name = options.method == FillMethod::Lattice
-                             ? fmt::format("lattice-{:g}mm", options.diameter * 1e3)
-                             : fmt::format("adaptive-{}", filled->clump.spheres.size());
     filled->clump.source_sha256 = digest;
     nlohmann::json entry = clump_to_json(filled->clump);
     entry["fill_seconds"] = seconds;

@@ -104,14 +104,7 @@ int run_validate(const ValidateArgs& args) {
   else
     return report_error(kCommand, {ErrorCode::InvalidArgument,
                                    fmt::format("unknown composite '{}' (single or four-square)", args.composite)});
-  if (!(setup.release_height > 0.0 && setup.release_height < 10.0) ||
-      !(setup.incline_deg > 0.0 && setup.incline_deg < 90.0) ||
-      !(setup.start_distance > 0.0 && setup.start_distance < 0.45) ||
-      (setup.tilt_rate_deg_per_s && !(*setup.tilt_rate_deg_per_s > 0.0))) {
-    return report_error(kCommand, {ErrorCode::InvalidArgument,
-                                   "the set-up is out of range (height in (0, 10) m, incline in (0, 90) deg, start in "
-                                   "(0, 0.45) m, tilt rate > 0)"});
-  }
+  if (auto ok = check_lab_setup(setup); !ok) return report_error(kCommand, ok.error());
   auto clumps = read_clump_library(args.input);
   if (!clumps) return report_error(kCommand, clumps.error());
   auto clump = select_clump(std::move(*clumps), args.clump, args.input);

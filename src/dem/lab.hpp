@@ -14,19 +14,19 @@
 namespace clumpforge {
 
 struct LabOptions {
-  int trials = 10;                  ///< >= 1
-  std::uint64_t seed = 1;           ///< trial i uses substream i: any thread count, the same bits
+  int trials = 10;                         ///< >= 1
+  std::uint64_t seed = 1;                  ///< trial i uses substream i: any thread count, the same bits
   std::optional<Interaction> interaction;  ///< overrides the table's particle-surface pair
-  ContactSettings contact;          ///< contact law settings (rolling model, limitForce, ...)
-  std::optional<double> time_step;  ///< [s]; default: the estimate's choice
+  ContactSettings contact;                 ///< contact law settings (rolling model, limitForce, ...)
+  std::optional<double> time_step;         ///< [s]; default: the estimate's choice
   /// Default time step: at least this many steps per Hertz contact (50 = the estimate's
   /// choice; the diagnosis, which replays trials thousands of times, uses 25).
   int steps_per_contact = 50;
-  double frame_rate_hz = 1000.0;    ///< track sampling, like a high-speed camera
-  double tilt_rate_deg_per_s = 5.0; ///< used when the recording has none
-  double max_time = 6.0;            ///< [s] simulated time limit of a drop or roll trial (a tilt runs to 89 deg)
+  double frame_rate_hz = 1000.0;     ///< track sampling, like a high-speed camera
+  double tilt_rate_deg_per_s = 5.0;  ///< used when the recording has none
+  double max_time = 6.0;             ///< [s] simulated time limit of a drop or roll trial (a tilt runs to 89 deg)
   std::string particle_material = "tuber";
-  std::vector<PhysicsTerm> terms;   ///< extra physics
+  std::vector<PhysicsTerm> terms;  ///< extra physics
   /// Centre of mass relative to the visible centroid, in the clump's body frame [m]: a
   /// non-uniform density. The spheres (the shape) move by -offset; tracks follow the shape.
   Eigen::Vector3d com_offset = Eigen::Vector3d::Zero();
@@ -41,51 +41,57 @@ struct ImpactDiagnostics {
 };
 
 struct LabResult {
-  Recording recording;              ///< the set-up and one trial per run (summary + track)
+  Recording recording;                           ///< the set-up and one trial per run (summary + track)
   std::vector<Eigen::Quaterniond> orientations;  ///< initial orientation of each trial
   std::vector<ImpactDiagnostics> impacts;        ///< per trial (drop tests)
-  Interaction interaction;          ///< coefficients actually used
+  Interaction interaction;                       ///< coefficients actually used
   TimeStepEstimate estimate;
-  double time_step = 0.0;           ///< [s]
-  std::uint64_t steps = 0;          ///< over all trials
+  double time_step = 0.0;   ///< [s]
+  std::uint64_t steps = 0;  ///< over all trials
 };
 
 /// A test's world ready for trials: the particle, the plate(s), materials and the time step.
 struct LabWorld {
-  World world;                    ///< the particle is bodies[0], not yet placed
+  World world;                                              ///< the particle is bodies[0], not yet placed
   Eigen::Vector3d tracked_point = Eigen::Vector3d::Zero();  ///< visible centroid, body frame [m]
   Interaction interaction;
   TimeStepEstimate estimate;
-  double time_step = 0.0;         ///< [s]
+  double time_step = 0.0;  ///< [s]
 };
-Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, const Recording& setup, const LabOptions& options);
+Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, const Recording& setup,
+                                const LabOptions& options);
 
 /// One dense sample of a replayed trial (the tracked point, not the centre of mass).
 struct ReplaySample {
-  double t = 0.0;          ///< [s] since release (tilt: since the plate started turning)
-  double x = 0.0, z = 0.0; ///< tracked point [m]
-  double angle = 0.0;      ///< in-plane angle of the body's x axis [rad]
-  double tilt_deg = 0.0;   ///< plate angle (tilt)
-  double speed = 0.0;      ///< centre-of-mass speed [m/s]
-  double lowest = 0.0;     ///< height of the body's lowest point above z = 0 [m]
+  double t = 0.0;            ///< [s] since release (tilt: since the plate started turning)
+  double x = 0.0, z = 0.0;   ///< tracked point [m]
+  double angle = 0.0;        ///< in-plane angle of the body's x axis [rad]
+  double tilt_deg = 0.0;     ///< plate angle (tilt)
+  double speed = 0.0;        ///< centre-of-mass speed [m/s]
+  double lowest = 0.0;       ///< height of the body's lowest point above z = 0 [m]
   double along_plate = 0.0;  ///< tilt: centre-of-mass coordinate along the plate's downhill axis [m]
-  int contacts = 0;        ///< sphere-wall contacts
-  int wall = -1;           ///< the wall touched (roll: 0 incline, 1 flat), -1 none
+  int contacts = 0;          ///< sphere-wall contacts
+  int wall = -1;             ///< the wall touched (roll: 0 incline, 1 flat), -1 none
 };
 
 struct ReplayOptions {
-  double duration = 1.0;         ///< [s] simulated after release
-  double sample_interval = 1e-4; ///< [s]
-  double settle = 0.05;          ///< tilt: settling before the plate turns [s]
-  double record_from = 0.0;      ///< [s] samples before this are left out (the first one is kept)
+  double duration = 1.0;          ///< [s] simulated after release
+  double sample_interval = 1e-4;  ///< [s]
+  double settle = 0.05;           ///< tilt: settling before the plate turns [s]
+  double record_from = 0.0;       ///< [s] samples before this are left out (the first one is kept)
   double stop_after_rest = -1.0;  ///< end this long after the body came to rest (speed < 2 mm/s) [s]; < 0 never
-  double stop_after_slip = -1.0; ///< tilt: end this long after 10 mm of slip along the plate [s]; < 0 never
+  double stop_after_slip = -1.0;  ///< tilt: end this long after 10 mm of slip along the plate [s]; < 0 never
 };
 
 /// Runs one trial of `setup` from the given initial orientation (the body placed as the
 /// test places it) and returns the tracked point every `sample_interval`.
-std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& setup, const Eigen::Quaterniond& orientation,
-                                       const LabOptions& options, const ReplayOptions& replay);
+std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& setup,
+                                       const Eigen::Quaterniond& orientation, const LabOptions& options,
+                                       const ReplayOptions& replay);
+
+/// Checks a set-up asked for directly (not read from a recording): release height in
+/// (0, 10) m, incline in (0, 90) deg, roll start in (0, 0.45) m along the slope, tilt rate > 0.
+Result<void> check_lab_setup(const Recording& setup);
 
 /// Runs `options.trials` trials of `setup`'s test (its test, surface and set-up fields)
 /// with `clump` as the particle. Fails for an unknown surface or particle material, bad

@@ -66,6 +66,8 @@ Result<FillResult> fill_body(const PreparedBody& body, const FillOptions& option
     return fail(ErrorCode::InvalidArgument, "no sphere fits inside the body with these options");
   }
   clump.parameters.emplace_back("sdf_voxel_m", result.voxel_size);
+  clump.name = options.method == FillMethod::Lattice ? fmt::format("lattice-{:g}mm", options.diameter * 1e3)
+                                                     : fmt::format("adaptive-{}", clump.spheres.size());
   clump.density = body.properties.density;
   clump.mass = body.properties.mass;
   clump.body_volume = body.properties.volume;

@@ -48,7 +48,8 @@ struct FillResult {
   std::vector<Diagnostic> notes;
 };
 
-/// Fills `body`; the clump's spheres are in the body's principal frame. Fails for absurd
+/// Fills `body`; the clump's spheres are in the body's principal frame. The clump is named
+/// `lattice-<d>mm` or `adaptive-<sphere count>`. Fails for absurd
 /// options (non-positive diameter, a diameter larger than the body, a zero budget) or when
 /// no sphere fits.
 Result<FillResult> fill_body(const PreparedBody& body, const FillOptions& options, const RunContext& context = {});

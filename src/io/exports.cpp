@@ -352,6 +352,15 @@ Result<Files> format_files(const Clump& clump, const ExportOptions& options, con
       files = csv(clump, output);
       break;
   }
+  // A companion named like the primary (`X.yade.py` given for YADE, whose companion is the
+  // `.py` of the primary's stem) would overwrite it.
+  for (std::size_t i = 1; i < files.size(); ++i) {
+    if (files[i].first.lexically_normal() == files[0].first.lexically_normal())
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("{} export: '{}' would be both the primary file and its companion; give the primary "
+                              "another extension (e.g. '{}')",
+                              to_string(format), output.string(), sibling(output, ".txt").string()));
+  }
   return files;
 }
 }  // namespace export_detail

@@ -424,4 +424,36 @@ Result<void> write_recording(const fs::path& dir, const Recording& r) {
   return write_files_atomically(files);
 }
 
+Result<RecordingSet> read_recordings(const fs::path& path) {
+  RecordingSet set;
+  std::error_code ec;
+  if (fs::is_regular_file(path / "recording.json", ec) ||
+      (fs::is_regular_file(path, ec) && path.filename() == "recording.json")) {
+    auto r = read_recording(path);
+    if (!r) return std::unexpected(r.error());
+    set.recordings.push_back(std::move(*r));
+    std::string name = fs::is_directory(path, ec) ? path.filename().string() : path.parent_path().filename().string();
+    if (name.empty()) name = fs::absolute(path).lexically_normal().parent_path().filename().string();
+    set.names.push_back(name);
+    return set;
+  }
+  if (!fs::is_directory(path, ec))
+    return fail(ErrorCode::NotFound, fmt::format("{}: no such recording directory", path.string()));
+  std::vector<fs::path> children;
+  for (const auto& entry : fs::directory_iterator(path, ec)) {
+    if (entry.is_directory() && fs::is_regular_file(entry.path() / "recording.json")) children.push_back(entry.path());
+  }
+  if (children.empty())
+    return fail(ErrorCode::NotFound,
+                fmt::format("{}: neither a recording (recording.json) nor a directory of recordings", path.string()));
+  std::sort(children.begin(), children.end());
+  for (const auto& child : children) {
+    auto r = read_recording(child);
+    if (!r) return std::unexpected(r.error());
+    set.recordings.push_back(std::move(*r));
+    set.names.push_back(child.filename().string());
+  }
+  return set;
+}
+
 }  // namespace clumpforge

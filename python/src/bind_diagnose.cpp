@@ -1,0 +1,161 @@
+/// The diagnosis: which physics the model leaves out, from recorded tracks.
+#include "common.hpp"
+#include "diagnose/diagnose.hpp"
+
+namespace clumpforge::python {
+namespace {
+
+std::string effect_name(Effect e) {
+  return effect_spec(effect_library(), e).name;
+}
+
+void bind_enums(py::module_& m) {
+  py::enum_<Verdict>(m, "Verdict")
+      .value("none", Verdict::None)
+      .value("named", Verdict::Named)
+      .value("ambiguous", Verdict::Ambiguous)
+      .value("unexplained", Verdict::Unexplained)
+      .value("undecidable", Verdict::Undecidable);
+  py::enum_<Basis> basis(m, "Basis");
+  for (Basis b : {Basis::Consistent, Basis::SlightMisfit, Basis::FrameByFrame, Basis::Ensemble,
+                  Basis::UnexplainedPhases, Basis::TooFewTrials, Basis::TooNoisy, Basis::SummariesOnly})
+    basis.value(std::string(basis_name(b)).c_str(), b);
+  py::enum_<Phase> phase(m, "Phase");
+  for (Phase p : {Phase::Hold, Phase::Flight, Phase::Impact, Phase::Rebound, Phase::LaterBounces, Phase::Incline,
+                  Phase::Transition, Phase::Flat, Phase::Rest, Phase::Stick, Phase::Slip})
+    phase.value(std::string(phase_name(p)).c_str(), p);
+  py::enum_<Axis>(m, "Axis").value("x", Axis::X).value("z", Axis::Z);
+  m.def(
+      "effects",
+      [] {
+        py::dict out;
+        for (const auto& spec : effect_library()) out[py::str(spec.name)] = spec.description;
+        return out;
+      },
+      "The library of candidate effects: {name: description}.");
+}
+
+void bind_parts(py::module_& m) {
+  py::class_<ParameterValue>(m, "ParameterValue", "A fitted value with its 95 % interval.")
+      .def_readonly("name", &ParameterValue::name)
+      .def_readonly("value", &ParameterValue::value)
+      .def_readonly("low", &ParameterValue::low)
+      .def_readonly("high", &ParameterValue::high);
+  py::class_<SurfaceParameters>(m, "SurfaceParameters")
+      .def_readonly("surface", &SurfaceParameters::surface)
+      .def_readonly("interaction", &SurfaceParameters::interaction);
+  py::class_<PhaseReport>(m, "PhaseReport", "The misfit of one phase of one recording.")
+      .def_readonly("recording", &PhaseReport::recording)
+      .def_readonly("phase", &PhaseReport::phase)
+      .def_readonly("values", &PhaseReport::values)
+      .def_readonly("chi2_per_value", &PhaseReport::chi2_per_value)
+      .def_readonly("improved_chi2_per_value", &PhaseReport::improved_chi2_per_value)
+      .def_readonly("p_value", &PhaseReport::p_value)
+      .def_readonly("significant", &PhaseReport::significant)
+      .def_readonly("bias_x_mm", &PhaseReport::bias_x_mm)
+      .def_readonly("bias_z_mm", &PhaseReport::bias_z_mm)
+      .def_readonly("axis", &PhaseReport::axis)
+      .def_readonly("statement", &PhaseReport::statement);
+  py::class_<HypothesisReport>(m, "HypothesisReport", "One candidate effect as fitted and tested.")
+      .def_readonly("name", &HypothesisReport::name)
+      .def_readonly("values", &HypothesisReport::values)
+      .def_readonly("delta_chi2", &HypothesisReport::delta_chi2)
+      .def_readonly("delta_bic", &HypothesisReport::delta_bic)
+      .def_readonly("heldout_delta_chi2", &HypothesisReport::heldout_delta_chi2)
+      .def_readonly("passes", &HypothesisReport::passes)
+      .def_readonly("evaluations", &HypothesisReport::evaluations);
+  py::class_<FitQuality>(m, "FitQuality")
+      .def_readonly("train_rms_mm", &FitQuality::train_rms_mm)
+      .def_readonly("heldout_rms_mm", &FitQuality::heldout_rms_mm)
+      .def_readonly("train_chi2_per_value", &FitQuality::train_chi2_per_value)
+      .def_readonly("heldout_chi2_per_value", &FitQuality::heldout_chi2_per_value);
+  py::class_<TrackComparison>(m, "TrackComparison", "A recording's first trial against both models (replay time).")
+      .def_readonly("recording", &TrackComparison::recording)
+      .def_readonly("t", &TrackComparison::t)
+      .def_readonly("x", &TrackComparison::x)
+      .def_readonly("z", &TrackComparison::z)
+      .def_readonly("baseline_t", &TrackComparison::baseline_t)
+      .def_readonly("baseline_x", &TrackComparison::baseline_x)
+      .def_readonly("baseline_z", &TrackComparison::baseline_z)
+      .def_readonly("improved_t", &TrackComparison::improved_t)
+      .def_readonly("improved_x", &TrackComparison::improved_x)
+      .def_readonly("improved_z", &TrackComparison::improved_z)
+      .def_readonly("horizon", &TrackComparison::horizon, "[s] predictable from the release up to here");
+  py::class_<PhaseOf>(m, "PhaseOf")
+      .def_readonly("recording", &PhaseOf::recording)
+      .def_readonly("phase", &PhaseOf::phase)
+      .def_readonly("chi2_per_value", &PhaseOf::chi2_per_value)
+      .def_readonly("where", &PhaseOf::where);
+}
+
+void bind_result(py::module_& m) {
+  py::class_<DiagnoseResult>(m, "DiagnoseResult", "What a diagnosis concludes, and on what basis.")
+      .def_readonly("verdict", &DiagnoseResult::verdict)
+      .def_readonly("basis", &DiagnoseResult::basis)
+      .def_property_readonly("effect",
+                             [](const DiagnoseResult& r) -> std::optional<std::string> {
+                               if (!r.effect) return std::nullopt;
+                               return effect_name(*r.effect);
+                             })
+      .def_property_readonly("name", &verdict_name, "the verdict as reports write it")
+      .def_readonly("statement", &DiagnoseResult::statement)
+      .def_readonly("candidates", &DiagnoseResult::candidates)
+      .def_readonly("experiment", &DiagnoseResult::experiment)
+      .def_readonly("effect_parameters", &DiagnoseResult::effect_parameters)
+      .def_readonly("baseline", &DiagnoseResult::baseline)
+      .def_readonly("improved", &DiagnoseResult::improved)
+      .def_readonly("uncalibrated", &DiagnoseResult::uncalibrated)
+      .def_readonly("before", &DiagnoseResult::before)
+      .def_readonly("after", &DiagnoseResult::after)
+      .def_readonly("phases", &DiagnoseResult::phases)
+      .def_readonly("hypotheses", &DiagnoseResult::hypotheses)
+      .def_readonly("unexplained", &DiagnoseResult::unexplained)
+      .def_readonly("outliers", &DiagnoseResult::outliers)
+      .def_readonly("tracks", &DiagnoseResult::tracks)
+      .def_readonly("notes", &DiagnoseResult::notes)
+      .def_readonly("undecidable", &DiagnoseResult::undecidable)
+      .def_readonly("evaluations", &DiagnoseResult::evaluations)
+      .def_readonly("seconds", &DiagnoseResult::seconds);
+}
+
+DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, const std::vector<std::string>& effects,
+                             std::optional<MaterialTable> materials, double orientation_prior_deg,
+                             double model_accuracy, int ensemble_replays, int max_evaluations, std::uint64_t seed,
+                             const py::object& progress) {
+  std::vector<Recording> list;
+  std::vector<std::string> names;
+  for (const auto& [name, recording] : recordings) {
+    names.push_back(py::cast<std::string>(name));
+    list.push_back(py::cast<Recording>(recording));
+  }
+  if (list.empty()) raise({ErrorCode::InvalidArgument, "no recordings to diagnose"});
+  const MaterialTable table = materials ? *materials : default_material_table();
+  for (const auto& r : list) unwrap(table.find(r.surface));
+  if (max_evaluations < 5 || max_evaluations > 10000)
+    raise({ErrorCode::InvalidArgument, "max_evaluations must be between 5 and 10000"});
+  DiagnoseOptions options;
+  for (const auto& e : effects) options.effects.push_back(unwrap(parse_effect(e)));
+  options.orientation_prior_deg = orientation_prior_deg;
+  options.model_accuracy_m = model_accuracy;
+  options.ensemble_replays = ensemble_replays;
+  options.max_evaluations = max_evaluations;
+  options.seed = seed;
+  return run_released(progress, [&](const RunContext& c) { return diagnose(clump, table, list, names, options, c); });
+}
+
+}  // namespace
+
+void bind_diagnose(py::module_& m) {
+  bind_enums(m);
+  bind_parts(m);
+  bind_result(m);
+  m.def("diagnose", &run_diagnosis, py::arg("clump"), py::arg("recordings"),
+        py::arg("effects") = std::vector<std::string>{}, py::arg("materials") = py::none(),
+        py::arg("orientation_prior_deg") = 15.0, py::arg("model_accuracy") = 3e-4, py::arg("ensemble_replays") = 12,
+        py::arg("max_evaluations") = 45, py::arg("seed") = 1, py::arg("progress") = py::none(),
+        "Finds which physics the model leaves out (`clumpforge diagnose`): recordings is {name: Recording} (as "
+        "read_recordings returns), effects the candidates (default: every effect of the library), model_accuracy [m] "
+        "how closely any clump follows the real particle.");
+}
+
+}  // namespace clumpforge::python

@@ -1,0 +1,187 @@
+"""The Python package, imported as a user imports it (PYTHONPATH=build/python), against
+analytic answers and the files the library writes. Run by ctest (label python)."""
+
+import math
+import pathlib
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import clumpforge as cf
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SHARED = ROOT.parent / "shared"
+
+
+def box(a, b, c):
+    """A closed, outward box of sides a, b, c [m], centred at (1, 2, 3) mm."""
+    o = np.array([1e-3, 2e-3, 3e-3])
+    v = np.array([[x, y, z] for x in (-a / 2, a / 2) for y in (-b / 2, b / 2) for z in (-c / 2, c / 2)]) + o
+    # vertex index = 4 ix + 2 iy + iz
+    f = [[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+         [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]
+    return cf.Mesh(v, np.array(f, dtype=np.int32))
+
+
+def test_the_readme_example_works_as_written(tmp_path):
+    mesh = cf.load_mesh(str(ROOT / "meshes/tuber-default.stl"), units="mm")
+    repaired = cf.repair(mesh)
+    props = cf.mass_properties(repaired.mesh, density=1085.0)
+    clump = cf.fill(repaired.mesh, method="lattice", diameter=0.002, density=1085.0)
+    assert clump.centres.shape == (len(clump.radii), 3)
+    # the study's tuber: ~3.7 g, ~19 mm long
+    assert 3.0e-3 < props.mass < 4.5e-3
+    assert repaired.after.closed and repaired.after.self_intersecting_pairs == 0
+    assert clump.name == "lattice-2mm" and np.allclose(clump.radii, 1e-3)
+    assert clump.mass == pytest.approx(props.mass, rel=1e-12)
+    np.testing.assert_allclose(clump.principal_moments, props.principal_moments, rtol=1e-12)
+
+
+def test_mass_properties_of_a_box_are_exact():
+    a, b, c = 0.02, 0.01, 0.006
+    props = cf.mass_properties(box(a, b, c), density=1000.0)
+    m = 1000.0 * a * b * c
+    assert props.volume == pytest.approx(a * b * c, rel=1e-12)
+    assert props.mass == pytest.approx(m, rel=1e-12)
+    np.testing.assert_allclose(props.centroid, [1e-3, 2e-3, 3e-3], atol=1e-15)
+    expected = sorted([m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12])
+    np.testing.assert_allclose(props.principal_moments, expected, rtol=1e-12)
+    assert isinstance(props.principal_axes, np.ndarray) and props.principal_axes.shape == (3, 3)
+
+
+def test_a_lattice_fill_of_a_box_has_the_lattice_count():
+    # a 10 x 10 x 10 mm cube, 2 mm pitch, a node at the centroid: nodes at 0, +-2, +-4 mm
+    clump = cf.fill(box(0.01, 0.01, 0.01), method="lattice", diameter=0.002, density=1000.0)
+    assert len(clump) == 125
+    assert set(np.round(np.abs(clump.centres.ravel()) * 1e3, 9)) == {0.0, 2.0, 4.0}
+    # the union of 125 touching 2 mm spheres is 125 * (4/3 pi r^3) of 1e-6 m^3
+    assert clump.error.volume_error == pytest.approx(125 * 4 / 3 * math.pi * 1e-9 / 1e-6 - 1, abs=1e-3)
+
+
+def test_library_errors_are_python_exceptions_with_the_library_message(tmp_path):
+    with pytest.raises(cf.NotFoundError) as missing:
+        cf.load_mesh(str(tmp_path / "none.stl"))
+    assert "none.stl" in str(missing.value) and missing.value.code == "not found"
+    assert isinstance(missing.value, FileNotFoundError)
+    open_box = box(0.01, 0.01, 0.01)
+    open_box = cf.Mesh(open_box.vertices, open_box.faces[:-1])
+    with pytest.raises(cf.InvalidMeshError, match="repair"):
+        cf.mass_properties(open_box, density=1000.0)
+    with pytest.raises(cf.InvalidArgumentError, match="diameter"):
+        cf.fill(box(0.01, 0.01, 0.01), diameter=-1.0)
+    with pytest.raises(cf.InvalidArgumentError, match="unknown method"):
+        cf.fill(box(0.01, 0.01, 0.01), method="voxel")
+    with pytest.raises(cf.InvalidArgumentError):
+        cf.Mesh(np.zeros((3, 3)), np.array([[0, 1, 7]], dtype=np.int32))
+
+
+def test_a_library_round_trips_and_exports_write_files(tmp_path):
+    clump = cf.fill(box(0.01, 0.008, 0.006), method="adaptive", max_spheres=20, density=1085.0, name="box")
+    path = tmp_path / "lib.h5"
+    cf.write_library(str(path), [clump])
+    back = cf.read_clump(str(path), "box")
+    np.testing.assert_array_equal(back.centres, clump.centres)
+    np.testing.assert_array_equal(back.radii, clump.radii)
+    assert back.mass == clump.mass and back.error.surface_rms == clump.error.surface_rms
+    files = cf.export(clump, "liggghts", str(tmp_path / "box.txt"))
+    text = pathlib.Path(files[0]).read_text()
+    assert f"nspheres {len(clump)}" in text.replace("  ", " ") or str(len(clump)) in text
+    pop = cf.export_population([clump, back_renamed(back)], "yade", str(tmp_path / "pop"), fractions=[3, 1])
+    assert pop["number_fractions"] == pytest.approx([0.75, 0.25])
+    assert (tmp_path / "pop" / "population.py").exists()
+
+
+def back_renamed(clump):
+    return cf.Clump("box2", clump.centres, clump.radii, clump.density, clump.mass, clump.principal_moments,
+                    clump.body_volume)
+
+
+def test_a_drop_rebounds_as_the_cli_says_and_reports_progress():
+    clump = cf.read_clump(str(ROOT / "clumps/tuber-default.h5"), "lattice-2mm")
+    stages = []
+    result = cf.validate(clump, test="drop", surface="Q235", trials=4, seed=7,
+                         progress=lambda stage, fraction: stages.append((stage, fraction)))
+    assert result.summaries.shape == (4,)
+    # a rebound below the release height, above zero; sqrt(h/H) below the table's e = 0.7
+    assert np.all((result.summaries > 0) & (result.summaries < 0.2))
+    assert all(i.apparent_restitution < 0.7 for i in result.impacts)
+    assert stages and all(0.0 <= f <= 1.0 for _, f in stages)
+    again = cf.validate(clump, test="drop", surface="Q235", trials=4, seed=7)
+    np.testing.assert_array_equal(again.summaries, result.summaries)  # seeds in options: the same bits
+
+
+def test_long_calls_release_the_gil_and_a_raising_callback_stops_them():
+    clump = cf.read_clump(str(ROOT / "clumps/tuber-default.h5"), "lattice-2mm")
+    ticks = 0
+    done = threading.Event()
+
+    def run():
+        cf.validate(clump, test="roll", surface="soil", trials=6)
+        done.set()
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    worker.join()
+    assert ticks > 50  # the main thread ran while the DEM did
+
+    class Stop(Exception):
+        pass
+
+    def stop(stage, fraction):
+        if fraction > 0.2:
+            raise Stop()
+
+    started = time.monotonic()
+    with pytest.raises(Stop):
+        cf.validate(clump, test="roll", surface="soil", trials=200, progress=stop)
+    assert time.monotonic() - started < 30
+
+
+def test_recordings_read_and_absurd_ones_are_refused(tmp_path):
+    recordings = cf.read_recordings(str(ROOT / "clumps/tuber-default-diagnosis/recordings"))
+    assert list(recordings) == ["drop-0.2m", "drop-1m", "roll-100mm", "tilt"]
+    drop = recordings["drop-1m"]
+    assert drop.test == cf.LabTest.drop and drop.release_height == pytest.approx(1.0)
+    trial = drop.trials[0]
+    assert trial.has_track and trial.t.shape == trial.x.shape == trial.z.shape
+    assert trial.release_orientation is None  # like a real lab's
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    (bad / "recording.json").write_text('{"format": "recording/1", "test": "drop", "surface": "Q235", '
+                                        '"release_height_m": 1e9, "trials": []}')
+    with pytest.raises(cf.Error, match="recording.json"):
+        cf.read_recording(str(bad))
+
+
+def test_materials_export_names_its_conventions():
+    text = cf.export_materials(cf.default_materials(), "liggghts", conventions="liggghts")
+    assert "coefficientRestitution" in text and "Tsuji" in text
+    assert "lever arm R = the element sphere's radius" in text
+    assert cf.default_materials().interaction("tuber", "Q235").restitution > 0
+
+
+def test_ctrl_c_stops_a_long_call_within_a_second():
+    import os
+    import signal
+
+    clump = cf.read_clump(str(ROOT / "clumps/tuber-default.h5"), "lattice-2mm")
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    started = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        cf.validate(clump, test="roll", surface="soil", trials=400)
+    elapsed = time.monotonic() - started
+    timer.join()
+    assert elapsed < 1.5
+
+
+def test_an_export_whose_companion_would_overwrite_it_is_refused(tmp_path):
+    clump = cf.read_clump(str(ROOT / "clumps/tuber-default.h5"), "lattice-2mm")
+    with pytest.raises(cf.InvalidArgumentError, match="both the primary file and its companion"):
+        cf.export(clump, "yade", str(tmp_path / "c.py"))
+    assert list(tmp_path.iterdir()) == []
