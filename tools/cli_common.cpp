@@ -1,11 +1,17 @@
 #include "cli_common.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <vector>
 
 #include "core/sha256.hpp"
 #include "core/units.hpp"
@@ -138,6 +144,61 @@ void print_progress(std::string_view stage, double fraction) {
   fmt::print(stderr, "\r  [{:>3.0f} %] {:<40}", 100.0 * fraction, stage);
   if (fraction >= 1.0) fmt::print(stderr, "\n");
   std::fflush(stderr);
+}
+
+namespace {
+extern "C" char** environ;
+// Where the Python package lives: installed beside this program (PREFIX/bin/clumpforge ->
+// PREFIX/<python install dir>), else the build tree it was built in.
+std::filesystem::path python_package_root() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = exe.parent_path().parent_path() / CLUMPFORGE_PYTHON_INSTALL_DIR;
+    if (fs::is_regular_file(installed / "clumpforge" / "figures.py", ec)) return installed;
+  }
+  const fs::path built = CLUMPFORGE_PYTHON_BUILD_DIR;
+  if (fs::is_regular_file(built / "clumpforge" / "figures.py", ec)) return built;
+  return {};
+}
+}  // namespace
+
+bool draw_figures(std::string_view command, std::string_view kind, const std::string& directory) {
+  const std::filesystem::path root = python_package_root();
+  if (root.empty()) {
+    report_warning(command, fmt::format("figures not drawn: the clumpforge Python package was not found (the data "
+                                        "are in {}; draw them with python3 -m clumpforge.figures {} {})",
+                                        directory, kind, directory));
+    return false;
+  }
+  const char* old_path = std::getenv("PYTHONPATH");
+  std::string python_path = "PYTHONPATH=" + root.string() + (old_path && *old_path ? std::string(":") + old_path : "");
+  std::vector<std::string> env_strings{python_path, "MPLBACKEND=Agg"};
+  for (char** e = environ; *e; ++e) {
+    const std::string_view entry(*e);
+    if (!entry.starts_with("PYTHONPATH=") && !entry.starts_with("MPLBACKEND=")) env_strings.emplace_back(entry);
+  }
+  std::vector<char*> envp;
+  for (auto& e : env_strings) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  std::string python = CLUMPFORGE_PYTHON, module_flag = "-m", module = "clumpforge.figures", kind_arg(kind),
+              dir_arg = directory;
+  std::vector<char*> argv{python.data(), module_flag.data(), module.data(), kind_arg.data(), dir_arg.data(), nullptr};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, python.c_str(), &actions, nullptr, argv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  int status = 0;
+  if (spawned != 0 || waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    report_warning(command, fmt::format("figures not drawn ({} -m clumpforge.figures {} {} failed; is "
+                                        "python3-matplotlib installed?); the data are in {}",
+                                        python, kind, directory, directory));
+    return false;
+  }
+  return true;
 }
 
 }  // namespace clumpforge::cli

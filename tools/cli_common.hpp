@@ -58,4 +58,10 @@ RunContext progress_context(bool json);
 void print_progress(std::string_view stage, double fraction);
 bool stderr_is_terminal();
 
+/// Draws a result folder's figures (PNG and SVG) with the Python package's matplotlib module
+/// (`python3 -m clumpforge.figures KIND DIR`, docs/figures.md): the package next to this
+/// program (build tree or installation). When Python, matplotlib or the package is missing,
+/// or drawing fails, says so on stderr and returns false; the folder's data stay as written.
+bool draw_figures(std::string_view command, std::string_view kind, const std::string& directory);
+
 }  // namespace clumpforge::cli

@@ -17,7 +17,6 @@
 #include "io/materials_export.hpp"
 #include "io/materials_io.hpp"
 #include "io/recording_io.hpp"
-#include "io/svg_plot.hpp"
 
 namespace clumpforge::cli {
 namespace {
@@ -132,63 +131,6 @@ std::string markdown(const PaperCalibration& c) {
   return text;
 }
 
-std::string response_plot(const ParameterCalibration& p) {
-  Plot plot{fmt::format("{} on {}: {} test", p.parameter, p.surface, to_string(p.test)),
-            p.parameter,
-            fmt::format("mean response [{}]", unit_of(p.test)),
-            false,
-            false,
-            {},
-            {{p.measured_mean, "measured"}}};
-  PlotSeries levels{"level means (10 trials)", {}, {}, "#1f77b4", false, true};
-  for (const auto& l : p.levels) {
-    levels.x.push_back(l.value);
-    levels.y.push_back(l.mean);
-  }
-  PlotSeries fit{"quadratic fit", {}, {}, "#d62728", true, false};
-  const double low = p.levels.front().value, high = p.levels.back().value;
-  for (int i = 0; i <= 60; ++i) {
-    const double x = low + (high - low) * i / 60.0;
-    fit.x.push_back(x);
-    fit.y.push_back(p.fit(x));
-  }
-  PlotSeries chosen{"calibrated", {p.calibrated}, {p.measured_mean}, "#2ca02c", false, true};
-  plot.series = {levels, fit, chosen};
-  return render_svg(plot);
-}
-
-// Histogram (as joined bin counts) of the simulated responses at the calibrated values and
-// of the lab's trials: the spread that orientation makes.
-std::string distribution_plot(const ParameterCalibration& p) {
-  std::vector<double> all = p.verification_responses;
-  all.insert(all.end(), p.measured.begin(), p.measured.end());
-  const double low = *std::min_element(all.begin(), all.end()), high = *std::max_element(all.begin(), all.end());
-  const int bins = 8;
-  const double width = std::max((high - low) / bins, 1e-9);
-  auto histogram = [&](const std::vector<double>& values, const std::string& name, const std::string& colour) {
-    PlotSeries series{name, {}, {}, colour, true, true};
-    for (int b = 0; b < bins; ++b) {
-      const double from = low + b * width;
-      series.x.push_back(from + 0.5 * width);
-      series.y.push_back(static_cast<double>(std::count_if(values.begin(), values.end(), [&](double v) {
-        return v >= from && (v < from + width || (b == bins - 1 && v <= high));
-      })));
-    }
-    return series;
-  };
-  Plot plot{fmt::format("{} test on {}: trials by outcome", to_string(p.test), p.surface),
-            fmt::format("outcome [{}]", unit_of(p.test)),
-            "trials",
-            false,
-            false,
-            {},
-            {}};
-  plot.series = {histogram(p.verification_responses, fmt::format("simulated at {} = {:.3g}", p.parameter, p.calibrated),
-                           "#1f77b4"),
-                 histogram(p.measured, "measured", "#d62728")};
-  return render_svg(plot);
-}
-
 std::string joint_markdown(const std::vector<JointSurfaceResult>& results) {
   std::string text =
       "| surface | e [95 %] | mu_s [95 %] | mu_r [95 %] | chi^2 | DEM runs |\n| --- | --- | --- | --- | ---: | ---: "
@@ -264,6 +206,7 @@ int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<R
     files->emplace_back(fs::path(args.out) / "calibration.json", report.dump(2) + "\n");
     files->emplace_back(fs::path(args.out) / "calibration.md", "# Joint calibration (" + clump.name + ")\n\n" + text);
     if (auto ok = write_files_atomically(*files); !ok) return report_error(kCommand, ok.error());
+    draw_figures(kCommand, "calibration", args.out);
   }
   if (args.json)
     std::cout << report.dump(2) << "\n";
@@ -341,26 +284,8 @@ int run_calibrate(const CalibrateArgs& args) {
         {{fs::path(args.out) / "calibration.json", report.dump(2) + "\n"},
          {fs::path(args.out) / "calibration.md",
           fmt::format("# Calibration by the study's method ({})\n\n{}\n", clump->name, markdown(*calibration))}});
-    Plot overview{"Measured against calibrated (verification runs)",
-                  "measured mean",
-                  "simulated mean at the calibrated values",
-                  false,
-                  false,
-                  {},
-                  {}};
-    PlotSeries points{"tests (mm, or deg for tilt)", {}, {}, "#1f77b4", false, true};
-    double top = 0.0;
-    for (const auto& p : calibration->steps) {
-      files.emplace_back(fs::path(args.out) / fmt::format("sweep-{}-{}.svg", p.parameter, p.surface), response_plot(p));
-      files.emplace_back(fs::path(args.out) / fmt::format("distribution-{}-{}.svg", to_string(p.test), p.surface),
-                         distribution_plot(p));
-      points.x.push_back(p.measured_mean);
-      points.y.push_back(p.verification_mean);
-      top = std::max({top, p.measured_mean, p.verification_mean});
-    }
-    overview.series = {points, {"equal", {0.0, 1.1 * top}, {0.0, 1.1 * top}, "#999999", true, false}};
-    files.emplace_back(fs::path(args.out) / "measured-vs-calibrated.svg", render_svg(overview));
     if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
+    draw_figures(kCommand, "calibration", args.out);
   }
   if (args.json) {
     std::cout << report.dump(2) << "\n";

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <ranges>
@@ -15,7 +16,6 @@
 #include "io/clump_library.hpp"
 #include "io/materials_io.hpp"
 #include "io/recording_io.hpp"
-#include "io/svg_plot.hpp"
 
 namespace fs = std::filesystem;
 
@@ -201,47 +201,23 @@ nlohmann::json report_json(const DiagnoseResult& r, const std::string& clump_nam
   return j;
 }
 
-std::vector<std::pair<fs::path, std::string>> plots(const DiagnoseResult& r, const fs::path& dir) {
-  std::vector<std::pair<fs::path, std::string>> files;
+// What the figures need beside report.json: each recording's first trial against both models.
+std::string tracks_json(const DiagnoseResult& r) {
+  nlohmann::json out = nlohmann::json::array();
   for (const auto& t : r.tracks) {
-    for (int axis = 0; axis < 2; ++axis) {
-      Plot plot;
-      plot.title = fmt::format("{}: recorded vs baseline vs improved ({}; fitted up to {:.3f} s)", t.recording,
-                               verdict_name(r), std::min(t.horizon, 99.0));
-      plot.x_label = "time since release [s]";
-      plot.y_label = axis == 0 ? "height z [mm]" : "horizontal x [mm]";
-      auto mm = [](const std::vector<double>& v) {
-        std::vector<double> out;
-        for (double x : v) out.push_back(1000.0 * x);
-        return out;
-      };
-      const auto& rec_y = axis == 0 ? t.z : t.x;
-      PlotSeries recorded{"recorded", t.t, mm(rec_y), "#444444", false, true};
-      PlotSeries baseline{"baseline", t.baseline_t, mm(axis == 0 ? t.baseline_z : t.baseline_x),
-                          "#d62728",  true,         false};
-      PlotSeries improved{"improved", t.improved_t, mm(axis == 0 ? t.improved_z : t.improved_x),
-                          "#2ca02c",  true,         false};
-      plot.series = {recorded, baseline, improved};
-      files.emplace_back(dir / fmt::format("track-{}-{}.svg", t.recording, axis == 0 ? "z" : "x"), render_svg(plot));
-    }
+    out.push_back({{"recording", t.recording},
+                   {"t", t.t},
+                   {"x", t.x},
+                   {"z", t.z},
+                   {"baseline_t", t.baseline_t},
+                   {"baseline_x", t.baseline_x},
+                   {"baseline_z", t.baseline_z},
+                   {"improved_t", t.improved_t},
+                   {"improved_x", t.improved_x},
+                   {"improved_z", t.improved_z},
+                   {"horizon", std::isfinite(t.horizon) ? nlohmann::json(t.horizon) : nlohmann::json()}});
   }
-  // Residuals by phase: chi^2 per value, baseline and improved, one point per (recording, phase).
-  Plot plot;
-  plot.title = "residuals by phase: chi^2 per value (1 = noise level)";
-  plot.x_label = "phase index (see report.json phases[])";
-  plot.y_label = "chi^2 per value";
-  plot.log_y = true;
-  PlotSeries before{"baseline", {}, {}, "#d62728", false, true}, after{"improved", {}, {}, "#2ca02c", false, true};
-  for (std::size_t k = 0; k < r.phases.size(); ++k) {
-    before.x.push_back(static_cast<double>(k));
-    before.y.push_back(r.phases[k].chi2_per_value);
-    after.x.push_back(static_cast<double>(k));
-    after.y.push_back(r.phases[k].improved_chi2_per_value);
-  }
-  plot.series = {before, after};
-  plot.reference_lines = {{1.0, "noise"}};
-  files.emplace_back(dir / "residuals-by-phase.svg", render_svg(plot));
-  return files;
+  return out.dump() + "\n";
 }
 
 void print_text(const DiagnoseResult& r) {
@@ -374,9 +350,11 @@ int run_diagnose(const DiagnoseArgs& args) {
     fs::create_directories(args.out, ec);
     if (ec || !fs::is_directory(args.out))
       return report_error(kCommand, {ErrorCode::IoError, fmt::format("cannot create '{}'", args.out)});
-    auto files = plots(*result, args.out);
-    files.emplace_back(fs::path(args.out) / "report.json", report.dump(2) + "\n");
+    const std::vector<std::pair<fs::path, std::string>> files{
+        {fs::path(args.out) / "report.json", report.dump(2) + "\n"},
+        {fs::path(args.out) / "tracks.json", tracks_json(*result)}};
     if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
+    draw_figures(kCommand, "diagnosis", args.out);
   }
   if (args.json)
     std::cout << report.dump(2) << "\n";

@@ -11,7 +11,6 @@
 #include "core/atomic_file.hpp"
 #include "fill/study.hpp"
 #include "fill_report.hpp"
-#include "io/svg_plot.hpp"
 
 namespace clumpforge::cli {
 namespace {
@@ -66,20 +65,6 @@ std::string markdown_table(const std::vector<StudyRow>& rows) {
   return text;
 }
 
-Plot error_plot(const std::vector<StudyRow>& rows, const std::string& title, const std::string& y_label,
-                double (*metric)(const StudyRow&)) {
-  Plot plot{title, "spheres in the clump", y_label, true, true, {}, {}};
-  PlotSeries lattice{"lattice 1/2/4 mm", {}, {}, "#d62728", true, true};
-  PlotSeries adaptive{"adaptive", {}, {}, "#1f77b4", true, true};
-  for (const auto& r : rows) {
-    auto& s = r.method == FillMethod::Lattice ? lattice : adaptive;
-    s.x.push_back(r.error.sphere_count);
-    s.y.push_back(metric(r));
-  }
-  plot.series = {lattice, adaptive};
-  return plot;
-}
-
 // The fewest adaptive spheres whose worst mass-matched moment error is at most the finest
 // lattice's (the first lattice row).
 std::string headline(const std::vector<StudyRow>& rows) {
@@ -126,16 +111,6 @@ int run_study(const StudyArgs& args) {
   if (!rows) return report_error(kCommand, rows.error());
 
   const fs::path dir(args.output);
-  const std::vector<std::pair<std::string, Plot>> plots{
-      {"study-mass.svg", error_plot(*rows, "Mass error at the body's density", "|mass error|",
-                                    [](const StudyRow& r) { return std::abs(r.error.mass_error); })},
-      {"study-inertia.svg",
-       error_plot(*rows, "Worst principal-moment error, mass-matched", "|relative error|",
-                  [](const StudyRow& r) { return worst(r.error.principal_moment_errors_mass_matched); })},
-      {"study-surface.svg", error_plot(*rows, "Surface deviation (RMS)", "RMS distance [m]",
-                                       [](const StudyRow& r) { return r.error.surface_rms; })},
-      {"study-time.svg",
-       error_plot(*rows, "Fill and error-report time", "seconds", [](const StudyRow& r) { return r.fill_seconds; })}};
   const std::string summary = headline(*rows);
   std::vector<std::pair<fs::path, std::string>> files{
       {dir / "study.csv", csv_table(*rows)},
@@ -143,27 +118,31 @@ int run_study(const StudyArgs& args) {
        fmt::format("# Resolution study of {}\n\nSigned-distance voxel {:.3g} mm; density {} kg/m^3 ({}).\n\n{}\n{}.\n",
                    args.input, loaded->body.sdf.voxel_size() * 1e3, args.density, density_source(args.density_given),
                    markdown_table(*rows), summary)}};
-  for (const auto& [name, plot] : plots) files.emplace_back(dir / name, render_svg(plot));
+  nlohmann::json report{{"input", args.input},
+                        {"output", args.output},
+                        {"density_kg_m3", args.density},
+                        {"density_source", density_source(args.density_given)},
+                        {"summary", summary},
+                        {"rows", nlohmann::json::array()}};
+  for (const auto& r : *rows) {
+    nlohmann::json row = error_to_json(r.error);
+    row["name"] = r.name;
+    row["method"] = std::string(to_string(r.method));
+    row["spheres"] = r.error.sphere_count;
+    row["worst_moment_error_mass_matched"] = worst(r.error.principal_moment_errors_mass_matched);
+    row["fill_seconds"] = r.fill_seconds;
+    report["rows"].push_back(row);
+  }
+  files.emplace_back(dir / "study.json", report.dump(2) + "\n");
   if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
+  const bool drawn = draw_figures(kCommand, "study", args.output);
 
   if (args.json) {
-    nlohmann::json report{{"input", args.input},
-                          {"output", args.output},
-                          {"density_kg_m3", args.density},
-                          {"density_source", density_source(args.density_given)},
-                          {"summary", summary},
-                          {"rows", nlohmann::json::array()}};
-    for (const auto& r : *rows) {
-      nlohmann::json row = error_to_json(r.error);
-      row["name"] = r.name;
-      row["fill_seconds"] = r.fill_seconds;
-      report["rows"].push_back(row);
-    }
     std::cout << report.dump(2) << "\n";
   } else {
     fmt::print("resolution study of {} -> {}/ (density {:g} kg/m^3, {})\n\n{}\n{}.\n", args.input, args.output,
                args.density, density_source(args.density_given), markdown_table(*rows), summary);
-    fmt::print("wrote study.csv, study.md, study-mass.svg, study-inertia.svg, study-surface.svg, study-time.svg\n");
+    fmt::print("wrote study.csv, study.md, study.json{}\n", drawn ? " and the figure study.png / study.svg" : "");
   }
   return kExitOk;
 }

@@ -1,7 +1,6 @@
 #pragma once
-#include <functional>
-
 #include <CLI/CLI.hpp>
+#include <functional>
 
 namespace clumpforge::cli {
 

@@ -1408,10 +1408,19 @@ void track_plots(const Context& c, DiagnoseResult& result, const std::vector<Tri
         }
       };
       sampled(full_base[k].replay, cmp.baseline_t, cmp.baseline_x, cmp.baseline_z);
-      sampled(full_improved[k].replay, cmp.improved_t, cmp.improved_x, cmp.improved_z);
-      // The improved model's own x origin differs slightly: shift its curve onto the recording's frame.
-      const double dx = full_improved[k].alignment.x_offset - a.x_offset,
-                   dz = full_improved[k].alignment.z_offset - a.z_offset;
+      // The improved model has its own fitted release time and frame origins: map its replay
+      // into the frame the recording is drawn in (the baseline's), where recorded time t maps
+      // to replay time t - shift.
+      const Alignment& ai = full_improved[k].alignment;
+      const double dt = ai.shift - a.shift, dx = ai.x_offset - a.x_offset, dz = ai.z_offset - a.z_offset;
+      const double improved_start = cmp.t.front() - dt, improved_end = end - dt;
+      for (std::size_t s = 0; s < full_improved[k].replay.size(); s += 10) {
+        const ReplaySample& sample = full_improved[k].replay[s];
+        if (sample.t < improved_start || sample.t > improved_end) continue;
+        cmp.improved_t.push_back(sample.t + dt);
+        cmp.improved_x.push_back(sample.x);
+        cmp.improved_z.push_back(sample.z);
+      }
       for (double& x : cmp.improved_x) x += dx;
       for (double& z : cmp.improved_z) z += dz;
       result.tracks.push_back(std::move(cmp));

@@ -110,11 +110,12 @@ TEST(StudyCli, WritesTablesAndPlots) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   ASSERT_EQ(j["rows"].size(), 5u);  // lattice 1, 2, 4 mm and two budgets
-  for (const char* file :
-       {"study.csv", "study.md", "study-mass.svg", "study-inertia.svg", "study-surface.svg", "study-time.svg"}) {
+  for (const char* file : {"study.csv", "study.md", "study.json", "study.png", "study.svg"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / file)) << file;
   }
-  EXPECT_NE(test::read_text(dir / "out" / "study-inertia.svg").find("<svg"), std::string::npos);
+  EXPECT_NE(test::read_text(dir / "out" / "study.svg").find("<svg"), std::string::npos);
+  EXPECT_EQ(test::read_text(dir / "out" / "study.png").substr(1, 3), "PNG");
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(dir / "out" / "study.json"))["rows"].size(), 5u);
   const std::string csv = test::read_text(dir / "out" / "study.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 6);
   EXPECT_EQ(test::run_clumpforge(fmt::format("study '{}' -o '{}' --budgets 0", body, (dir / "bad").string())).exit_code,

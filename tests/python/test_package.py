@@ -185,3 +185,34 @@ def test_an_export_whose_companion_would_overwrite_it_is_refused(tmp_path):
     with pytest.raises(cf.InvalidArgumentError, match="both the primary file and its companion"):
         cf.export(clump, "yade", str(tmp_path / "c.py"))
     assert list(tmp_path.iterdir()) == []
+
+
+def test_figures_draw_a_diagnosis_folder_with_lost_frames(tmp_path):
+    """The figures module on a folder like diagnose writes: a lost frame (null) and a release
+    horizon; PNG and SVG come out whole, nothing temporary stays, and a bad folder is refused."""
+    import json
+    import subprocess
+    import sys
+
+    from clumpforge import figures
+
+    t = np.linspace(0.0, 0.45, 200)
+    z = 1.0 - 0.5 * 9.81 * t**2
+    recorded = list(z + 1e-4 * np.sin(40 * t))
+    recorded[17] = None
+    track = {"recording": "drop-1m", "t": list(t), "x": [0.0] * t.size, "z": recorded, "horizon": 0.3,
+             "baseline_t": list(t), "baseline_x": [0.0] * t.size, "baseline_z": list(z + 1e-3 * t),
+             "improved_t": list(t), "improved_x": [0.0] * t.size, "improved_z": list(z)}
+    report = {"verdict": "air_drag", "noise_m": {"drop-1m": 1e-4},
+              "phases": [{"recording": "drop-1m", "phase": "flight", "chi2_per_value": 4.0,
+                          "improved_chi2_per_value": 1.1, "significant": True}]}
+    (tmp_path / "report.json").write_text(json.dumps(report))
+    (tmp_path / "tracks.json").write_text(json.dumps([track]))
+    written = figures.draw("diagnosis", tmp_path)
+    names = sorted(pathlib.Path(p).name for p in written)
+    assert names == ["residuals-by-phase.png", "residuals-by-phase.svg", "track-drop-1m.png", "track-drop-1m.svg"]
+    assert (tmp_path / "track-drop-1m.png").read_bytes()[1:4] == b"PNG"
+    assert not list(tmp_path.glob("*.tmp.*"))
+    bad = subprocess.run([sys.executable, "-m", "clumpforge.figures", "study", str(tmp_path)], capture_output=True,
+                         text=True)
+    assert bad.returncode == 1 and "study.json" in bad.stderr
