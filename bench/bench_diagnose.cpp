@@ -5,7 +5,7 @@
 // the detection rate per effect, the false-positive rate on the controls and the median
 // held-out improvement; writes summary.json and summary.md into --out. Resumable: a case
 // whose report.json exists is not run again.
-//   bench_diagnose --clump clumps/tuber-default-diagnosis.h5 --cli build/tools/clumpforge --out bench-out/diagnose
+//   bench_diagnose --library clumps/tuber-default-diagnosis.h5 --cli build/tools/clumpforge -o bench-out/diagnose
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -175,10 +175,10 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   std::vector<std::string> only;
   bool full_set = false, existing_only = false;
-  app.add_option("--clump", clump_file, "Clump library the recordings are made with and diagnosed against");
-  app.add_option("--clump-name", clump_name, "Which clump of the library");
+  app.add_option("--library", clump_file, "Clump library the recordings are made with and diagnosed against");
+  app.add_option("--clump", clump_name, "Which clump of the library (a name)");
   app.add_option("--cli", cli, "The clumpforge executable");
-  app.add_option("--out", out, "Working directory (recordings, answers, reports, summary)");
+  app.add_option("-o,--output,--out", out, "Working directory (recordings, answers, reports, summary)");
   app.add_option("--controls", controls, "Effect-free controls");
   app.add_option("--trials", trials, "Trials per recording");
   app.add_option("--seed", seed, "Seed of the whole benchmark");
@@ -195,10 +195,10 @@ int main(int argc, char** argv) {
   app.add_option("--fps", fps, "Camera frame rate of the generated tracks [Hz] (labs: 1000, 240)");
   app.add_option("--noise", noise, "Camera noise of the generated tracks [m] (1e-4 at 1000 fps, 5e-4 at 240 fps)");
   app.add_flag("--no-pre-roll", no_pre_roll, "Generated tracks begin after the release");
-  app.add_option("--generator-clump", generator_file,
-                 "Clump library the recordings are made with (default: --clump's file); a finer clump of the same mesh "
+  app.add_option("--generator-library", generator_file,
+                 "Clump library the recordings are made with (default: --library); a finer clump of the same mesh "
                  "than the diagnosed one");
-  app.add_option("--generator-clump-name", generator_name, "Which clump of the generator's library");
+  app.add_option("--generator-clump", generator_name, "Which clump of the generator's library (a name)");
   app.add_option("--recordings-set", recordings_set,
                  "Score a recording set made elsewhere (case-NN/ folders and ANSWERS.json, e.g. "
                  "../shared/data/lab-like) instead of generating one");
@@ -324,8 +324,8 @@ int main(int argc, char** argv) {
       std::ofstream(dir / "answer.json") << answer_json(c.options, *made);
       // Blind: the diagnosis sees the recordings directory and the clump, nothing else.
       const std::string command = fmt::format(
-          "'{}' diagnose --recordings '{}' --clump '{}' {} --json > '{}.tmp' 2> '{}'", cli,
-          (dir / "recordings").string(), clump_file, clump_name.empty() ? "" : "--clump-name '" + clump_name + "'",
+          "'{}' diagnose --recordings '{}' --library '{}' {} --json > '{}.tmp' 2> '{}'", cli,
+          (dir / "recordings").string(), clump_file, clump_name.empty() ? "" : "--clump '" + clump_name + "'",
           report.string(), (dir / "stderr.txt").string());
       if (std::system(command.c_str()) != 0) {
         std::cerr << c.id << ": diagnose failed, see " << (dir / "stderr.txt").string() << "\n";

@@ -41,7 +41,7 @@ echo
 echo "== 6. diagnosis of a bundled recording set with a concealed effect (clumps/tuber-default-diagnosis/recordings:"
 echo "      drops from 0.2 and 1 m, a roll from 100 mm, a tilt; 4 tracked trials each, made by clumpforge-conceal"
 echo "      from a 340-sphere clump of the scan, no release orientation recorded)"
-$cf diagnose --recordings clumps/tuber-default-diagnosis/recordings --clump clumps/tuber-default-diagnosis.h5 --output "$out/diagnosis"
+$cf diagnose --recordings clumps/tuber-default-diagnosis/recordings --library clumps/tuber-default-diagnosis.h5 --output "$out/diagnosis"
 echo
 echo "   the generator's answer (read only now, after the diagnosis): $(python3 -c 'import json; a=json.load(open("clumps/tuber-default-diagnosis/answer.json")); print(a["effect"], a["effect_parameters"])')"
 echo

@@ -120,6 +120,26 @@ CLI::Option* add_output_option(CLI::App& app, std::string& target, const std::st
   return output;
 }
 
+CLI::Option* add_library_option(CLI::App& app, std::string& library, const std::string& description) {
+  return app.add_option("--library", library, description)->type_name("FILE");
+}
+
+CLI::Option* add_clump_option(CLI::App& app, std::string& clump, const std::string& description) {
+  const CLI::Validator a_name(
+      [](std::string& value) -> std::string {
+        const std::filesystem::path path(value);
+        const std::string ext = path.extension().string();
+        if (ext == ".h5" || ext == ".hdf5" || value.find('/') != std::string::npos)
+          return "--clump takes a clump's name (e.g. lattice-2mm); the library file '" + value +
+                 "' goes to --library (the first argument in validate and export)";
+        return {};
+      },
+      "", "clump name");
+  CLI::Option* option = app.add_option("--clump", clump, description)->type_name("NAME")->check(a_name);
+  app.add_option("--clump-name", clump, "same as --clump")->group("")->check(a_name);  // older scripts
+  return option;
+}
+
 std::string density_source(bool given) {
   return given ? "given" : "not given: the study's Corydalis tuber density (--density to set)";
 }

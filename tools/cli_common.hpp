@@ -45,6 +45,13 @@ Result<LoadedBody> load_closed_body(const std::string& path, const std::string& 
 /// is still read, hidden from the help).
 CLI::Option* add_output_option(CLI::App& app, std::string& target, const std::string& description);
 
+/// A clump library and a clump in it, spelled the same in every command: the file is
+/// `--library FILE` (a positional argument in `validate` and `export`), a clump's name is
+/// `--clump NAME`; a file given to `--clump` is refused with a message that says where it
+/// goes. The older `--clump-name` is still read, hidden from the help.
+CLI::Option* add_library_option(CLI::App& app, std::string& library, const std::string& description);
+CLI::Option* add_clump_option(CLI::App& app, std::string& clump, const std::string& description);
+
 /// The study's Corydalis tuber density, used when a command is given none [kg/m^3].
 inline constexpr double kStudyDensity = 1085.0;
 /// How a density came to be used, for the output and the report: "given" or the default said

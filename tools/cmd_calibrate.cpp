@@ -1,4 +1,4 @@
-// clumpforge calibrate --recordings DIR... --clump CLUMP.h5 [--clump-name NAME] [--method paper]
+// clumpforge calibrate --recordings DIR... --library CLUMP.h5 [--clump NAME] [--method paper]
 //                      [--trials-per-level N] [--seed S] [--output DIR] [--json]
 #include <fmt/format.h>
 
@@ -305,8 +305,8 @@ Command add_calibrate_command(CLI::App& app) {
       app.add_subcommand("calibrate", "Calibrate e, mu_s and mu_r against recordings by the study's method");
   sub->add_option("--recordings", args->recordings, "Recording directories (drop, tilt, roll on each surface)")
       ->required();
-  sub->add_option("--clump", args->clump_file, "Clump library (.h5)")->required();
-  sub->add_option("--clump-name", args->clump_name, "Which clump of the file (needed when it holds several)");
+  add_library_option(*sub, args->clump_file, "Clump library (.h5)")->required();
+  add_clump_option(*sub, args->clump_name, "Which clump of the library (needed when it holds several)");
   sub->add_option("--method", args->method,
                   "paper: the study's one-at-a-time sweep, fit and inversion; joint: all three together with bootstrap "
                   "intervals")
@@ -329,7 +329,7 @@ Command add_calibrate_command(CLI::App& app) {
   sub->add_flag("--json", args->json, "Print the report as JSON");
   sub->footer(
       "Example:\n  clumpforge calibrate --recordings ../shared/data/paper/drop-Q235 ../shared/data/paper/tilt-Q235 "
-      "\\\n      ../shared/data/paper/roll-Q235 --clump clumps/tuber-default.h5 --clump-name lattice-2mm --method "
+      "\\\n      ../shared/data/paper/roll-Q235 --library clumps/tuber-default.h5 --clump lattice-2mm --method "
       "joint --output cal/");
   return {sub, [args] { return run_calibrate(*args); }};
 }

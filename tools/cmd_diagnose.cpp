@@ -1,4 +1,4 @@
-// clumpforge diagnose --recordings DIR... (--mesh MESH | --clump CLUMP.h5) [--output DIR] [--json]
+// clumpforge diagnose --recordings DIR... (--mesh MESH | --library CLUMP.h5 [--clump NAME]) [--output DIR] [--json]
 // Where the DEM and the recordings disagree, which physics is missing, and the fit once it is added.
 #include <fmt/format.h>
 
@@ -272,7 +272,7 @@ void print_text(const DiagnoseResult& r) {
 int run_diagnose(const DiagnoseArgs& args) {
   constexpr std::string_view kCommand = "diagnose";
   if (args.mesh.empty() == args.clump.empty())
-    return report_error(kCommand, {ErrorCode::InvalidArgument, "give exactly one of --mesh and --clump"});
+    return report_error(kCommand, {ErrorCode::InvalidArgument, "give exactly one of --mesh and --library"});
   if (args.spheres != 0 && (args.spheres < 1 || args.spheres > 5000)) {
     return report_error(
         kCommand, {ErrorCode::InvalidArgument, "--spheres must be 0 (chosen by convergence) or between 1 and 5000"});
@@ -373,8 +373,8 @@ Command add_diagnose_command(CLI::App& app) {
       ->required()
       ->expected(1, -1);
   sub->add_option("--mesh", args->mesh, "The particle's closed mesh (filled adaptively with --spheres spheres)");
-  sub->add_option("--clump", args->clump, "The particle as a clump library (.h5)");
-  sub->add_option("--clump-name", args->clump_name, "Which clump of the library (needed when it holds several)");
+  add_library_option(*sub, args->clump, "The particle as a clump library (.h5)");
+  add_clump_option(*sub, args->clump_name, "Which clump of the library (needed when it holds several)");
   sub->add_option("--spheres", args->spheres,
                   "With --mesh: spheres of the adaptive clump; 0 (default) chooses them by convergence to the scan "
                   "(surface RMS within a third of --model-accuracy)");
@@ -398,10 +398,10 @@ Command add_diagnose_command(CLI::App& app) {
                   "beyond the release horizon (0: skip)");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
-  add_output_option(*sub, args->out, "Directory for report.json and the SVG plots");
+  add_output_option(*sub, args->out, "Directory for report.json, tracks.json and the figures (PNG, SVG)");
   sub->add_flag("--json", args->json, "Print the report as JSON");
   sub->footer(
-      "Example:\n  clumpforge diagnose --recordings clumps/tuber-default-diagnosis/recordings/* \\\n      --clump "
+      "Example:\n  clumpforge diagnose --recordings clumps/tuber-default-diagnosis/recordings/* \\\n      --library "
       "clumps/tuber-default-diagnosis.h5 --output diagnosis/");
   return {sub, [args] { return run_diagnose(*args); }};
 }

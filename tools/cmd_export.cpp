@@ -157,8 +157,8 @@ Command add_export_command(CLI::App& app) {
   sub->add_option("--format", args->format, "liggghts, yade, edem, pfc, mercurydpm, chrono, vtk or csv")->required();
   add_output_option(*sub, args->output, "Primary output file (a directory for mercurydpm and for a population)")
       ->required();
-  sub->add_option("--clump", args->clump,
-                  "Which clump of each library named without ':CLUMP' (needed when it holds several)");
+  add_clump_option(*sub, args->clump,
+                   "Which clump of each library named without ':CLUMP' (needed when it holds several)");
   sub->add_flag("--all", args->all, "Every clump of each library named without ':CLUMP'");
   sub->add_option("--fractions", args->fractions,
                   "Population: one fraction per clump, comma-separated (default: equal)");

@@ -76,10 +76,10 @@ Command add_materials_command(CLI::App& app) {
                   "Write in an engine's syntax: liggghts, yade or edem (default: the JSON materials file)");
   sub->add_option("--particle", args->particle, "The particles' material (LIGGGHTS atom type 1)")
       ->capture_default_str();
-  sub->add_option(
-      "--clump", args->clump_file,
+  add_library_option(
+      *sub, args->clump_file,
       "Clump library (.h5): LIGGGHTS' rolling friction scaled by the clump's lever ratio (docs/exports/materials.md)");
-  sub->add_option("--clump-name", args->clump_name, "Which clump of the file (needed when it holds several)");
+  add_clump_option(*sub, args->clump_name, "Which clump of the library (needed when it holds several)");
   add_output_option(*sub, args->output, "File to write (default: standard output)");
   sub->footer(
       "Example:\n  clumpforge materials --calibration out/calibration.json --export liggghts -o materials.liggghts");

@@ -181,7 +181,7 @@ Command add_validate_command(CLI::App& app) {
   CLI::App* sub =
       app.add_subcommand("validate", "Run the study's drop, tilt or roll test on a clump in the built-in DEM");
   sub->add_option("clump_file", args->input, "Clump library (.h5)")->required();
-  sub->add_option("--clump", args->clump, "Which clump of the file (needed when it holds several)");
+  add_clump_option(*sub, args->clump, "Which clump of the library (needed when it holds several)");
   sub->add_option("--test", args->test, "drop, tilt or roll")->required();
   sub->add_option("--surface", args->surface, "Plate material: Q235 or soil")->required();
   sub->add_option("--trials", args->trials, "Trials (random orientations)")->capture_default_str();

@@ -7,9 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "clumpforge/core.hpp"  // LabTest
+
 namespace clumpforge {
 
-enum class LabTest { Drop, Roll, Tilt };
 enum class Composite { Single, FourSquare };
 
 std::string_view to_string(LabTest test);

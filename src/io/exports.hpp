@@ -6,17 +6,13 @@
 #include <string_view>
 #include <vector>
 
+#include "clumpforge/io.hpp"
 #include "core/clump.hpp"
 #include "core/error.hpp"
 
 namespace clumpforge {
 
-enum class ExportFormat { Liggghts, Yade, Edem, Pfc, MercuryDpm, Chrono, Vtk, Csv };
-
-/// "liggghts", "yade", "edem", "pfc", "mercurydpm", "chrono", "vtk", "csv"; a near miss
-/// gets a "did you mean".
-Result<ExportFormat> parse_export_format(std::string_view name);
-std::string_view to_string(ExportFormat format);
+// ExportFormat, parse_export_format and to_string(ExportFormat): <clumpforge/io.hpp>.
 
 /// Which MercuryDPM clump layout to write: the one today's MercuryDPM reads
 /// (`Drivers/Clump/ClumpHeaders/ClumpInput.h`: `<Name>/Clump/Clump.txt`, `<Name>/Inertia/Mass.txt`,

@@ -116,7 +116,7 @@ std::string liggghts(const Resolved& r, const MaterialsExportOptions& o) {
                                               lever, o.clump)
                                         : "# coefficientRollingFriction: the calibrated mu_r unchanged, although "
                                           "LIGGGHTS' cdt lever is shorter (see above);\n"
-                                          "# export with the clump (--clump) to scale them by its lever ratio.\n";
+                                          "# export with the clump (--library) to scale them by its lever ratio.\n";
   }
   text += per_pair("coefficientRollingFriction", [lever](const Interaction& i) { return i.rolling_friction * lever; });
   for (std::size_t i = 1; i < n; ++i) {

@@ -133,6 +133,46 @@ TEST(Cli, EveryCommandsHelpEndsWithAnExample) {
   }
 }
 
+// One meaning per option name: --clump is always a clump's NAME, --library always a FILE;
+// a library file given to --clump is refused with a message that says where it goes.
+TEST(Cli, ClumpIsANameAndLibraryAFileInEveryCommand) {
+  for (const char* command : {"export", "validate", "calibrate", "materials", "diagnose"}) {
+    const auto help = test::run_clumpforge(fmt::format("{} --help", command));
+    ASSERT_EQ(help.exit_code, 0) << command;
+    EXPECT_NE(help.out.find("--clump NAME"), std::string::npos) << command << ":\n" << help.out;
+    EXPECT_EQ(help.out.find("--clump-name"), std::string::npos) << command;
+    EXPECT_EQ(help.out.find("--clump TEXT"), std::string::npos) << command;
+  }
+  for (const char* command : {"calibrate", "materials", "diagnose"}) {
+    const auto help = test::run_clumpforge(fmt::format("{} --help", command));
+    EXPECT_NE(help.out.find("--library FILE"), std::string::npos) << command << ":\n" << help.out;
+  }
+  const std::string library = (test::source_dir() / "clumps" / "tuber-default.h5").string();
+  for (const std::string& line :
+       {fmt::format("validate '{}' --clump '{}' --test drop --surface Q235", library, library),
+        fmt::format("calibrate --recordings ../shared/data/paper/drop-Q235 --clump '{}'", library),
+        fmt::format("diagnose --recordings ../shared/data/paper/drop-Q235 --clump-name tuber.h5")}) {
+    const auto run = test::run_clumpforge(line);
+    EXPECT_EQ(run.exit_code, 2) << line << "\n" << run.err;
+    EXPECT_NE(run.err.find("goes to --library"), std::string::npos) << line << "\n" << run.err;
+  }
+}
+
+// Progress on a terminal for a command that runs longer than a second, none when piped:
+// the same validation under a pseudo-terminal (util-linux `script`) and into a pipe.
+TEST(Cli, ProgressOnATerminalNoneWhenPiped) {
+  const std::string library = (test::source_dir() / "clumps" / "tuber-default.h5").string();
+  const std::string validate = fmt::format(
+      "'{}' validate '{}' --clump lattice-2mm --test tilt --surface Q235 --trials 4", CLUMPFORGE_BINARY, library);
+  const auto terminal = test::run_command(fmt::format("script -qfec \"{}\" /dev/null", validate));
+  ASSERT_EQ(terminal.exit_code, 0) << terminal.err;
+  EXPECT_NE(terminal.out.find("%] "), std::string::npos) << terminal.out;  // "\r  [ 50 %] trial 2 of 4"
+  const auto piped = test::run_command(validate);
+  ASSERT_EQ(piped.exit_code, 0) << piped.err;
+  EXPECT_EQ(piped.err.find("%]"), std::string::npos) << piped.err;
+  EXPECT_EQ(piped.out.find("%]"), std::string::npos) << piped.out;
+}
+
 // A density that was not given is said, in the output and the report, never silent.
 TEST(Cli, ADefaultDensityIsSaidNotSilent) {
   test::ScratchDir dir("density");

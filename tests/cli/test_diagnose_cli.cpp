@@ -35,7 +35,7 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   // A track whose time goes backwards: refused with the file and the line.
   write(dir / "rec" / "recording.json", kManifest);
   write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n0.0005,0,0.21\n");
-  auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --output '{}'",
+  auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --output '{}'",
                                               (dir / "rec").string(), clump(), (dir / "out").string()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("trial-01.csv:4"), std::string::npos) << run.err;
@@ -43,26 +43,26 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "report.json"));
   // An unknown column.
   write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m,speed\n0.000,0,0.21,0\n");
-  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}'", (dir / "rec").string(), clump()));
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}'", (dir / "rec").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("unknown column 'speed'"), std::string::npos) << run.err;
   // Both particle sources, neither, a missing directory, an unknown effect.
   run = test::run_clumpforge(
-      fmt::format("diagnose --recordings '{}' --clump '{}' --mesh x.stl", (dir / "rec").string(), clump()));
+      fmt::format("diagnose --recordings '{}' --library '{}' --mesh x.stl", (dir / "rec").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.err.find("exactly one of --mesh and --clump"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("exactly one of --mesh and --library"), std::string::npos) << run.err;
   run =
-      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}'", (dir / "nowhere").string(), clump()));
+      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}'", (dir / "nowhere").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("nowhere"), std::string::npos) << run.err;
   write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n");
   run = test::run_clumpforge(
-      fmt::format("diagnose --recordings '{}' --clump '{}' --effects air_drga", (dir / "rec").string(), clump()));
+      fmt::format("diagnose --recordings '{}' --library '{}' --effects air_drga", (dir / "rec").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("did you mean 'air_drag'"), std::string::npos) << run.err;
   // A track too short to decide anything: that verdict, not a guess.
   run = test::run_clumpforge(
-      fmt::format("diagnose --recordings '{}' --clump '{}' --json", (dir / "rec").string(), clump()));
+      fmt::format("diagnose --recordings '{}' --library '{}' --json", (dir / "rec").string(), clump()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(nlohmann::json::parse(run.out)["verdict"], "undecidable");
 }
@@ -93,7 +93,7 @@ TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
     std::filesystem::remove_all(dir / "rec");
     write(dir / "rec" / "recording.json", m);
     if (!track.empty()) write(dir / "rec" / "trial-01.csv", track);
-    const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --clump '{}' --output '{}' --json",
+    const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --output '{}' --json",
                                                       (dir / "rec").string(), clump(), (dir / "out").string()));
     EXPECT_EQ(run.exit_code, 1) << run.err;
     EXPECT_NE(run.err.find((dir / "rec").string()), std::string::npos) << run.err;  // names the file
@@ -144,7 +144,7 @@ TEST(DiagnoseCli, SummariesOnlySayWhatTheyCanDecide) {
   // by the impacts of an irregular body; drag and speed dependence are undecidable.
   test::ScratchDir dir("diagnose-paper");
   const auto paper = test::shared_dir() / "data" / "paper";
-  const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' '{}' --clump '{}' --json --output '{}'",
+  const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' '{}' --library '{}' --json --output '{}'",
                                                     (paper / "drop-Q235").string(), (paper / "roll-Q235").string(),
                                                     clump(), (dir / "out").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;

@@ -76,13 +76,13 @@ TEST(CalibrateCli, BadInputIsAClearError) {
   const std::string lib = (test::source_dir() / "clumps" / "tuber-default.h5").string();
   const std::string drop = (test::shared_dir() / "data" / "paper" / "drop-Q235").string();
   const std::vector<std::pair<std::string, std::string>> cases{
-      {fmt::format("calibrate --recordings '{}' --clump '{}' --clump-name lattice-4mm --method bayes", drop, lib),
+      {fmt::format("calibrate --recordings '{}' --library '{}' --clump lattice-4mm --method bayes", drop, lib),
        "unknown method 'bayes'"},
-      {fmt::format("calibrate --recordings /nonexistent/rec --clump '{}' --clump-name lattice-4mm", lib),
+      {fmt::format("calibrate --recordings /nonexistent/rec --library '{}' --clump lattice-4mm", lib),
        "no recording manifest"},
-      {fmt::format("calibrate --recordings '{}' --clump '{}' --clump-name lattice-4mm --method joint", drop, lib),
+      {fmt::format("calibrate --recordings '{}' --library '{}' --clump lattice-4mm --method joint", drop, lib),
        "needs drop, tilt and roll"},
-      {fmt::format("calibrate --recordings '{}' --clump '{}' --clump-name lattice-4mm --trials-per-level 0", drop, lib),
+      {fmt::format("calibrate --recordings '{}' --library '{}' --clump lattice-4mm --trials-per-level 0", drop, lib),
        "between 1 and 1000"},
   };
   for (const auto& [arguments, expected] : cases) {

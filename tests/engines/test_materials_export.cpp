@@ -52,7 +52,7 @@ std::vector<double> compare_means(const std::string& conventions, int drops) {
                                                    (dir / "tuber.multisphere").string()));
   EXPECT_EQ(exported.exit_code, 0) << exported.err;
   exported = test::run_clumpforge(
-      fmt::format("materials --calibration '{}' --export liggghts --clump '{}' --clump-name lattice-4mm -o '{}'",
+      fmt::format("materials --calibration '{}' --export liggghts --library '{}' --clump lattice-4mm -o '{}'",
                   (dir / "calibration.json").string(), library, (dir / "materials.liggghts").string()));
   EXPECT_EQ(exported.exit_code, 0) << exported.err;
   auto clumps = read_clump_library(library);
