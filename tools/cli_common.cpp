@@ -115,13 +115,33 @@ Result<LoadedBody> load_closed_body(const std::string& path, const std::string& 
 }
 
 CLI::Option* add_output_option(CLI::App& app, std::string& target, const std::string& description) {
-  CLI::Option* output = app.add_option("-o,--output", target, description);
+  CLI::Option* output = app.add_option("-o,--output", target, description)->type_name("PATH")->group(kSharedOptions);
   app.add_option("--out", target, "same as --output")->group("");  // hidden, for scripts written before
   return output;
 }
 
 CLI::Option* add_library_option(CLI::App& app, std::string& library, const std::string& description) {
-  return app.add_option("--library", library, description)->type_name("FILE");
+  return app.add_option("--library", library, description)->type_name("FILE")->group(kSharedOptions);
+}
+
+CLI::Option* add_json_flag(CLI::App& app, bool& json, const std::string& what) {
+  return app.add_flag("--json", json, what)->group(kSharedOptions);
+}
+
+CLI::Option* add_seed_option(CLI::App& app, std::uint64_t& seed, const std::string& what) {
+  return app.add_option("--seed", seed, what)->type_name("UINT")->capture_default_str()->group(kSharedOptions);
+}
+
+CLI::Option* add_materials_option(CLI::App& app, std::string& path, const std::string& what) {
+  return app.add_option("--materials", path, what)->type_name("FILE")->group(kSharedOptions);
+}
+
+CLI::Option* add_units_option(CLI::App& app, std::string& units, const std::string& what) {
+  return app.add_option("--units", units, what)->type_name("mm|cm|m")->capture_default_str()->group(kSharedOptions);
+}
+
+CLI::Option* add_density_option(CLI::App& app, double& density, const std::string& what) {
+  return app.add_option("--density", density, what)->type_name("KG_M3")->group(kSharedOptions);
 }
 
 CLI::Option* add_clump_option(CLI::App& app, std::string& clump, const std::string& description) {
@@ -135,7 +155,8 @@ CLI::Option* add_clump_option(CLI::App& app, std::string& clump, const std::stri
         return {};
       },
       "", "clump name");
-  CLI::Option* option = app.add_option("--clump", clump, description)->type_name("NAME")->check(a_name);
+  CLI::Option* option =
+      app.add_option("--clump", clump, description)->type_name("NAME")->check(a_name)->group(kSharedOptions);
   app.add_option("--clump-name", clump, "same as --clump")->group("")->check(a_name);  // older scripts
   return option;
 }

@@ -1,6 +1,7 @@
 #pragma once
 /// Helpers shared by the subcommands: exit codes, error printing, JSON of library types.
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -51,6 +52,16 @@ CLI::Option* add_output_option(CLI::App& app, std::string& target, const std::st
 /// goes. The older `--clump-name` is still read, hidden from the help.
 CLI::Option* add_library_option(CLI::App& app, std::string& library, const std::string& description);
 CLI::Option* add_clump_option(CLI::App& app, std::string& clump, const std::string& description);
+
+/// The options most commands share, added by one function each so that every command spells,
+/// types and lists them alike (under "Shared options" in --help); `what` says what the
+/// option means for that command.
+CLI::Option* add_json_flag(CLI::App& app, bool& json, const std::string& what);
+CLI::Option* add_seed_option(CLI::App& app, std::uint64_t& seed, const std::string& what);
+CLI::Option* add_materials_option(CLI::App& app, std::string& path, const std::string& what);
+CLI::Option* add_units_option(CLI::App& app, std::string& units, const std::string& what);
+CLI::Option* add_density_option(CLI::App& app, double& density, const std::string& what);
+inline constexpr const char* kSharedOptions = "Shared options";
 
 /// The study's Corydalis tuber density, used when a command is given none [kg/m^3].
 inline constexpr double kStudyDensity = 1085.0;

@@ -314,10 +314,10 @@ Command add_calibrate_command(CLI::App& app) {
   sub->add_option("--trials-per-level", args->trials_per_level,
                   "Trials per swept level (joint: orientations per evaluation)")
       ->capture_default_str();
-  sub->add_option("--seed", args->seed, "Seed of the trial orientations")->capture_default_str();
+  add_seed_option(*sub, args->seed, "Seed of the trial orientations");
   add_output_option(*sub, args->out, "Directory for calibration.json, calibration.md and the plots");
-  sub->add_option("--materials", args->materials,
-                  "Materials file (JSON, see docs/materials.json) overriding the built-in table");
+  add_materials_option(*sub, args->materials,
+                       "Materials file (JSON, see docs/materials.json) overriding the built-in table");
   sub->add_option(
          "--conventions", args->conventions,
          "Contact conventions to calibrate under: edem (rolling lever to the centre of mass, Coulomb limit on spring + "
@@ -326,7 +326,7 @@ Command add_calibrate_command(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--export", args->export_format,
                   "Also write the calibrated materials for an engine: liggghts, yade or edem (into --output)");
-  sub->add_flag("--json", args->json, "Print the report as JSON");
+  add_json_flag(*sub, args->json, "Print the report as JSON");
   sub->footer(
       "Example:\n  clumpforge calibrate --recordings ../shared/data/paper/drop-Q235 ../shared/data/paper/tilt-Q235 "
       "\\\n      ../shared/data/paper/roll-Q235 --library clumps/tuber-default.h5 --clump lattice-2mm --method "

@@ -378,13 +378,13 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_option("--spheres", args->spheres,
                   "With --mesh: spheres of the adaptive clump; 0 (default) chooses them by convergence to the scan "
                   "(surface RMS within a third of --model-accuracy)");
-  sub->add_option("--units", args->units, "With --mesh: its length unit (mm, cm, m)");
-  sub->add_option("--density", args->density, "With --mesh: bulk density [kg/m^3]");
+  add_units_option(*sub, args->units, "With --mesh: its length unit (mm, cm, m)");
+  add_density_option(*sub, args->density, "With --mesh: bulk density [kg/m^3]");
   sub->add_option("--effects", args->effects, "Candidate effects to test (default: the whole library)");
-  sub->add_option("--materials", args->materials, "Materials file (JSON) overriding the built-in table");
+  add_materials_option(*sub, args->materials, "Materials file (JSON) overriding the built-in table");
   sub->add_option("--max-evaluations", args->max_evaluations,
                   "Fit budget per candidate (Levenberg-Marquardt iterations: a fifth of it)");
-  sub->add_option("--seed", args->seed, "Seed (the release orientations drawn from each prior)");
+  add_seed_option(*sub, args->seed, "Seed (the release orientations drawn from each prior)");
   sub->add_option("--orientation-prior", args->orientation_prior_deg,
                   "Uncertainty of a recorded release orientation (orientation_wxyz) [deg]; never taken as exact");
   sub->add_option("--model-accuracy", args->model_accuracy_mm,
@@ -399,7 +399,7 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   add_output_option(*sub, args->out, "Directory for report.json, tracks.json and the figures (PNG, SVG)");
-  sub->add_flag("--json", args->json, "Print the report as JSON");
+  add_json_flag(*sub, args->json, "Print the report as JSON");
   sub->footer(
       "Example:\n  clumpforge diagnose --recordings clumps/tuber-default-diagnosis/recordings/* \\\n      --library "
       "clumps/tuber-default-diagnosis.h5 --output diagnosis/");

@@ -168,7 +168,7 @@ Command add_export_command(CLI::App& app) {
                   "mercurydpm: 'current' (<Name>/Clump/Clump.txt, <Name>/Inertia/Mass.txt, TOI.txt, PD.txt; read by "
                   "Drivers/Clump/ClumpHeaders/ClumpInput.h) or 'legacy' (clump/clump.txt, inertia/*.txt)")
       ->capture_default_str();
-  sub->add_flag("--json", args->json, "Print the files written as JSON");
+  add_json_flag(*sub, args->json, "Print the files written as JSON");
   sub->footer(
       "Examples:\n"
       "  clumpforge export clumps/tuber-default.h5 --clump lattice-2mm --format yade -o tuber.txt\n"

@@ -186,12 +186,13 @@ Command add_fill_command(CLI::App& app) {
   sub->add_option("--target-error", args->target_error, "Adaptive: stop when this fraction of the volume is uncovered");
   sub->add_option("--min-radius", args->min_radius, "Adaptive: smallest sphere radius, e.g. 0.3mm");
   sub->add_option("--voxel", args->voxel, "Signed-distance voxel size, e.g. 0.1mm (default: smallest diameter / 8)");
-  CLI::Option* density = sub->add_option("--density", args->density,
-                                         "Bulk density [kg/m^3] (default: the Corydalis tuber's, said in the output)")
-                             ->capture_default_str();
-  sub->add_option("--units", args->units, "Length unit of the mesh file: mm, cm or m")->capture_default_str();
+  CLI::Option* density =
+      add_density_option(*sub, args->density,
+                         "Bulk density [kg/m^3] (default: the Corydalis tuber's, said in the output)")
+          ->capture_default_str();
+  add_units_option(*sub, args->units, "Length unit of the mesh file: mm, cm or m");
   sub->add_flag("--append", args->append, "Add the clumps to an existing library file instead of replacing it");
-  sub->add_flag("--json", args->json, "Print one JSON report on stdout");
+  add_json_flag(*sub, args->json, "Print one JSON report on stdout");
   sub->footer("Example:\n  clumpforge fill tuber.stl -o tuber.h5 --diameters 1,2,4mm --density 1085");
   return {sub, [args, density] {
             args->density_given = density->count() > 0;

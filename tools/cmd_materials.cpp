@@ -69,7 +69,7 @@ Command add_materials_command(CLI::App& app) {
   auto args = std::make_shared<MaterialsArgs>();
   CLI::App* sub = app.add_subcommand(
       "materials", "Print the DEM's materials and interaction table, as JSON or in an engine's syntax");
-  sub->add_option("--materials", args->materials, "A materials file to apply over the built-in table first");
+  add_materials_option(*sub, args->materials, "A materials file to apply over the built-in table first");
   sub->add_option("--calibration", args->calibration,
                   "A stored calibration (calibration.json of 'clumpforge calibrate') to apply");
   sub->add_option("--export", args->format,

@@ -66,9 +66,9 @@ Command add_props_command(CLI::App& app) {
   auto args = std::make_shared<PropsArgs>();
   CLI::App* sub = app.add_subcommand("props", "Exact volume, mass, centroid and inertia of a closed mesh");
   sub->add_option("mesh", args->input, "A closed mesh (run 'repair' first on a raw scan)")->required();
-  sub->add_option("--density", args->density, "Bulk density [kg/m^3], e.g. 1085 for the Corydalis tuber")->required();
-  sub->add_option("--units", args->units, "Length unit of the file: mm, cm or m")->capture_default_str();
-  sub->add_flag("--json", args->json, "Print one JSON object on stdout");
+  add_density_option(*sub, args->density, "Bulk density [kg/m^3], e.g. 1085 for the Corydalis tuber")->required();
+  add_units_option(*sub, args->units, "Length unit of the file: mm, cm or m");
+  add_json_flag(*sub, args->json, "Print one JSON object on stdout");
   sub->footer("Example:\n  clumpforge props tuber.stl --density 1085 --units mm");
   return {sub, [args] { return run_props(*args); }};
 }

@@ -99,9 +99,8 @@ Command add_repair_command(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("repair", "Repair a scan into a closed, outward, 2-manifold body");
   sub->add_option("input", args->input, "Input mesh (STL, OBJ, PLY, OFF, any format assimp reads)")->required();
   add_output_option(*sub, args->output, "Output mesh: .stl (binary), .ply or .obj")->required();
-  sub->add_option("--units", args->units, "Length unit of the input file (and of the output): mm, cm or m")
-      ->capture_default_str();
-  sub->add_flag("--json", args->json, "Print one JSON report on stdout");
+  add_units_option(*sub, args->units, "Length unit of the input file (and of the output): mm, cm or m");
+  add_json_flag(*sub, args->json, "Print one JSON report on stdout");
   sub->footer("Example:\n  clumpforge repair scan.stl -o tuber.stl --units mm");
   return {sub, [args] { return run_repair(*args); }};
 }

@@ -155,11 +155,12 @@ Command add_study_command(CLI::App& app) {
   sub->add_option("mesh", args->input, "A closed mesh (run 'repair' first on a raw scan)")->required();
   add_output_option(*sub, args->output, "Directory for the tables and plots")->required();
   sub->add_option("--budgets", args->budgets, "Adaptive sphere budgets")->delimiter(',')->capture_default_str();
-  CLI::Option* density = sub->add_option("--density", args->density,
-                                         "Bulk density [kg/m^3] (default: the Corydalis tuber's, said in the output)")
-                             ->capture_default_str();
-  sub->add_option("--units", args->units, "Length unit of the mesh file: mm, cm or m")->capture_default_str();
-  sub->add_flag("--json", args->json, "Print the rows as JSON");
+  CLI::Option* density =
+      add_density_option(*sub, args->density,
+                         "Bulk density [kg/m^3] (default: the Corydalis tuber's, said in the output)")
+          ->capture_default_str();
+  add_units_option(*sub, args->units, "Length unit of the mesh file: mm, cm or m");
+  add_json_flag(*sub, args->json, "Print the rows as JSON");
   sub->footer("Example:\n  clumpforge study tuber.stl -o study/ --budgets 32,64,128,256");
   return {sub, [args, density] {
             args->density_given = density->count() > 0;

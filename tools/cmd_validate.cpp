@@ -185,10 +185,10 @@ Command add_validate_command(CLI::App& app) {
   sub->add_option("--test", args->test, "drop, tilt or roll")->required();
   sub->add_option("--surface", args->surface, "Plate material: Q235 or soil")->required();
   sub->add_option("--trials", args->trials, "Trials (random orientations)")->capture_default_str();
-  sub->add_option("--seed", args->seed, "Seed of the orientations")->capture_default_str();
+  add_seed_option(*sub, args->seed, "Seed of the orientations");
   add_output_option(*sub, args->out, "Write the run as a recording (recording.json + tracks) in this directory");
-  sub->add_option("--materials", args->materials,
-                  "Materials file (JSON, see docs/materials.json) overriding the built-in table");
+  add_materials_option(*sub, args->materials,
+                       "Materials file (JSON, see docs/materials.json) overriding the built-in table");
   sub->add_option("--restitution", args->restitution, "Override e (0, 1]");
   sub->add_option("--static-friction", args->static_friction, "Override mu_s");
   sub->add_option("--rolling-friction", args->rolling_friction, "Override mu_r");
@@ -207,7 +207,7 @@ Command add_validate_command(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--tilt-rate", args->tilt_rate, "Tilt: plate rate [deg/s] (default 5)");
   sub->add_option("--composite", args->composite, "Tilt: four-square (the study's) or single")->capture_default_str();
-  sub->add_flag("--json", args->json, "Print per-trial summaries, their spread and the parameters used as JSON");
+  add_json_flag(*sub, args->json, "Print per-trial summaries, their spread and the parameters used as JSON");
   sub->footer(
       "Example:\n  clumpforge validate clumps/tuber-default.h5 --clump lattice-2mm --test drop --surface Q235 --trials "
       "10");

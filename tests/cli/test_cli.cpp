@@ -130,6 +130,17 @@ TEST(Cli, EveryCommandsHelpEndsWithAnExample) {
       EXPECT_NE(run.out.find("-o,--output"), std::string::npos) << command;
     }
     EXPECT_EQ(run.out.find(" --out "), std::string::npos) << command;
+    // The options commands share are added by one function each and listed together.
+    const auto shared = run.out.find("Shared options:");
+    ASSERT_NE(shared, std::string::npos) << command;
+    for (const std::string option :
+         {"--json", "--seed UINT", "--materials FILE", "--units mm|cm|m", "--density KG_M3"}) {
+      const std::string name = option.substr(0, option.find(' ')) + " ";
+      if (run.out.find(name) == std::string::npos) continue;  // the command has no such option
+      const auto at = run.out.find(option);
+      ASSERT_NE(at, std::string::npos) << command << ": " << option << " spelled differently";
+      EXPECT_GT(at, shared) << command << ": " << option;
+    }
   }
 }
 
