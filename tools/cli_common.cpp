@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/sha256.hpp"
+#include "core/text.hpp"
 #include "core/units.hpp"
 #include "mesh/load.hpp"
 
@@ -159,6 +160,30 @@ CLI::Option* add_clump_option(CLI::App& app, std::string& clump, const std::stri
       app.add_option("--clump", clump, description)->type_name("NAME")->check(a_name)->group(kSharedOptions);
   app.add_option("--clump-name", clump, "same as --clump")->group("")->check(a_name);  // older scripts
   return option;
+}
+
+// "1,2,4mm" or "1mm,2mm" -> metres; the unit of the last item applies to bare numbers.
+Result<std::vector<double>> parse_diameter_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const auto comma = text.find(',', start);
+    items.emplace_back(trim(std::string_view(text).substr(start, comma - start)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  std::string unit;
+  const std::string& last = items.back();
+  const auto unit_start = last.find_first_not_of("0123456789.eE+- ");
+  if (unit_start != std::string::npos) unit = last.substr(unit_start);
+  std::vector<double> values;
+  for (auto& item : items) {
+    const bool has_unit = item.find_first_not_of("0123456789.eE+- ") != std::string::npos;
+    auto value = parse_length(has_unit ? item : item + unit);
+    if (!value) return std::unexpected(value.error());
+    values.push_back(*value);
+  }
+  return values;
 }
 
 std::string density_source(bool given) {

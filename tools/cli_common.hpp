@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "fill/body.hpp"
@@ -62,6 +63,9 @@ CLI::Option* add_materials_option(CLI::App& app, std::string& path, const std::s
 CLI::Option* add_units_option(CLI::App& app, std::string& units, const std::string& what);
 CLI::Option* add_density_option(CLI::App& app, double& density, const std::string& what);
 inline constexpr const char* kSharedOptions = "Shared options";
+
+/// "1,2,4mm" or "1mm,2mm" -> metres; the unit of the last item applies to bare numbers.
+Result<std::vector<double>> parse_diameter_list(const std::string& text);
 
 /// The study's Corydalis tuber density, used when a command is given none [kg/m^3].
 inline constexpr double kStudyDensity = 1085.0;

@@ -12,10 +12,10 @@ int main(int argc, char** argv) {
   CLI::App app{"clumpforge: turn a particle scan into a measured multi-sphere DEM clump"};
   app.set_version_flag("--version", std::string(clumpforge::kVersion));
   app.require_subcommand(1);
-  const std::vector<Command> commands{
-      add_repair_command(app),    add_props_command(app),     add_fill_command(app),
-      add_export_command(app),    add_study_command(app),     add_validate_command(app),
-      add_calibrate_command(app), add_materials_command(app), add_diagnose_command(app)};
+  const std::vector<Command> commands{add_repair_command(app),    add_props_command(app),     add_fill_command(app),
+                                      add_export_command(app),    add_study_command(app),     add_validate_command(app),
+                                      add_calibrate_command(app), add_materials_command(app), add_diagnose_command(app),
+                                      add_batch_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

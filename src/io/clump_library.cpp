@@ -1,8 +1,7 @@
 #include "io/clump_library.hpp"
 
-#include <hdf5.h>
-
 #include <fmt/format.h>
+#include <hdf5.h>
 
 #include <functional>
 #include <set>
@@ -86,12 +85,18 @@ void write_int_attribute(hid_t object, const char* name, long long value) {
 void write_dataset(hid_t group, const char* name, std::initializer_list<hsize_t> dims, const double* data) {
   const std::vector<hsize_t> shape(dims);
   Handle space(H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr), H5Sclose);
-  Handle dataset(H5Dcreate2(group, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
+  // No modification times in object headers: the same clumps give the same bytes.
+  Handle properties(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_obj_track_times(properties.get(), false);
+  Handle dataset(H5Dcreate2(group, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
+                 H5Dclose);
   check(dataset.ok() ? 0 : -1, name);
   check(H5Dwrite(dataset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), name);
 }
 
-void write_vector(hid_t group, const char* name, const Eigen::Vector3d& v) { write_dataset(group, name, {3}, v.data()); }
+void write_vector(hid_t group, const char* name, const Eigen::Vector3d& v) {
+  write_dataset(group, name, {3}, v.data());
+}
 
 void write_matrix(hid_t group, const char* name, const Eigen::Matrix3d& m) {
   const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rows = m;
@@ -101,6 +106,7 @@ void write_matrix(hid_t group, const char* name, const Eigen::Matrix3d& m) {
 Handle create_group(hid_t parent, const char* name, bool track_order = false) {
   Handle properties(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);
   if (track_order) H5Pset_link_creation_order(properties.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED);
+  H5Pset_obj_track_times(properties.get(), false);
   Handle group(H5Gcreate2(parent, name, H5P_DEFAULT, properties.get(), H5P_DEFAULT), H5Gclose);
   check(group.ok() ? 0 : -1, name);
   return group;
@@ -194,7 +200,8 @@ struct Reader {
     Handle attribute(H5Aopen(object, name, H5P_DEFAULT), H5Aclose);
     if (!attribute.ok()) damaged(fmt::format("attribute '{}' is missing", name));
     double value = 0.0;
-    if (H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, &value) < 0) damaged(fmt::format("attribute '{}' unreadable", name));
+    if (H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, &value) < 0)
+      damaged(fmt::format("attribute '{}' unreadable", name));
     return value;
   }
   std::vector<double> dataset(hid_t group, const char* name, std::vector<hsize_t> expected_dims) const {
@@ -207,7 +214,8 @@ struct Reader {
     if (dims.size() != expected_dims.size()) damaged(fmt::format("dataset '{}' has rank {}", name, rank));
     hsize_t count = 1;
     for (std::size_t k = 0; k < dims.size(); ++k) {
-      if (expected_dims[k] != 0 && dims[k] != expected_dims[k]) damaged(fmt::format("dataset '{}' has the wrong shape", name));
+      if (expected_dims[k] != 0 && dims[k] != expected_dims[k])
+        damaged(fmt::format("dataset '{}' has the wrong shape", name));
       count *= dims[k];
     }
     std::vector<double> values(count);
@@ -266,7 +274,8 @@ struct Reader {
     Clump c;
     c.name = string_attribute(group.get(), "name");
     const std::string method = string_attribute(group.get(), "method");
-    if (method != "lattice" && method != "adaptive") damaged(fmt::format("clump '{}' has unknown method '{}'", name, method));
+    if (method != "lattice" && method != "adaptive")
+      damaged(fmt::format("clump '{}' has unknown method '{}'", name, method));
     c.method = method == "lattice" ? FillMethod::Lattice : FillMethod::Adaptive;
     if (string_attribute(group.get(), "units") != "m") damaged(fmt::format("clump '{}' is not in metres", name));
     c.density = double_attribute(group.get(), "density_kg_m3");
@@ -277,7 +286,8 @@ struct Reader {
     c.spheres.resize(spheres.size() / 4);
     for (std::size_t i = 0; i < c.spheres.size(); ++i) {
       c.spheres[i] = {{spheres[4 * i], spheres[4 * i + 1], spheres[4 * i + 2]}, spheres[4 * i + 3]};
-      if (!(c.spheres[i].radius > 0.0)) damaged(fmt::format("clump '{}' sphere {} has radius {}", name, i, c.spheres[i].radius));
+      if (!(c.spheres[i].radius > 0.0))
+        damaged(fmt::format("clump '{}' sphere {} has radius {}", name, i, c.spheres[i].radius));
     }
     if (c.spheres.empty()) damaged(fmt::format("clump '{}' has no spheres", name));
     c.inertia = matrix(group.get(), "inertia_kg_m2");
@@ -314,13 +324,21 @@ std::vector<std::string> child_names(hid_t group) {
 }
 }  // namespace
 
-Result<void> write_clump_library(const fs::path& path, std::span<const Clump> clumps) {
+namespace {
+Result<void> check_names(std::span<const Clump> clumps, std::string_view where) {
   std::set<std::string> names;
   for (const auto& clump : clumps) {
     if (clump.name.empty() || clump.name.find('/') != std::string::npos || !names.insert(clump.name).second) {
-      return fail(ErrorCode::InvalidArgument, fmt::format("clump name '{}' is empty, has a '/' or repeats", clump.name));
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("{}clump name '{}' is empty, has a '/' or repeats", where, clump.name));
     }
   }
+  return {};
+}
+
+// Writes the file's header attributes, then `body(file)`, atomically.
+template <class Body>
+Result<void> write_library_file(const fs::path& path, Body&& body) {
   return write_path_atomically(path, [&](const fs::path& temporary) -> Result<void> {
     QuietHdf5 quiet;
     try {
@@ -329,39 +347,84 @@ Result<void> write_clump_library(const fs::path& path, std::span<const Clump> cl
       write_string_attribute(file.get(), "format", kClumpLibraryFormat);
       write_int_attribute(file.get(), "schema_version", kClumpSchemaVersion);
       write_string_attribute(file.get(), "tool_version", kVersion);
-      Handle group = create_group(file.get(), "clumps", true);
-      for (const auto& clump : clumps) write_clump(group.get(), clump);
+      body(file.get());
     } catch (const Hdf5Failure& failure) {
       return fail(ErrorCode::IoError, fmt::format("writing '{}' failed at '{}'", path.string(), failure.what));
     }
     return {};
   });
 }
+}  // namespace
+
+Result<void> write_clump_library(const fs::path& path, std::span<const Clump> clumps) {
+  if (auto ok = check_names(clumps, ""); !ok) return ok;
+  return write_library_file(path, [&](hid_t file) {
+    Handle group = create_group(file, "clumps", true);
+    for (const auto& clump : clumps) write_clump(group.get(), clump);
+  });
+}
+
+Result<void> write_population_library(const fs::path& path, std::span<const ScanClumps> scans) {
+  std::set<std::string> scan_names;
+  for (const auto& scan : scans) {
+    if (scan.scan.empty() || scan.scan.find('/') != std::string::npos || !scan_names.insert(scan.scan).second)
+      return fail(ErrorCode::InvalidArgument, fmt::format("scan name '{}' is empty, has a '/' or repeats", scan.scan));
+    if (auto ok = check_names(scan.clumps, "scan '" + scan.scan + "': "); !ok) return ok;
+  }
+  return write_library_file(path, [&](hid_t file) {
+    Handle all = create_group(file, "scans", true);
+    for (const auto& scan : scans) {
+      Handle group = create_group(all.get(), scan.scan.c_str(), false);
+      Handle clumps = create_group(group.get(), "clumps", true);
+      for (const auto& clump : scan.clumps) write_clump(clumps.get(), clump);
+    }
+  });
+}
 
 Result<std::vector<Clump>> read_clump_library(const fs::path& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) return fail(ErrorCode::NotFound, fmt::format("'{}': no such file", path.string()));
-  if (fs::is_directory(path, ec)) return fail(ErrorCode::InvalidArgument, fmt::format("'{}' is a directory", path.string()));
+  if (fs::is_directory(path, ec))
+    return fail(ErrorCode::InvalidArgument, fmt::format("'{}' is a directory", path.string()));
   QuietHdf5 quiet;
   if (H5Fis_hdf5(path.c_str()) <= 0) {
-    return fail(ErrorCode::ParseError, fmt::format("'{}' is not an HDF5 file (expected a clump library from 'clumpforge fill')", path.string()));
+    return fail(
+        ErrorCode::ParseError,
+        fmt::format("'{}' is not an HDF5 file (expected a clump library from 'clumpforge fill')", path.string()));
   }
   try {
     Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
     if (!file.ok()) return fail(ErrorCode::ParseError, fmt::format("'{}' is a damaged HDF5 file", path.string()));
     const Reader reader{path.string()};
-    if (!reader.has_attribute(file.get(), "format") || reader.string_attribute(file.get(), "format") != kClumpLibraryFormat) {
-      return fail(ErrorCode::ParseError, fmt::format("'{}' is an HDF5 file but not a clumpforge clump library (no format "
-                                                     "attribute '{}')", path.string(), kClumpLibraryFormat));
+    if (!reader.has_attribute(file.get(), "format") ||
+        reader.string_attribute(file.get(), "format") != kClumpLibraryFormat) {
+      return fail(ErrorCode::ParseError,
+                  fmt::format("'{}' is an HDF5 file but not a clumpforge clump library (no format "
+                              "attribute '{}')",
+                              path.string(), kClumpLibraryFormat));
     }
     const double version = reader.double_attribute(file.get(), "schema_version");
     if (version > kClumpSchemaVersion) {
-      return fail(ErrorCode::ParseError, fmt::format("'{}' uses clump schema v{}; this clumpforge reads v{} (upgrade it)",
-                                                     path.string(), version, kClumpSchemaVersion));
+      return fail(ErrorCode::ParseError,
+                  fmt::format("'{}' uses clump schema v{}; this clumpforge reads v{} (upgrade it)", path.string(),
+                              version, kClumpSchemaVersion));
     }
-    Handle group = reader.open_group(file.get(), "clumps");
     std::vector<Clump> clumps;
-    for (const auto& name : child_names(group.get())) clumps.push_back(reader.clump(group.get(), name));
+    if (H5Lexists(file.get(), "scans", H5P_DEFAULT) > 0) {
+      // A population (clumpforge batch): /scans/<scan>/clumps/<clump>, named "<scan>/<clump>".
+      Handle scans = reader.open_group(file.get(), "scans");
+      for (const auto& scan : child_names(scans.get())) {
+        Handle scan_group = reader.open_group(scans.get(), scan.c_str());
+        Handle group = reader.open_group(scan_group.get(), "clumps");
+        for (const auto& name : child_names(group.get())) {
+          clumps.push_back(reader.clump(group.get(), name));
+          clumps.back().name = scan + "/" + clumps.back().name;
+        }
+      }
+    } else {
+      Handle group = reader.open_group(file.get(), "clumps");
+      for (const auto& name : child_names(group.get())) clumps.push_back(reader.clump(group.get(), name));
+    }
     if (clumps.empty()) return fail(ErrorCode::ParseError, fmt::format("'{}' holds no clumps", path.string()));
     return clumps;
   } catch (const Hdf5Failure& failure) {

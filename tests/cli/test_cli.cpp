@@ -119,7 +119,7 @@ namespace clumpforge {
 // Issue 15, item 4: every command's --help ends with an example of its use.
 TEST(Cli, EveryCommandsHelpEndsWithAnExample) {
   for (const char* command :
-       {"repair", "props", "fill", "export", "study", "validate", "calibrate", "materials", "diagnose"}) {
+       {"repair", "props", "fill", "export", "study", "validate", "calibrate", "materials", "diagnose", "batch"}) {
     const auto run = test::run_clumpforge(fmt::format("{} --help", command));
     EXPECT_EQ(run.exit_code, 0) << command;
     const auto example = run.out.rfind("Example");

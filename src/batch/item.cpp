@@ -1,0 +1,182 @@
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <numeric>
+
+#include "batch/batch.hpp"
+#include "core/rng.hpp"
+#include "core/sha256.hpp"
+#include "dem/lab.hpp"
+#include "dem/materials.hpp"
+#include "fill/body.hpp"
+#include "fill/fill.hpp"
+#include "mesh/load.hpp"
+#include "mesh/repair.hpp"
+#include "mesh/triangle_mesh.hpp"
+
+namespace clumpforge {
+namespace fs = std::filesystem;
+
+namespace {
+bool is_scan(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".stl" || ext == ".obj" || ext == ".ply" || ext == ".off";
+}
+
+std::uint64_t hash_text(std::uint64_t seed, std::string_view text) {
+  std::uint64_t h = 1469598103934665603ULL ^ seed;  // FNV-1a, then mixed
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  return Rng(h).next_u64();
+}
+}  // namespace
+
+Result<std::vector<ScanItem>> list_scans(std::span<const fs::path> inputs) {
+  std::vector<fs::path> files;
+  for (const auto& input : inputs) {
+    std::error_code ec;
+    if (fs::is_directory(input, ec)) {
+      for (const auto& entry : fs::directory_iterator(input, ec))
+        if (entry.is_regular_file() && is_scan(entry.path())) files.push_back(entry.path());
+    } else if (fs::is_regular_file(input, ec)) {
+      files.push_back(input);
+    } else {
+      return fail(ErrorCode::NotFound, fmt::format("'{}': no such scan file or folder", input.string()));
+    }
+  }
+  if (files.empty()) return fail(ErrorCode::NotFound, "no scans (.stl, .obj, .ply, .off) in the inputs given");
+  std::map<std::string, ScanItem> by_name;
+  for (const auto& file : files) {
+    const std::string name = file.stem().string();
+    if (by_name.contains(name))
+      return fail(ErrorCode::InvalidArgument, fmt::format("two scans are named '{}' ('{}' and '{}'): names must be "
+                                                          "unique, they name the results",
+                                                          name, by_name[name].path.string(), file.string()));
+    auto digest = sha256_file(file);
+    if (!digest) return std::unexpected(digest.error());
+    std::error_code ec;
+    by_name[name] = {name, file, *digest, fs::file_size(file, ec)};
+  }
+  std::vector<ScanItem> items;
+  for (auto& [name, item] : by_name) items.push_back(std::move(item));
+  return items;
+}
+
+std::uint64_t item_seed(std::uint64_t run_seed, const std::string& sha256) {
+  return hash_text(run_seed, sha256);
+}
+
+namespace {
+ScanShape shape_of(const PreparedBody& body) {
+  ScanShape s;
+  s.volume = body.properties.volume;
+  s.mass = body.properties.mass;
+  s.area = surface_area(body.soup);
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(1e300), high = -low;
+  for (const auto& p : body.soup.points) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  std::array<double, 3> d{high.x() - low.x(), high.y() - low.y(), high.z() - low.z()};
+  std::sort(d.begin(), d.end(), std::greater<>());
+  s.length = d[0];
+  s.width = d[1];
+  s.thickness = d[2];
+  s.sphericity = std::cbrt(M_PI) * std::pow(6.0 * s.volume, 2.0 / 3.0) / s.area;
+  s.elongation = s.width / s.length;
+  s.flatness = s.thickness / s.width;
+  return s;
+}
+
+Result<LabSummary> run_test(const Clump& clump, LabTest test, const std::string& surface, int trials,
+                            std::uint64_t seed, const RunContext& context) {
+  Recording setup;
+  setup.test = test;
+  setup.surface = surface;
+  if (test == LabTest::Tilt) setup.composite = Composite::FourSquare;
+  LabOptions options;
+  options.trials = trials;
+  options.seed = seed;
+  auto run = run_lab_test(clump, default_material_table(), setup, options, context);
+  if (!run) return std::unexpected(run.error());
+  LabSummary s{clump.name, surface, test, run->recording.summaries()};
+  const double n = static_cast<double>(s.values.size());
+  s.mean = std::accumulate(s.values.begin(), s.values.end(), 0.0) / n;
+  double squares = 0.0;
+  for (double v : s.values) squares += (v - s.mean) * (v - s.mean);
+  s.standard_deviation = n > 1 ? std::sqrt(squares / (n - 1)) : 0.0;
+  return s;
+}
+
+// The scan's body: loaded, repaired, checked closed, in its principal frame.
+Result<PreparedBody> body_of(const ScanItem& item, const BatchOptions& options, ItemResult& result,
+                             const RunContext& context) {
+  auto clock = std::chrono::steady_clock::now();
+  auto lap = [&](const char* stage) {
+    const auto now = std::chrono::steady_clock::now();
+    result.stage_seconds.emplace_back(stage, std::chrono::duration<double>(now - clock).count());
+    clock = now;
+  };
+  auto loaded = load_mesh(item.path, {.unit = options.units});
+  if (!loaded) return std::unexpected(loaded.error());
+  auto repaired = repair_mesh(std::move(loaded->soup), {}, context);
+  if (!repaired) return std::unexpected(repaired.error());
+  lap("repair");
+  double smallest = 1e-3;
+  for (const auto& f : options.fills)
+    if (f.method == FillMethod::Lattice) smallest = std::min(smallest, f.diameter);
+  SdfOptions sdf;
+  sdf.feature_size = smallest;
+  auto body = prepare_body(repaired->soup, options.density, sdf, context);
+  lap("mass properties and signed distance");
+  return body;
+}
+}  // namespace
+
+Result<ItemResult> run_item(const ScanItem& item, const BatchOptions& options, const RunContext& context) {
+  ItemResult result{.scan = item.name, .sha256 = item.sha256, .seed = item_seed(options.seed, item.sha256)};
+  auto failed = [&](const Error& e) -> Result<ItemResult> {
+    if (e.code == ErrorCode::Cancelled) return std::unexpected(e);
+    result.error = e.message;
+    result.clumps.clear();
+    result.outcomes.clear();
+    return result;
+  };
+  auto body = body_of(item, options, result, context);
+  if (!body) return failed(body.error());
+  result.shape = shape_of(*body);
+  for (std::size_t k = 0; k < options.fills.size(); ++k) {
+    const FillSpec& spec = options.fills[k];
+    const auto started = std::chrono::steady_clock::now();
+    FillOptions fill_options;
+    fill_options.method = spec.method;
+    fill_options.diameter = spec.diameter;
+    fill_options.max_spheres = spec.max_spheres;
+    auto filled = fill_body(*body, fill_options, context);
+    if (!filled) return failed(filled.error());
+    filled->clump.source_sha256 = item.sha256;
+    result.clumps.push_back(std::move(filled->clump));
+    result.stage_seconds.emplace_back(
+        "fill " + result.clumps.back().name,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    if (!spec.validate) continue;
+    for (const std::string& surface : options.surfaces) {
+      for (LabTest test : options.tests) {
+        const auto dem_started = std::chrono::steady_clock::now();
+        const Clump& clump = result.clumps.back();
+        const std::string key = fmt::format("{}/{}/{}", clump.name, to_string(test), surface);
+        auto summary = run_test(clump, test, surface, options.trials, hash_text(result.seed, key), context);
+        if (!summary) return failed(summary.error());
+        result.outcomes.push_back(std::move(*summary));
+        result.stage_seconds.emplace_back(
+            "dem " + key, std::chrono::duration<double>(std::chrono::steady_clock::now() - dem_started).count());
+      }
+    }
+  }
+  return result;
+}
+
+}  // namespace clumpforge

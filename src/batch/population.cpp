@@ -1,0 +1,198 @@
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "batch/batch.hpp"
+#include "core/atomic_file.hpp"
+#include "io/clump_library.hpp"
+
+namespace clumpforge {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+std::string number(double v) {
+  return fmt::format("{:.10g}", v);
+}
+
+// One CSV row per scan and clump; the DEM columns are the options' tests x surfaces, empty
+// for a clump that was not validated.
+std::string population_csv(const std::vector<ItemResult>& items, const BatchOptions& o) {
+  std::string csv =
+      "scan,sha256,clump,method,spheres,volume_m3,mass_kg,length_m,width_m,thickness_m,sphericity,elongation,"
+      "flatness,mass_error,worst_moment_error_mass_matched,com_offset_m,axis_error_deg,surface_rms_m,dice";
+  for (const auto& surface : o.surfaces)
+    for (LabTest t : o.tests) csv += fmt::format(",{0}_{1}_mean,{0}_{1}_sd", to_string(t), surface);
+  csv += "\n";
+  for (const auto& r : items) {
+    if (!r.error.empty()) continue;
+    for (const Clump& c : r.clumps) {
+      const ClumpError& e = c.error;
+      csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", r.scan, r.sha256, c.name,
+                         to_string(c.method), c.spheres.size(), number(r.shape.volume), number(r.shape.mass),
+                         number(r.shape.length), number(r.shape.width), number(r.shape.thickness),
+                         number(r.shape.sphericity), number(r.shape.elongation), number(r.shape.flatness),
+                         number(e.mass_error), number(e.principal_moment_errors_mass_matched.cwiseAbs().maxCoeff()),
+                         number(e.com_offset_norm), number(e.axis_error_deg), number(e.surface_rms), number(e.dice));
+      for (const auto& surface : o.surfaces) {
+        for (LabTest t : o.tests) {
+          auto found = std::find_if(r.outcomes.begin(), r.outcomes.end(), [&](const LabSummary& s) {
+            return s.clump == c.name && s.surface == surface && s.test == t;
+          });
+          csv += found == r.outcomes.end() ? ",," : "," + number(found->mean) + "," + number(found->standard_deviation);
+        }
+      }
+      csv += "\n";
+    }
+  }
+  return csv;
+}
+
+json population_json(const std::vector<ItemResult>& items) {
+  json scans = json::array(), failed = json::array();
+  for (const auto& r : items) {
+    if (!r.error.empty()) {
+      failed.push_back({{"scan", r.scan}, {"sha256", r.sha256}, {"error", r.error}});
+      continue;
+    }
+    json clumps = json::array();
+    for (const Clump& c : r.clumps) {
+      json outcomes = json::array();
+      for (const auto& s : r.outcomes)
+        if (s.clump == c.name)
+          outcomes.push_back({{"test", std::string(to_string(s.test))},
+                              {"surface", s.surface},
+                              {"values", s.values},
+                              {"mean", s.mean},
+                              {"standard_deviation", s.standard_deviation}});
+      clumps.push_back(
+          {{"name", c.name},
+           {"method", std::string(to_string(c.method))},
+           {"spheres", c.spheres.size()},
+           {"mass_error", c.error.mass_error},
+           {"worst_moment_error_mass_matched", c.error.principal_moment_errors_mass_matched.cwiseAbs().maxCoeff()},
+           {"surface_rms_m", c.error.surface_rms},
+           {"dice", c.error.dice},
+           {"outcomes", outcomes}});
+    }
+    scans.push_back({{"scan", r.scan},
+                     {"sha256", r.sha256},
+                     {"seed", std::to_string(r.seed)},
+                     {"volume_m3", r.shape.volume},
+                     {"mass_kg", r.shape.mass},
+                     {"length_m", r.shape.length},
+                     {"width_m", r.shape.width},
+                     {"thickness_m", r.shape.thickness},
+                     {"sphericity", r.shape.sphericity},
+                     {"elongation", r.shape.elongation},
+                     {"flatness", r.shape.flatness},
+                     {"clumps", clumps}});
+  }
+  return {{"format", "clumpforge-population/1"}, {"scans", scans}, {"failed", failed}};
+}
+}  // namespace
+
+Result<void> assemble_population(const fs::path& dir, std::span<const ScanItem> items, const BatchOptions& options) {
+  std::vector<ItemResult> results;
+  std::vector<ScanClumps> library;
+  for (const ScanItem& item : items) {
+    auto stored = load_item(dir, item, options);
+    if (!stored)
+      return fail(ErrorCode::NotFound, fmt::format("'{}': scan '{}' has no stored result", dir.string(), item.name));
+    if (stored->error.empty()) library.push_back({stored->scan, stored->clumps});
+    results.push_back(std::move(*stored));
+  }
+  std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.scan < b.scan; });
+  std::sort(library.begin(), library.end(), [](const auto& a, const auto& b) { return a.scan < b.scan; });
+  if (library.empty()) return fail(ErrorCode::InvalidArgument, "every scan failed: no population to assemble");
+  if (auto ok = write_population_library(dir / "library.h5", library); !ok) return ok;
+  return write_files_atomically({{dir / "population.csv", population_csv(results, options)},
+                                 {dir / "population.json", population_json(results).dump(1) + "\n"}});
+}
+
+Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& options, const RunContext& context) {
+  if (plan.shards < 1 || plan.shard < 1 || plan.shard > plan.shards)
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("shard {}/{} is not one of 1..N of N >= 1", plan.shard, plan.shards));
+  std::vector<const ScanItem*> mine;
+  for (std::size_t i = 0; i < plan.items.size(); ++i)
+    if (static_cast<int>(i % static_cast<std::size_t>(plan.shards)) == plan.shard - 1) mine.push_back(&plan.items[i]);
+  // Largest first: the long items start early and the end of the run is not one big scan.
+  std::stable_sort(mine.begin(), mine.end(), [](const ScanItem* a, const ScanItem* b) { return a->bytes > b->bytes; });
+  BatchSummary summary;
+  for (std::size_t k = 0; k < mine.size(); ++k) {
+    const ScanItem& item = *mine[k];
+    context.report(fmt::format("{} ({} of {})", item.name, k + 1, mine.size()), static_cast<double>(k) / mine.size());
+    if (plan.resume) {
+      if (auto stored = load_item(plan.output, item, options)) {
+        summary.reused.push_back(item.name);
+        if (!stored->error.empty()) summary.failed.push_back(item.name + ": " + stored->error);
+        continue;
+      }
+    }
+    auto result = run_item(item, options, context);
+    if (!result) return std::unexpected(result.error());
+    if (auto ok = store_item(plan.output, *result, options); !ok) return std::unexpected(ok.error());
+    if (result->error.empty())
+      summary.done.push_back(item.name);
+    else
+      summary.failed.push_back(item.name + ": " + result->error);
+  }
+  context.report("done", 1.0);
+  for (const ScanItem& item : plan.items)
+    if (!load_item(plan.output, item, options)) summary.missing.push_back(item.name);
+  if (summary.missing.empty()) {
+    if (auto ok = assemble_population(plan.output, plan.items, options); !ok) return std::unexpected(ok.error());
+    summary.assembled = true;
+  }
+  return summary;
+}
+
+Result<BatchSummary> merge_batches(std::span<const fs::path> dirs, const fs::path& output,
+                                   const BatchOptions& options) {
+  std::map<std::string, ScanItem> items;
+  BatchSummary summary;
+  for (const fs::path& dir : dirs) {
+    std::error_code ec;
+    if (!fs::is_directory(dir / "items", ec))
+      return fail(ErrorCode::NotFound, fmt::format("'{}' is not a batch output folder (no items/)", dir.string()));
+    std::vector<fs::path> records;
+    for (const auto& entry : fs::directory_iterator(dir / "items", ec))
+      if (entry.path().extension() == ".json") records.push_back(entry.path());
+    std::sort(records.begin(), records.end());
+    for (const fs::path& record : records) {
+      const ScanItem probe{record.stem().string(), {}, {}, 0};
+      ScanItem item = probe;
+      std::ifstream in(record);
+      try {
+        item.sha256 = json::parse(in).at("sha256").get<std::string>();
+      } catch (const std::exception&) {
+        return fail(ErrorCode::ParseError, fmt::format("'{}' is not a batch item record", record.string()));
+      }
+      auto stored = load_item(dir, item, options);
+      if (!stored)
+        return fail(ErrorCode::InvalidArgument, fmt::format("'{}' was made with other batch options (give --merge the "
+                                                            "options the shards ran with) or is damaged",
+                                                            record.string()));
+      if (auto known = items.find(item.name); known != items.end()) {
+        if (known->second.sha256 != item.sha256)
+          return fail(ErrorCode::InvalidArgument, fmt::format("scan '{}' differs between the shards", item.name));
+        continue;
+      }
+      if (auto ok = store_item(output, *stored, options); !ok) return std::unexpected(ok.error());
+      summary.reused.push_back(item.name);
+      if (!stored->error.empty()) summary.failed.push_back(item.name + ": " + stored->error);
+      items.emplace(item.name, std::move(item));
+    }
+  }
+  std::vector<ScanItem> all;
+  for (auto& [name, item] : items) all.push_back(std::move(item));
+  if (auto ok = assemble_population(output, all, options); !ok) return std::unexpected(ok.error());
+  summary.assembled = true;
+  return summary;
+}
+
+}  // namespace clumpforge
