@@ -163,7 +163,7 @@ CLI::Option* add_clump_option(CLI::App& app, std::string& clump, const std::stri
 }
 
 // "1,2,4mm" or "1mm,2mm" -> metres; the unit of the last item applies to bare numbers.
-Result<std::vector<double>> parse_diameter_list(const std::string& text) {
+std::vector<std::string> split_list(const std::string& text) {
   std::vector<std::string> items;
   std::size_t start = 0;
   while (start <= text.size()) {
@@ -172,6 +172,11 @@ Result<std::vector<double>> parse_diameter_list(const std::string& text) {
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
+  return items;
+}
+
+Result<std::vector<double>> parse_diameter_list(const std::string& text) {
+  const std::vector<std::string> items = split_list(text);
   std::string unit;
   const std::string& last = items.back();
   const auto unit_start = last.find_first_not_of("0123456789.eE+- ");

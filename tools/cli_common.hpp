@@ -64,6 +64,8 @@ CLI::Option* add_units_option(CLI::App& app, std::string& units, const std::stri
 CLI::Option* add_density_option(CLI::App& app, double& density, const std::string& what);
 inline constexpr const char* kSharedOptions = "Shared options";
 
+/// "a, b,c" -> {"a", "b", "c"} (each trimmed; empty items kept, for the caller to refuse).
+std::vector<std::string> split_list(const std::string& text);
 /// "1,2,4mm" or "1mm,2mm" -> metres; the unit of the last item applies to bare numbers.
 Result<std::vector<double>> parse_diameter_list(const std::string& text);
 

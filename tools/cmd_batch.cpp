@@ -3,13 +3,14 @@
 // clumpforge batch --merge SHARD_DIR... -o DIR
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iostream>
 #include <set>
+#include <sstream>
 
 #include "batch/batch.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
-#include "core/text.hpp"
 
 namespace clumpforge::cli {
 namespace {
@@ -28,19 +29,6 @@ struct BatchArgs {
   bool resume = false, merge = false, json = false;
 };
 
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const auto comma = text.find(',', start);
-    const std::string item(trim(std::string_view(text).substr(start, comma - start)));
-    if (!item.empty()) out.push_back(item);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
 Result<BatchOptions> options_of(const BatchArgs& a) {
   BatchOptions o;
   auto unit = parse_length_unit(a.units);
@@ -53,7 +41,7 @@ Result<BatchOptions> options_of(const BatchArgs& a) {
   if (a.trials < 1 || a.trials > 10000) return fail(ErrorCode::InvalidArgument, "--trials must be between 1 and 10000");
   o.trials = a.trials;
   o.seed = a.seed;
-  const auto wanted = split(a.validate);
+  const auto wanted = split_list(a.validate);
   std::set<std::string> validated(wanted.begin(), wanted.end()), known;
   o.fills.clear();
   if (!a.diameters.empty() && a.diameters != "none") {
@@ -73,22 +61,18 @@ Result<BatchOptions> options_of(const BatchArgs& a) {
   }
   if (o.fills.empty()) return fail(ErrorCode::InvalidArgument, "no clumps to make: give --diameters or --budgets");
   for (const auto& v : wanted)
-    if (!known.contains(v))
+    if (!v.empty() && v != "none" && !known.contains(v))
       return fail(ErrorCode::InvalidArgument,
                   fmt::format("--validate {}: not one of the clumps made ({})", v, fmt::join(known, ", ")));
   o.tests.clear();
-  for (const auto& t : split(a.tests)) {
-    if (t == "drop")
-      o.tests.push_back(LabTest::Drop);
-    else if (t == "tilt")
-      o.tests.push_back(LabTest::Tilt);
-    else if (t == "roll")
-      o.tests.push_back(LabTest::Roll);
-    else
-      return fail(ErrorCode::InvalidArgument, fmt::format("--tests: unknown test '{}' (drop, tilt, roll)", t));
+  for (const auto& t : split_list(a.tests)) {
+    auto test = parse_lab_test(t);
+    if (!test) return fail(ErrorCode::InvalidArgument, "--tests: " + test.error().message);
+    o.tests.push_back(*test);
   }
-  o.surfaces = split(a.surfaces);
-  if (o.surfaces.empty()) return fail(ErrorCode::InvalidArgument, "--surfaces: give at least one surface");
+  o.surfaces = split_list(a.surfaces);
+  if (std::find(o.surfaces.begin(), o.surfaces.end(), "") != o.surfaces.end())
+    return fail(ErrorCode::InvalidArgument, fmt::format("--surfaces '{}': an empty surface name", a.surfaces));
   return o;
 }
 

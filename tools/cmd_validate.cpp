@@ -28,14 +28,6 @@ struct ValidateArgs {
   bool json = false, limit_force = false;
 };
 
-Result<LabTest> parse_test(const std::string& name) {
-  if (name == "drop") return LabTest::Drop;
-  if (name == "tilt") return LabTest::Tilt;
-  if (name == "roll") return LabTest::Roll;
-  return fail(ErrorCode::InvalidArgument, fmt::format("unknown test '{}'{} (drop, tilt or roll)", name,
-                                                      did_you_mean(name, {"drop", "tilt", "roll"})));
-}
-
 struct Spread {
   double mean = 0.0, std = 0.0, min = 0.0, max = 0.0;
 };
@@ -53,7 +45,7 @@ Spread spread(const std::vector<double>& v) {
 
 int run_validate(const ValidateArgs& args) {
   constexpr std::string_view kCommand = "validate";
-  auto test = parse_test(args.test);
+  auto test = parse_lab_test(args.test);
   if (!test) return report_error(kCommand, test.error());
   if (args.trials < 1 || args.trials > 100000)
     return report_error(kCommand, {ErrorCode::InvalidArgument, "--trials must be between 1 and 100000"});

@@ -10,10 +10,7 @@ namespace clumpforge::python {
 namespace {
 
 LabTest test_of(const std::string& name) {
-  if (name == "drop") return LabTest::Drop;
-  if (name == "tilt") return LabTest::Tilt;
-  if (name == "roll") return LabTest::Roll;
-  raise({ErrorCode::InvalidArgument, "unknown test '" + name + "' (drop, tilt or roll)"});
+  return unwrap(parse_lab_test(name));
 }
 
 ContactConventions conventions_of(const std::string& name) {

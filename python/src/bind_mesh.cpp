@@ -4,6 +4,7 @@
 #include "mesh/load.hpp"
 #include "mesh/mass_properties.hpp"
 #include "mesh/mesh_writer.hpp"
+#include "mesh/public_mesh.hpp"
 #include "mesh/repair.hpp"
 #include "mesh/topology.hpp"
 #include "mesh/triangle_mesh.hpp"
@@ -28,24 +29,13 @@ RowFaces faces_of(const TriangleSoup& soup) {
 }
 
 TriangleSoup soup_from(const Eigen::Ref<const RowVertices>& vertices, const Eigen::Ref<const RowFaces>& faces) {
-  TriangleSoup soup;
-  soup.points.reserve(static_cast<std::size_t>(vertices.rows()));
-  for (Eigen::Index i = 0; i < vertices.rows(); ++i) {
-    if (!vertices.row(i).allFinite())
-      raise({ErrorCode::InvalidArgument, "vertex " + std::to_string(i) + " is not finite"});
-    soup.points.emplace_back(vertices.row(i).transpose());
-  }
-  const int n = static_cast<int>(vertices.rows());
-  soup.faces.reserve(static_cast<std::size_t>(faces.rows()));
-  for (Eigen::Index i = 0; i < faces.rows(); ++i) {
-    std::array<int, 3> face{faces(i, 0), faces(i, 1), faces(i, 2)};
-    for (int index : face)
-      if (index < 0 || index >= n)
-        raise({ErrorCode::InvalidArgument,
-               "face " + std::to_string(i) + " names vertex " + std::to_string(index) + " of " + std::to_string(n)});
-    soup.faces.push_back(face);
-  }
-  return soup;
+  Mesh mesh;
+  mesh.vertices.reserve(static_cast<std::size_t>(vertices.rows()));
+  for (Eigen::Index i = 0; i < vertices.rows(); ++i)
+    mesh.vertices.push_back({vertices(i, 0), vertices(i, 1), vertices(i, 2)});
+  mesh.faces.reserve(static_cast<std::size_t>(faces.rows()));
+  for (Eigen::Index i = 0; i < faces.rows(); ++i) mesh.faces.push_back({faces(i, 0), faces(i, 1), faces(i, 2)});
+  return unwrap(soup_of(mesh));  // checks finite vertices and faces in range, with the library's messages
 }
 
 LengthUnit unit_of(const std::string& units) {

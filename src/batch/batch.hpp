@@ -93,8 +93,9 @@ std::string options_fingerprint(const BatchOptions& options);
 /// Items are stored in `dir/items/<scan>.json` (+ `<scan>.h5` with its clumps), each
 /// written atomically when it finishes.
 Result<void> store_item(const std::filesystem::path& dir, const ItemResult& result, const BatchOptions& options);
-/// The stored item of `item`, when there is one made from the same content and options.
-std::optional<ItemResult> load_item(const std::filesystem::path& dir, const ScanItem& item,
+/// The stored result of scan `scan` in `dir`, when there is one made with these options and
+/// not damaged (compare its sha256 with the scan's before reusing it).
+std::optional<ItemResult> load_item(const std::filesystem::path& dir, const std::string& scan,
                                     const BatchOptions& options);
 
 struct BatchPlan {
@@ -110,12 +111,12 @@ struct BatchSummary {
 };
 
 /// Runs the plan's items (largest first) and, when every item is stored, assembles the
-/// population. `on_item` (may be empty) is told after each item.
+/// population; progress through `context`, one step per item.
 Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& options, const RunContext& context = {});
 
-/// Assembles the population from the stored items of `items` in `dir` (all must be stored):
-/// `library.h5` (one group per scan), `population.csv` and `population.json`, in name order.
-Result<void> assemble_population(const std::filesystem::path& dir, std::span<const ScanItem> items,
+/// Writes the population of `results` (every scan's) into `dir`: `library.h5` (one group
+/// per scan), `population.csv` and `population.json`, in the scans' name order.
+Result<void> assemble_population(const std::filesystem::path& dir, std::vector<ItemResult> results,
                                  const BatchOptions& options);
 
 /// Joins the stored items of shard runs (`dirs`, each a batch output folder made with the

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <map>
-#include <numeric>
 
 #include "batch/batch.hpp"
 #include "core/rng.hpp"
@@ -16,6 +15,7 @@
 #include "mesh/load.hpp"
 #include "mesh/repair.hpp"
 #include "mesh/triangle_mesh.hpp"
+#include "numerics/statistics.hpp"
 
 namespace clumpforge {
 namespace fs = std::filesystem;
@@ -75,12 +75,8 @@ ScanShape shape_of(const PreparedBody& body) {
   s.volume = body.properties.volume;
   s.mass = body.properties.mass;
   s.area = surface_area(body.soup);
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(1e300), high = -low;
-  for (const auto& p : body.soup.points) {
-    low = low.cwiseMin(p);
-    high = high.cwiseMax(p);
-  }
-  std::array<double, 3> d{high.x() - low.x(), high.y() - low.y(), high.z() - low.z()};
+  const Eigen::Vector3d size = bounding_box(body.soup).size();
+  std::array<double, 3> d{size.x(), size.y(), size.z()};
   std::sort(d.begin(), d.end(), std::greater<>());
   s.length = d[0];
   s.width = d[1];
@@ -103,11 +99,9 @@ Result<LabSummary> run_test(const Clump& clump, LabTest test, const std::string&
   auto run = run_lab_test(clump, default_material_table(), setup, options, context);
   if (!run) return std::unexpected(run.error());
   LabSummary s{clump.name, surface, test, run->recording.summaries()};
-  const double n = static_cast<double>(s.values.size());
-  s.mean = std::accumulate(s.values.begin(), s.values.end(), 0.0) / n;
-  double squares = 0.0;
-  for (double v : s.values) squares += (v - s.mean) * (v - s.mean);
-  s.standard_deviation = n > 1 ? std::sqrt(squares / (n - 1)) : 0.0;
+  const SampleSpread spread = sample_spread(s.values);
+  s.mean = spread.mean;
+  s.standard_deviation = spread.sd;
   return s;
 }
 

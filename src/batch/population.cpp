@@ -95,57 +95,65 @@ json population_json(const std::vector<ItemResult>& items) {
 }
 }  // namespace
 
-Result<void> assemble_population(const fs::path& dir, std::span<const ScanItem> items, const BatchOptions& options) {
-  std::vector<ItemResult> results;
-  std::vector<ScanClumps> library;
-  for (const ScanItem& item : items) {
-    auto stored = load_item(dir, item, options);
-    if (!stored)
-      return fail(ErrorCode::NotFound, fmt::format("'{}': scan '{}' has no stored result", dir.string(), item.name));
-    if (stored->error.empty()) library.push_back({stored->scan, stored->clumps});
-    results.push_back(std::move(*stored));
-  }
+Result<void> assemble_population(const fs::path& dir, std::vector<ItemResult> results, const BatchOptions& options) {
   std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.scan < b.scan; });
-  std::sort(library.begin(), library.end(), [](const auto& a, const auto& b) { return a.scan < b.scan; });
+  std::vector<ScanClumps> library;
+  for (const ItemResult& r : results)
+    if (r.error.empty()) library.push_back({r.scan, r.clumps});
   if (library.empty()) return fail(ErrorCode::InvalidArgument, "every scan failed: no population to assemble");
   if (auto ok = write_population_library(dir / "library.h5", library); !ok) return ok;
   return write_files_atomically({{dir / "population.csv", population_csv(results, options)},
                                  {dir / "population.json", population_json(results).dump(1) + "\n"}});
 }
 
+namespace {
+// The stored result of `item`, when it was made from this content with these options.
+std::optional<ItemResult> load_current(const fs::path& dir, const ScanItem& item, const BatchOptions& options) {
+  auto stored = load_item(dir, item.name, options);
+  if (stored && stored->sha256 != item.sha256) return std::nullopt;
+  return stored;
+}
+}  // namespace
+
 Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& options, const RunContext& context) {
   if (plan.shards < 1 || plan.shard < 1 || plan.shard > plan.shards)
     return fail(ErrorCode::InvalidArgument,
                 fmt::format("shard {}/{} is not one of 1..N of N >= 1", plan.shard, plan.shards));
-  std::vector<const ScanItem*> mine;
+  std::vector<const ScanItem*> mine, others;
   for (std::size_t i = 0; i < plan.items.size(); ++i)
-    if (static_cast<int>(i % static_cast<std::size_t>(plan.shards)) == plan.shard - 1) mine.push_back(&plan.items[i]);
+    (static_cast<int>(i % static_cast<std::size_t>(plan.shards)) == plan.shard - 1 ? mine : others)
+        .push_back(&plan.items[i]);
   // Largest first: the long items start early and the end of the run is not one big scan.
   std::stable_sort(mine.begin(), mine.end(), [](const ScanItem* a, const ScanItem* b) { return a->bytes > b->bytes; });
   BatchSummary summary;
+  std::vector<ItemResult> results;
   for (std::size_t k = 0; k < mine.size(); ++k) {
     const ScanItem& item = *mine[k];
     context.report(fmt::format("{} ({} of {})", item.name, k + 1, mine.size()), static_cast<double>(k) / mine.size());
-    if (plan.resume) {
-      if (auto stored = load_item(plan.output, item, options)) {
-        summary.reused.push_back(item.name);
-        if (!stored->error.empty()) summary.failed.push_back(item.name + ": " + stored->error);
-        continue;
-      }
+    std::optional<ItemResult> stored = plan.resume ? load_current(plan.output, item, options) : std::nullopt;
+    if (stored) {
+      summary.reused.push_back(item.name);
+    } else {
+      auto result = run_item(item, options, context);
+      if (!result) return std::unexpected(result.error());
+      if (auto ok = store_item(plan.output, *result, options); !ok) return std::unexpected(ok.error());
+      if (result->error.empty()) summary.done.push_back(item.name);
+      stored = std::move(*result);
     }
-    auto result = run_item(item, options, context);
-    if (!result) return std::unexpected(result.error());
-    if (auto ok = store_item(plan.output, *result, options); !ok) return std::unexpected(ok.error());
-    if (result->error.empty())
-      summary.done.push_back(item.name);
-    else
-      summary.failed.push_back(item.name + ": " + result->error);
+    if (!stored->error.empty()) summary.failed.push_back(item.name + ": " + stored->error);
+    results.push_back(std::move(*stored));
   }
   context.report("done", 1.0);
-  for (const ScanItem& item : plan.items)
-    if (!load_item(plan.output, item, options)) summary.missing.push_back(item.name);
+  // Another shard's items, when it wrote into the same folder.
+  for (const ScanItem* item : others) {
+    if (auto stored = load_current(plan.output, *item, options))
+      results.push_back(std::move(*stored));
+    else
+      summary.missing.push_back(item->name);
+  }
   if (summary.missing.empty()) {
-    if (auto ok = assemble_population(plan.output, plan.items, options); !ok) return std::unexpected(ok.error());
+    if (auto ok = assemble_population(plan.output, std::move(results), options); !ok)
+      return std::unexpected(ok.error());
     summary.assembled = true;
   }
   return summary;
@@ -153,7 +161,7 @@ Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& option
 
 Result<BatchSummary> merge_batches(std::span<const fs::path> dirs, const fs::path& output,
                                    const BatchOptions& options) {
-  std::map<std::string, ScanItem> items;
+  std::map<std::string, ItemResult> items;
   BatchSummary summary;
   for (const fs::path& dir : dirs) {
     std::error_code ec;
@@ -164,33 +172,25 @@ Result<BatchSummary> merge_batches(std::span<const fs::path> dirs, const fs::pat
       if (entry.path().extension() == ".json") records.push_back(entry.path());
     std::sort(records.begin(), records.end());
     for (const fs::path& record : records) {
-      const ScanItem probe{record.stem().string(), {}, {}, 0};
-      ScanItem item = probe;
-      std::ifstream in(record);
-      try {
-        item.sha256 = json::parse(in).at("sha256").get<std::string>();
-      } catch (const std::exception&) {
-        return fail(ErrorCode::ParseError, fmt::format("'{}' is not a batch item record", record.string()));
-      }
-      auto stored = load_item(dir, item, options);
+      auto stored = load_item(dir, record.stem().string(), options);
       if (!stored)
         return fail(ErrorCode::InvalidArgument, fmt::format("'{}' was made with other batch options (give --merge the "
                                                             "options the shards ran with) or is damaged",
                                                             record.string()));
-      if (auto known = items.find(item.name); known != items.end()) {
-        if (known->second.sha256 != item.sha256)
-          return fail(ErrorCode::InvalidArgument, fmt::format("scan '{}' differs between the shards", item.name));
+      if (auto known = items.find(stored->scan); known != items.end()) {
+        if (known->second.sha256 != stored->sha256)
+          return fail(ErrorCode::InvalidArgument, fmt::format("scan '{}' differs between the shards", stored->scan));
         continue;
       }
       if (auto ok = store_item(output, *stored, options); !ok) return std::unexpected(ok.error());
-      summary.reused.push_back(item.name);
-      if (!stored->error.empty()) summary.failed.push_back(item.name + ": " + stored->error);
-      items.emplace(item.name, std::move(item));
+      summary.reused.push_back(stored->scan);
+      if (!stored->error.empty()) summary.failed.push_back(stored->scan + ": " + stored->error);
+      items.emplace(stored->scan, std::move(*stored));
     }
   }
-  std::vector<ScanItem> all;
-  for (auto& [name, item] : items) all.push_back(std::move(item));
-  if (auto ok = assemble_population(output, all, options); !ok) return std::unexpected(ok.error());
+  std::vector<ItemResult> results;
+  for (auto& [name, result] : items) results.push_back(std::move(result));
+  if (auto ok = assemble_population(output, std::move(results), options); !ok) return std::unexpected(ok.error());
   summary.assembled = true;
   return summary;
 }

@@ -61,9 +61,6 @@ std::optional<std::string> read_text(const fs::path& path) {
   return text.str();
 }
 
-LabTest test_named(const std::string& name) {
-  return name == "drop" ? LabTest::Drop : name == "roll" ? LabTest::Roll : LabTest::Tilt;
-}
 }  // namespace
 
 std::string options_fingerprint(const BatchOptions& options) {
@@ -102,23 +99,22 @@ Result<void> store_item(const fs::path& dir, const ItemResult& r, const BatchOpt
   return write_files_atomically({{item_json(dir, r.scan), j.dump(1) + "\n"}});
 }
 
-std::optional<ItemResult> load_item(const fs::path& dir, const ScanItem& item, const BatchOptions& options) {
-  auto text = read_text(item_json(dir, item.name));
+std::optional<ItemResult> load_item(const fs::path& dir, const std::string& scan, const BatchOptions& options) {
+  auto text = read_text(item_json(dir, scan));
   if (!text) return std::nullopt;
   try {
     const json j = json::parse(*text);
-    if (j.at("format") != kItemFormat || j.at("sha256") != item.sha256 ||
-        j.at("options_sha256") != options_fingerprint(options))
+    if (j.at("format") != kItemFormat || j.at("scan") != scan || j.at("options_sha256") != options_fingerprint(options))
       return std::nullopt;
     ItemResult r{.scan = j.at("scan"), .sha256 = j.at("sha256"), .seed = std::stoull(j.at("seed").get<std::string>())};
     r.error = j.at("error");
     r.shape = shape_from(j.at("shape"));
     for (const auto& o : j.at("outcomes"))
-      r.outcomes.push_back({o.at("clump"), o.at("surface"), test_named(o.at("test")), o.at("values"), o.at("mean"),
-                            o.at("standard_deviation")});
+      r.outcomes.push_back({o.at("clump"), o.at("surface"), parse_lab_test(o.at("test").get<std::string>()).value(),
+                            o.at("values"), o.at("mean"), o.at("standard_deviation")});
     for (const auto& [stage, s] : j.at("stage_seconds").items()) r.stage_seconds.emplace_back(stage, s.get<double>());
     if (r.error.empty()) {
-      auto clumps = read_clump_library(item_h5(dir, item.name));
+      auto clumps = read_clump_library(item_h5(dir, scan));
       if (!clumps) return std::nullopt;
       r.clumps = std::move(*clumps);
     }

@@ -1,21 +1,36 @@
 #include "core/recording.hpp"
 
+#include "core/text.hpp"
+
 namespace clumpforge {
 
 std::string_view to_string(LabTest test) {
   switch (test) {
-    case LabTest::Drop: return "drop";
-    case LabTest::Roll: return "roll";
-    case LabTest::Tilt: return "tilt";
+    case LabTest::Drop:
+      return "drop";
+    case LabTest::Roll:
+      return "roll";
+    case LabTest::Tilt:
+      return "tilt";
   }
   return "drop";
 }
 
+Result<LabTest> parse_lab_test(std::string_view name) {
+  for (LabTest test : {LabTest::Drop, LabTest::Roll, LabTest::Tilt})
+    if (name == to_string(test)) return test;
+  return fail(ErrorCode::InvalidArgument, "unknown test '" + std::string(name) + "'" +
+                                              did_you_mean(name, {"drop", "roll", "tilt"}) + " (drop, roll or tilt)");
+}
+
 std::string_view summary_key(LabTest test) {
   switch (test) {
-    case LabTest::Drop: return "rebound_height_m";
-    case LabTest::Roll: return "roll_distance_m";
-    case LabTest::Tilt: return "slip_angle_deg";
+    case LabTest::Drop:
+      return "rebound_height_m";
+    case LabTest::Roll:
+      return "roll_distance_m";
+    case LabTest::Tilt:
+      return "slip_angle_deg";
   }
   return "";
 }

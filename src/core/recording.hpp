@@ -8,12 +8,15 @@
 #include <vector>
 
 #include "clumpforge/core.hpp"  // LabTest
+#include "core/error.hpp"
 
 namespace clumpforge {
 
 enum class Composite { Single, FourSquare };
 
 std::string_view to_string(LabTest test);
+/// "drop", "roll" or "tilt"; anything else is an error naming it, with a "did you mean".
+Result<LabTest> parse_lab_test(std::string_view name);
 std::string_view summary_key(LabTest test);  ///< rebound_height_m, roll_distance_m, slip_angle_deg
 
 /// One trial's track: a row per video frame; NaN where tracking was lost.

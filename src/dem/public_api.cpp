@@ -1,11 +1,11 @@
 // The installed interface of the dem module (<clumpforge/dem.hpp>) over the library's own.
 #include <cmath>
-#include <numeric>
 
 #include "clumpforge/dem.hpp"
 #include "core/public_types.hpp"
 #include "dem/lab.hpp"
 #include "dem/materials.hpp"
+#include "numerics/statistics.hpp"
 
 namespace clumpforge {
 
@@ -27,11 +27,9 @@ Result<LabOutcome> run_lab_test(const SphereClump& clump, const LabRequest& requ
   auto run = run_lab_test(*internal, default_material_table(), setup, options, context);
   if (!run) return std::unexpected(run.error());
   LabOutcome out{.quantity = std::string(summary_key(request.test)), .values = run->recording.summaries()};
-  const double n = static_cast<double>(out.values.size());
-  out.mean = std::accumulate(out.values.begin(), out.values.end(), 0.0) / n;
-  double squares = 0.0;
-  for (double v : out.values) squares += (v - out.mean) * (v - out.mean);
-  out.standard_deviation = n > 1 ? std::sqrt(squares / (n - 1)) : 0.0;
+  const SampleSpread spread = sample_spread(out.values);
+  out.mean = spread.mean;
+  out.standard_deviation = spread.sd;
   return out;
 }
 

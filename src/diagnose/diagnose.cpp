@@ -1397,32 +1397,23 @@ void track_plots(const Context& c, DiagnoseResult& result, const std::vector<Tri
         cmp.x.push_back(track.x[f] - a.x_offset);
         cmp.z.push_back(track.z[f] - a.z_offset);
       }
-      const double end = cmp.t.back();
-      auto sampled = [&](const std::vector<ReplaySample>& replay, std::vector<double>& t, std::vector<double>& x,
+      // Each model's replay mapped into the frame the recording is drawn in (the baseline's):
+      // a model has its own fitted release time and origins, and recorded time t maps to its
+      // replay time t - shift.
+      auto sampled = [&](const TrialScore& score, std::vector<double>& t, std::vector<double>& x,
                          std::vector<double>& z) {
-        for (std::size_t s = 0; s < replay.size(); s += 10) {
-          if (replay[s].t < cmp.t.front() || replay[s].t > end) continue;
-          t.push_back(replay[s].t);
-          x.push_back(replay[s].x);
-          z.push_back(replay[s].z);
+        const Alignment& own = score.alignment;
+        const double dt = own.shift - a.shift, dx = own.x_offset - a.x_offset, dz = own.z_offset - a.z_offset;
+        for (std::size_t s = 0; s < score.replay.size(); s += 10) {
+          const ReplaySample& sample = score.replay[s];
+          if (sample.t + dt < cmp.t.front() || sample.t + dt > cmp.t.back()) continue;
+          t.push_back(sample.t + dt);
+          x.push_back(sample.x + dx);
+          z.push_back(sample.z + dz);
         }
       };
-      sampled(full_base[k].replay, cmp.baseline_t, cmp.baseline_x, cmp.baseline_z);
-      // The improved model has its own fitted release time and frame origins: map its replay
-      // into the frame the recording is drawn in (the baseline's), where recorded time t maps
-      // to replay time t - shift.
-      const Alignment& ai = full_improved[k].alignment;
-      const double dt = ai.shift - a.shift, dx = ai.x_offset - a.x_offset, dz = ai.z_offset - a.z_offset;
-      const double improved_start = cmp.t.front() - dt, improved_end = end - dt;
-      for (std::size_t s = 0; s < full_improved[k].replay.size(); s += 10) {
-        const ReplaySample& sample = full_improved[k].replay[s];
-        if (sample.t < improved_start || sample.t > improved_end) continue;
-        cmp.improved_t.push_back(sample.t + dt);
-        cmp.improved_x.push_back(sample.x);
-        cmp.improved_z.push_back(sample.z);
-      }
-      for (double& x : cmp.improved_x) x += dx;
-      for (double& z : cmp.improved_z) z += dz;
+      sampled(full_base[k], cmp.baseline_t, cmp.baseline_x, cmp.baseline_z);
+      sampled(full_improved[k], cmp.improved_t, cmp.improved_x, cmp.improved_z);
       result.tracks.push_back(std::move(cmp));
       break;
     }

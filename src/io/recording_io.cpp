@@ -224,15 +224,9 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
     reader.error("format", fmt::format("format '{}' is not \"recording/1\"", manifest["format"].get<std::string>()));
   }
   const std::string test = reader.string(manifest, "test");
-  if (test == "drop")
-    r.test = LabTest::Drop;
-  else if (test == "roll")
-    r.test = LabTest::Roll;
-  else if (test == "tilt")
-    r.test = LabTest::Tilt;
-  else
-    reader.error("test", fmt::format("unknown test '{}'{} (drop, roll or tilt)", test,
-                                     did_you_mean(test, {"drop", "roll", "tilt"})));
+  auto parsed = parse_lab_test(test);
+  if (!parsed) reader.error("test", parsed.error().message);
+  r.test = *parsed;
   r.surface = reader.string(manifest, "surface");
   if (!manifest.contains("setup") || !manifest["setup"].is_object())
     reader.error("setup", "the manifest has no 'setup' object");

@@ -101,6 +101,18 @@ TEST_F(BatchCli, AbsurdOptionsAreRefusedWritingNothing) {
     EXPECT_NE(run.err.find("clumpforge batch: error:"), std::string::npos) << run.err;
   }
   EXPECT_FALSE(fs::exists(dir_ / "x"));
+  // Inputs that are not there, and two scans that would write one result.
+  const auto missing =
+      test::run_clumpforge(fmt::format("batch '{}' -o '{}'", (dir_ / "nowhere").string(), (dir_ / "x").string()));
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("nowhere': no such scan file or folder"), std::string::npos) << missing.err;
+  fs::create_directories(dir_ / "other");
+  fs::copy_file(scans() / "tuber-01.stl", dir_ / "other" / "tuber-01.stl");
+  const auto twice = test::run_clumpforge(
+      fmt::format("batch '{}' '{}' -o '{}'", scans().string(), (dir_ / "other").string(), (dir_ / "x").string()));
+  EXPECT_EQ(twice.exit_code, 1);
+  EXPECT_NE(twice.err.find("two scans are named 'tuber-01'"), std::string::npos) << twice.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x"));
 }
 
 }  // namespace
