@@ -21,8 +21,8 @@ void bind_enums(py::module_& m) {
                   Basis::UnexplainedPhases, Basis::TooFewTrials, Basis::TooNoisy, Basis::SummariesOnly})
     basis.value(std::string(basis_name(b)).c_str(), b);
   py::enum_<Phase> phase(m, "Phase");
-  for (Phase p : {Phase::Hold, Phase::Flight, Phase::Impact, Phase::Rebound, Phase::LaterBounces, Phase::Incline,
-                  Phase::Transition, Phase::Flat, Phase::Rest, Phase::Stick, Phase::Slip})
+  for (Phase p : {Phase::Hold, Phase::Flight, Phase::Impact, Phase::Rebound, Phase::SecondFlight, Phase::LaterBounces,
+                  Phase::Incline, Phase::Transition, Phase::Flat, Phase::Rest, Phase::Stick, Phase::Slip})
     phase.value(std::string(phase_name(p)).c_str(), p);
   py::enum_<Axis>(m, "Axis").value("x", Axis::X).value("z", Axis::Z);
   m.def(

@@ -6,12 +6,20 @@
 #include <algorithm>
 
 namespace clumpforge {
+bool can_dent(const MaterialTable& table, const LabOptions& lab, std::string_view surface) {
+  const auto particle = table.find(lab.particle_material);
+  const auto wall = table.find(surface);
+  if (!particle || !wall) return true;
+  return (*wall)->youngs_modulus <= kDentStiffnessRatio * (*particle)->youngs_modulus;
+}
+
 LabOptions lab_options_for(const Evaluator& ev, const Model& model, const Recording& recording) {
   LabOptions options = ev.lab;
   for (const auto& base : model.base) {
     if (base.surface == recording.surface) options.interaction = base.interaction;
   }
-  if (model.effect) apply_effect(*model.effect, model.values, options);
+  if (model.effect && (*model.effect != Effect::PlasticSubstrate || can_dent(*ev.table, options, recording.surface)))
+    apply_effect(*model.effect, model.values, options);
   if (recording.tilt_rate_deg_per_s) options.tilt_rate_deg_per_s = *recording.tilt_rate_deg_per_s;
   if (recording.test == LabTest::Drop)
     options.steps_per_contact = std::max(options.steps_per_contact, ev.drop_steps_per_contact);

@@ -37,6 +37,14 @@ struct TrackedTrial {
       std::numeric_limits<double>::infinity();  ///< the end of the first phase (+ the impact), track time [s]
 };
 
+/// A plastic substrate is a surface the particle dents: one about as stiff as the particle or
+/// softer (soil under a tuber, E 10 against 5 MPa). A plate more than this many times stiffer
+/// than the particle (steel, 210 GPa) stays elastic under it, and the particle's own yield is
+/// a restitution effect, not a dent in the plate.
+inline constexpr double kDentStiffnessRatio = 100.0;
+/// Whether `surface` can take a dent from the particle of `lab` (by kDentStiffnessRatio).
+bool can_dent(const MaterialTable& table, const LabOptions& lab, std::string_view surface);
+
 struct Model {
   std::vector<SurfaceParameters> base;  ///< one per surface of the recordings
   std::optional<Effect> effect;
