@@ -133,6 +133,16 @@ CLI::Option* add_seed_option(CLI::App& app, std::uint64_t& seed, const std::stri
   return app.add_option("--seed", seed, what)->type_name("UINT")->capture_default_str()->group(kSharedOptions);
 }
 
+CLI::Option* add_threads_option(CLI::App& app, int& threads) {
+  return app
+      .add_option("--threads", threads,
+                  "Threads per process (0: the cores shared evenly among the MPI ranks on a node, or all of them)")
+      ->type_name("N")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 4096))
+      ->group(kSharedOptions);
+}
+
 CLI::Option* add_materials_option(CLI::App& app, std::string& path, const std::string& what) {
   return app.add_option("--materials", path, what)->type_name("FILE")->group(kSharedOptions);
 }

@@ -59,6 +59,8 @@ CLI::Option* add_clump_option(CLI::App& app, std::string& clump, const std::stri
 /// option means for that command.
 CLI::Option* add_json_flag(CLI::App& app, bool& json, const std::string& what);
 CLI::Option* add_seed_option(CLI::App& app, std::uint64_t& seed, const std::string& what);
+/// --threads N: threads per process (per MPI rank); 0 = automatic.
+CLI::Option* add_threads_option(CLI::App& app, int& threads);
 CLI::Option* add_materials_option(CLI::App& app, std::string& path, const std::string& what);
 CLI::Option* add_units_option(CLI::App& app, std::string& units, const std::string& what);
 CLI::Option* add_density_option(CLI::App& app, double& density, const std::string& what);

@@ -24,7 +24,7 @@ struct BatchArgs {
   std::string tests = "drop,tilt,roll", surfaces = "Q235,soil";
   std::vector<int> budgets{128};
   double density = kStudyDensity;
-  int trials = 10;
+  int trials = 10, threads = 0;
   std::uint64_t seed = 1;
   bool resume = false, merge = false, json = false;
 };
@@ -85,7 +85,7 @@ Result<std::pair<int, int>> parse_shard(const std::string& text) {
   return std::pair{k, n};
 }
 
-int print_summary(const BatchArgs& args, const BatchSummary& s) {
+int print_summary(const BatchArgs& args, const BatchSummary& s, bool drawn) {
   if (args.json) {
     std::cout << nlohmann::json{{"output", args.output}, {"done", s.done},       {"reused", s.reused},
                                 {"failed", s.failed},    {"missing", s.missing}, {"assembled", s.assembled}}
@@ -96,7 +96,9 @@ int print_summary(const BatchArgs& args, const BatchSummary& s) {
                s.failed.size(), s.missing.empty() ? "" : fmt::format(", {} left to other shards", s.missing.size()));
     for (const auto& f : s.failed) fmt::print("  failed: {}\n", f);
     if (s.assembled)
-      fmt::print("wrote library.h5 (one group per scan), population.csv and population.json\n");
+      fmt::print(
+          "wrote library.h5 (one group per scan), population.csv and population.json{}\n",
+          drawn ? ", and the figures population-shapes, population-outcomes, population-errors (.png, .svg)" : "");
     else
       fmt::print("the population is assembled when every shard is done: clumpforge batch --merge DIR... -o OUT\n");
   }
@@ -111,7 +113,7 @@ int run_batch_command(const BatchArgs& args) {
     std::vector<fs::path> dirs(args.inputs.begin(), args.inputs.end());
     auto merged = merge_batches(dirs, args.output, *options);
     if (!merged) return report_error(kCommand, merged.error());
-    return print_summary(args, *merged);
+    return print_summary(args, *merged, draw_figures(kCommand, "population", args.output));
   }
   std::vector<fs::path> inputs(args.inputs.begin(), args.inputs.end());
   auto items = list_scans(inputs);
@@ -122,9 +124,15 @@ int run_batch_command(const BatchArgs& args) {
     if (!shard) return report_error(kCommand, shard.error());
     std::tie(plan.shard, plan.shards) = *shard;
   }
-  auto summary = run_batch(plan, *options, context);
+  // Under mpirun or srun the ranks share the scans (docs/cluster.md); on its own, one process.
+  auto team = Team::join({.threads_per_rank = args.threads});
+  if (!team) return report_error(kCommand, team.error());
+  auto summary =
+      run_batch(plan, *options, team->leader() ? context : RunContext{.cancelled = context.cancelled}, *team);
   if (!summary) return report_error(kCommand, summary.error());
-  return print_summary(args, *summary);
+  if (!team->leader()) return kExitOk;
+  const bool drawn = summary->assembled && draw_figures(kCommand, "population", args.output);
+  return print_summary(args, *summary, drawn);
 }
 }  // namespace
 
@@ -148,9 +156,11 @@ Command add_batch_command(CLI::App& app) {
   sub->add_flag("--resume", args->resume, "Keep the scans already stored in the output folder, do the rest");
   sub->add_option("--shard", args->shard, "Do only shard K of N (K/N), e.g. one Slurm array task");
   sub->add_flag("--merge", args->merge, "Join shard output folders (given as the arguments) into --output");
+  add_threads_option(*sub, args->threads);
   add_json_flag(*sub, args->json, "Print the summary as JSON");
   sub->footer(
       "Examples:\n  clumpforge batch meshes/ -o population/ --trials 4\n"
+      "  mpirun -np 8 clumpforge batch scans/ -o population/   (the ranks share the scans; docs/cluster.md)\n"
       "  clumpforge batch meshes/ -o part-1 --shard 1/2 ; clumpforge batch meshes/ -o part-2 --shard 2/2\n"
       "  clumpforge batch --merge part-1 part-2 -o population/");
   return {sub, [args] { return run_batch_command(*args); }};

@@ -1,10 +1,10 @@
 """Figures of clumpforge results, drawn with matplotlib, as PNG and SVG.
 
 The command line writes each result's data (``report.json``, ``tracks.json``,
-``calibration.json``, ``study.json``) and then calls this module to draw them; it can also
+``calibration.json``, ``study.json``, ``population.json``) and then calls this module to draw them; it can also
 be run by hand on such a folder::
 
-    python3 -m clumpforge.figures diagnosis|calibration|study DIR
+    python3 -m clumpforge.figures diagnosis|calibration|study|population DIR
 
 Every figure is written to a temporary name and renamed, so a folder never holds half a
 figure. ``draw(kind, directory)`` returns the files written.
@@ -370,7 +370,101 @@ def study(directory):
     return _save(fig, directory, "study")
 
 
-KINDS = {"diagnosis": diagnosis, "calibration": calibration, "study": study}
+# ---------------------------------------------------------------- population (batch)
+
+SHAPE_PANELS = (("volume_m3", "volume [cm$^3$]", 1e6), ("mass_kg", "mass [g]", 1e3),
+                ("length_m", "length L [mm]", 1e3), ("sphericity", "sphericity", 1.0),
+                ("elongation", "elongation W/L", 1.0), ("flatness", "flatness T/W", 1.0))
+OUTCOME_UNITS = {"drop": ("rebound height [mm]", 1e3), "roll": ("roll distance [mm]", 1e3),
+                 "tilt": ("slip angle [deg]", 1.0)}
+
+
+def _histogram(ax, values, label):
+    v = np.asarray(values, dtype=float)
+    ax.hist(v, bins=max(5, min(30, int(round(math.sqrt(v.size)) * 2))), color=LAB, alpha=0.75, edgecolor="white")
+    mean, ci = _mean_ci(v)
+    ax.axvline(mean, color="black", lw=1)
+    ax.axvspan(mean - ci, mean + ci, color="black", alpha=0.12, lw=0)
+    ax.set_xlabel(label)
+    ax.set_ylabel("scans")
+    spread = f", sd {v.std(ddof=1):.3g}" if v.size > 1 else ""
+    ax.set_title(f"mean {mean:.3g} (95 % CI $\\pm${ci:.2g}){spread}", fontsize=8)
+    ax.grid(alpha=0.3, axis="y")
+
+
+def population_shapes(report, directory):
+    """The population's shape distributions: one histogram per measure, mean and its 95 % CI."""
+    scans = report["scans"]
+    fig, axes = plt.subplots(2, 3, figsize=(11, 6.5), layout="constrained")
+    for ax, (key, label, scale) in zip(axes.ravel(), SHAPE_PANELS):
+        _histogram(ax, [s[key] * scale for s in scans], label)
+    failed = len(report.get("failed", []))
+    fig.suptitle(f"Population of {len(scans)} scans" + (f" ({failed} failed, left out)" if failed else ""))
+    return _save(fig, directory, "population-shapes")
+
+
+def population_outcomes(report, directory):
+    """DEM outcomes across the population: per validated clump, test and surface, the scans'
+    mean outcomes as points with their 95 % CI (trials), and the population's spread."""
+    series = {}
+    for s in report["scans"]:
+        for c in s["clumps"]:
+            for o in c["outcomes"]:
+                series.setdefault((o["test"], o["surface"]), {}).setdefault(c["name"], []).append(o["values"])
+    if not series:
+        return []
+    keys = sorted(series)
+    fig, axes = plt.subplots(1, len(keys), figsize=(3.2 * len(keys) + 1, 4.2), layout="constrained", squeeze=False)
+    for ax, key in zip(axes[0], keys):
+        label, scale = OUTCOME_UNITS.get(key[0], (key[0], 1.0))
+        for k, (clump, trials) in enumerate(sorted(series[key].items())):
+            means = [_mean_ci(np.asarray(t) * scale) for t in trials]
+            x = k + np.linspace(-0.25, 0.25, len(means)) if len(means) > 1 else np.array([k])
+            ax.errorbar(x, [m for m, _ in means], yerr=[ci for _, ci in means], fmt="o", ms=3, lw=0.8,
+                        color=(IMPROVED, LAB, BASELINE)[k % 3], capsize=2)
+            ax.boxplot([m for m, _ in means], positions=[k], widths=0.7, showfliers=False,
+                       medianprops={"color": "black"}, boxprops={"alpha": 0.4}, whiskerprops={"alpha": 0.4})
+        ax.set_xticks(range(len(series[key])), sorted(series[key]), rotation=20, fontsize=8)
+        ax.set_ylabel(label)
+        ax.set_title(f"{key[0]} on {key[1]}", fontsize=9)
+        ax.grid(alpha=0.3, axis="y")
+    fig.suptitle("DEM outcomes across the population: each point a scan's mean with its 95 % CI over trials")
+    return _save(fig, directory, "population-outcomes")
+
+
+def population_errors(report, directory):
+    """Fill error against sphere count: one point per scan and clump, lattice and adaptive."""
+    panels = (("mass_error", "|mass error| [%]", 100.0),
+              ("worst_moment_error_mass_matched", "worst moment error, mass-matched [%]", 100.0),
+              ("surface_rms_m", "surface RMS distance [mm]", 1e3))
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4), layout="constrained")
+    for ax, (key, label, scale) in zip(axes, panels):
+        for method, marker, colour in (("lattice", "s", LAB), ("adaptive", "o", IMPROVED)):
+            pts = [(c["spheres"], max(abs(c[key]) * scale, 1e-6)) for s in report["scans"] for c in s["clumps"]
+                   if c["method"] == method and key in c]
+            if pts:
+                ax.scatter(*zip(*pts), marker=marker, s=14, color=colour, alpha=0.7, label=method)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("spheres")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8, frameon=False)
+    fig.suptitle("Fill error against sphere count, every scan of the population")
+    return _save(fig, directory, "population-errors")
+
+
+def population(directory):
+    """The figures of a batch's folder (population.json)."""
+    directory = pathlib.Path(directory)
+    report = json.loads((directory / "population.json").read_text())
+    if not report["scans"]:
+        raise ValueError("population.json holds no scan")
+    return population_shapes(report, directory) + population_outcomes(report, directory) + \
+        population_errors(report, directory)
+
+
+KINDS = {"diagnosis": diagnosis, "calibration": calibration, "study": study, "population": population}
 
 
 def draw(kind, directory):

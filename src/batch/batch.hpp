@@ -17,6 +17,7 @@
 #include "core/recording.hpp"
 #include "core/run_context.hpp"
 #include "core/units.hpp"
+#include "parallel/team.hpp"
 
 namespace clumpforge {
 
@@ -111,8 +112,13 @@ struct BatchSummary {
 };
 
 /// Runs the plan's items (largest first) and, when every item is stored, assembles the
-/// population; progress through `context`, one step per item.
-Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& options, const RunContext& context = {});
+/// population; progress through `context` (done, failed, remaining, time left), one step per
+/// item. Under a distributed `team` every rank calls it alike: the ranks share the items through
+/// the team's queue, each storing what it runs, and the leader assembles the population (the
+/// other ranks return their own part of the summary, `assembled` false). The output folder
+/// must be one every rank sees.
+Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& options, const RunContext& context = {},
+                               const Team& team = Team());
 
 /// Writes the population of `results` (every scan's) into `dir`: `library.h5` (one group
 /// per scan), `population.csv` and `population.json`, in the scans' name order.

@@ -1,6 +1,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -115,21 +116,62 @@ std::optional<ItemResult> load_current(const fs::path& dir, const ScanItem& item
 }
 }  // namespace
 
-Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& options, const RunContext& context) {
+namespace {
+/// A batch's progress line: items done and failed so far, remaining, and the time left at the
+/// rate so far.
+std::string progress_line(std::size_t done, std::size_t failed, std::size_t total,
+                          std::chrono::steady_clock::duration elapsed, bool distributed) {
+  const double seconds = std::chrono::duration<double>(elapsed).count();
+  // Under MPI the leader knows what it handed out, not what the other ranks finished.
+  std::string line = distributed ? fmt::format("{} started, {} waiting", done, total - done)
+                                 : fmt::format("{} done, {} failed, {} remaining", done, failed, total - done);
+  if (done > 0 && done < total) {
+    const double left = seconds / static_cast<double>(done) * static_cast<double>(total - done);
+    line +=
+        left < 120.0 ? fmt::format(", about {:.0f} s left", left) : fmt::format(", about {:.0f} min left", left / 60);
+  }
+  return line;
+}
+
+/// Names joined for Team::gather (scan names hold no control characters).
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += n + '\x1f';
+  return out;
+}
+std::vector<std::string> split_joined(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t begin = 0;
+  for (std::size_t end = text.find('\x1f'); end != std::string::npos; end = text.find('\x1f', begin)) {
+    out.push_back(text.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  return out;
+}
+}  // namespace
+
+Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& options, const RunContext& context,
+                               const Team& team) {
   if (plan.shards < 1 || plan.shard < 1 || plan.shard > plan.shards)
     return fail(ErrorCode::InvalidArgument,
                 fmt::format("shard {}/{} is not one of 1..N of N >= 1", plan.shard, plan.shards));
-  std::vector<const ScanItem*> mine, others;
-  for (std::size_t i = 0; i < plan.items.size(); ++i)
-    (static_cast<int>(i % static_cast<std::size_t>(plan.shards)) == plan.shard - 1 ? mine : others)
-        .push_back(&plan.items[i]);
+  std::vector<std::size_t> mine;
+  std::vector<const ScanItem*> others;
+  for (std::size_t i = 0; i < plan.items.size(); ++i) {
+    if (static_cast<int>(i % static_cast<std::size_t>(plan.shards)) == plan.shard - 1)
+      mine.push_back(i);
+    else
+      others.push_back(&plan.items[i]);
+  }
   // Largest first: the long items start early and the end of the run is not one big scan.
-  std::stable_sort(mine.begin(), mine.end(), [](const ScanItem* a, const ScanItem* b) { return a->bytes > b->bytes; });
+  std::stable_sort(mine.begin(), mine.end(),
+                   [&](std::size_t a, std::size_t b) { return plan.items[a].bytes > plan.items[b].bytes; });
   BatchSummary summary;
-  std::vector<ItemResult> results;
-  for (std::size_t k = 0; k < mine.size(); ++k) {
-    const ScanItem& item = *mine[k];
-    context.report(fmt::format("{} ({} of {})", item.name, k + 1, mine.size()), static_cast<double>(k) / mine.size());
+  std::map<std::string, ItemResult> held;  // this rank's results
+  const auto started = std::chrono::steady_clock::now();
+  std::size_t finished = 0, failed = 0;
+  auto work = [&](std::size_t index) -> Result<void> {
+    const ScanItem& item = plan.items[index];
     std::optional<ItemResult> stored = plan.resume ? load_current(plan.output, item, options) : std::nullopt;
     if (stored) {
       summary.reused.push_back(item.name);
@@ -140,17 +182,45 @@ Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& option
       if (result->error.empty()) summary.done.push_back(item.name);
       stored = std::move(*result);
     }
-    if (!stored->error.empty()) summary.failed.push_back(item.name + ": " + stored->error);
-    results.push_back(std::move(*stored));
-  }
-  context.report("done", 1.0);
-  // Another shard's items, when it wrote into the same folder.
-  for (const ScanItem* item : others) {
-    if (auto stored = load_current(plan.output, *item, options))
+    ++finished;
+    if (!stored->error.empty()) ++failed;
+    held.emplace(item.name, std::move(*stored));
+    return {};
+  };
+  auto progress = [&](std::size_t handed_out, std::size_t total) {
+    const std::size_t done = team.distributed() ? handed_out : finished;
+    context.report(progress_line(done, failed, total, std::chrono::steady_clock::now() - started, team.distributed()),
+                   static_cast<double>(done) / std::max<std::size_t>(total, 1));
+  };
+  if (auto ok = team.share(mine, work, progress); !ok) return std::unexpected(ok.error());
+  context.report(progress_line(finished, failed, finished, std::chrono::steady_clock::now() - started, false), 1.0);
+  // The ranks' lists, on the leader; the other ranks are done.
+  const auto done = team.gather(joined(summary.done)), reused = team.gather(joined(summary.reused));
+  if (!team.leader()) return summary;
+  summary.done.clear();
+  summary.reused.clear();
+  for (const auto& d : done) std::ranges::copy(split_joined(d), std::back_inserter(summary.done));
+  for (const auto& r : reused) std::ranges::copy(split_joined(r), std::back_inserter(summary.reused));
+  std::ranges::sort(summary.done);
+  std::ranges::sort(summary.reused);
+  // The other ranks' items and another shard's, when it wrote into the same folder.
+  std::vector<ItemResult> results;
+  for (std::size_t i = 0; i < plan.items.size(); ++i) {
+    const ScanItem& item = plan.items[i];
+    if (auto h = held.find(item.name); h != held.end()) {
+      results.push_back(std::move(h->second));
+    } else if (auto stored = load_current(plan.output, item, options)) {
       results.push_back(std::move(*stored));
-    else
-      summary.missing.push_back(item->name);
+    } else if (std::find(others.begin(), others.end(), &item) != others.end()) {
+      summary.missing.push_back(item.name);
+    } else {
+      return fail(ErrorCode::IoError, fmt::format("scan '{}' was run by another rank but its result is not in '{}' "
+                                                  "(every rank must see the output folder: a shared file system)",
+                                                  item.name, (plan.output / "items").string()));
+    }
   }
+  for (const ItemResult& r : results)
+    if (!r.error.empty()) summary.failed.push_back(r.scan + ": " + r.error);
   if (summary.missing.empty()) {
     if (auto ok = assemble_population(plan.output, std::move(results), options); !ok)
       return std::unexpected(ok.error());

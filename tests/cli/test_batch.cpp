@@ -57,6 +57,11 @@ TEST_F(BatchCli, ABrokenScanIsReportedAndTheOthersMakeThePopulation) {
     ASSERT_EQ(adaptive["outcomes"].size(), 2u);  // drop and roll on Q235
     EXPECT_GT(adaptive["outcomes"][0]["mean"].get<double>(), 0.0);
   }
+  // The population's figures, drawn as PNG and SVG.
+  for (const char* stem : {"population-shapes", "population-outcomes", "population-errors"}) {
+    EXPECT_EQ(bytes(dir_ / "a" / (std::string(stem) + ".png")).substr(1, 3), "PNG") << stem;
+    EXPECT_TRUE(fs::exists(dir_ / "a" / (std::string(stem) + ".svg"))) << stem;
+  }
   // The library reads back: a population's clumps are "<scan>/<clump>", and export takes them.
   const auto exported =
       test::run_clumpforge(fmt::format("export '{}:tuber-05/adaptive-24' --format csv -o '{}'",
