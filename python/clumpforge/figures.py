@@ -18,6 +18,7 @@ import pathlib
 import sys
 
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -387,6 +388,7 @@ def _histogram(ax, values, label):
     ax.axvspan(mean - ci, mean + ci, color="black", alpha=0.12, lw=0)
     ax.set_xlabel(label)
     ax.set_ylabel("scans")
+    ax.yaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
     spread = f", sd {v.std(ddof=1):.3g}" if v.size > 1 else ""
     ax.set_title(f"mean {mean:.3g} (95 % CI $\\pm${ci:.2g}){spread}", fontsize=8)
     ax.grid(alpha=0.3, axis="y")
@@ -413,9 +415,15 @@ def population_outcomes(report, directory):
                 series.setdefault((o["test"], o["surface"]), {}).setdefault(c["name"], []).append(o["values"])
     if not series:
         return []
-    keys = sorted(series)
-    fig, axes = plt.subplots(1, len(keys), figsize=(3.2 * len(keys) + 1, 4.2), layout="constrained", squeeze=False)
-    for ax, key in zip(axes[0], keys):
+    tests = sorted({t for t, _ in series})
+    surfaces = sorted({s for _, s in series})
+    fig, axes = plt.subplots(len(surfaces), len(tests), figsize=(3.6 * len(tests) + 0.8, 3.4 * len(surfaces) + 0.6),
+                             layout="constrained", squeeze=False)
+    for (row, surface), (col, test) in ((r, c) for r in enumerate(surfaces) for c in enumerate(tests)):
+        ax, key = axes[row][col], (test, surface)
+        if key not in series:
+            ax.set_visible(False)
+            continue
         label, scale = OUTCOME_UNITS.get(key[0], (key[0], 1.0))
         for k, (clump, trials) in enumerate(sorted(series[key].items())):
             means = [_mean_ci(np.asarray(t) * scale) for t in trials]
@@ -426,6 +434,7 @@ def population_outcomes(report, directory):
                        medianprops={"color": "black"}, boxprops={"alpha": 0.4}, whiskerprops={"alpha": 0.4})
         ax.set_xticks(range(len(series[key])), sorted(series[key]), rotation=20, fontsize=8)
         ax.set_ylabel(label)
+        ax.ticklabel_format(axis="y", useOffset=False, style="plain")
         ax.set_title(f"{key[0]} on {key[1]}", fontsize=9)
         ax.grid(alpha=0.3, axis="y")
     fig.suptitle("DEM outcomes across the population: each point a scan's mean with its 95 % CI over trials")
