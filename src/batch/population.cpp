@@ -9,6 +9,8 @@
 #include "batch/batch.hpp"
 #include "core/atomic_file.hpp"
 #include "io/clump_library.hpp"
+#include "mesh/load.hpp"
+#include "mesh/triangle_mesh.hpp"
 
 namespace clumpforge {
 namespace fs = std::filesystem;
@@ -148,6 +150,21 @@ std::vector<std::string> split_joined(const std::string& text) {
   }
   return out;
 }
+
+/// Each scan's work, for ordering the queue: the body's volume (the lattice fills and their
+/// DEM tests grow with it; on the ten bundled tubers the items' times follow it, 9-31 s for
+/// 2.1-5.2 cm^3, where the files' sizes are within 2 %). A scan is read without repair (about
+/// 20 ms), each rank reading its share; one that does not load gets 0 (it fails fast).
+std::vector<double> work_estimates(const std::vector<ScanItem>& items, const std::vector<std::size_t>& mine,
+                                   const BatchOptions& options, const Team& team) {
+  std::vector<double> work(items.size(), 0.0);
+  for (std::size_t k = 0; k < mine.size(); ++k) {
+    if (static_cast<int>(k % static_cast<std::size_t>(team.size())) != team.rank()) continue;
+    if (auto loaded = load_mesh(items[mine[k]].path, {.unit = options.units}))
+      work[mine[k]] = std::abs(signed_volume(loaded->soup));
+  }
+  return team.sum(std::move(work));
+}
 }  // namespace
 
 Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& options, const RunContext& context,
@@ -164,8 +181,10 @@ Result<BatchSummary> run_batch(const BatchPlan& plan, const BatchOptions& option
       others.push_back(&plan.items[i]);
   }
   // Largest first: the long items start early and the end of the run is not one big scan.
-  std::stable_sort(mine.begin(), mine.end(),
-                   [&](std::size_t a, std::size_t b) { return plan.items[a].bytes > plan.items[b].bytes; });
+  const std::vector<double> cost = work_estimates(plan.items, mine, options, team);
+  std::stable_sort(mine.begin(), mine.end(), [&](std::size_t a, std::size_t b) {
+    return cost[a] != cost[b] ? cost[a] > cost[b] : plan.items[a].bytes > plan.items[b].bytes;
+  });
   BatchSummary summary;
   std::map<std::string, ItemResult> held;  // this rank's results
   const auto started = std::chrono::steady_clock::now();

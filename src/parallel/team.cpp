@@ -145,6 +145,16 @@ bool Team::all(bool mine) const {
 #endif
 }
 
+std::vector<double> Team::sum(std::vector<double> values) const {
+#ifdef CLUMPFORGE_MPI
+  if (impl_->mpi && impl_->size > 1) {
+    wait_for_all();
+    MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, impl_->world);
+  }
+#endif
+  return values;
+}
+
 std::vector<std::string> Team::gather(const std::string& line) const {
 #ifdef CLUMPFORGE_MPI
   if (impl_->mpi) {

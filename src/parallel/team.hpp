@@ -63,6 +63,9 @@ class Team {
 
   /// Every rank's `line`, in rank order, on the leader (the others get an empty list).
   std::vector<std::string> gather(const std::string& line) const;
+  /// The element-wise sum of every rank's `values` (the same length on every rank), on every
+  /// rank: each rank fills the entries it computed and leaves the others zero.
+  std::vector<double> sum(std::vector<double> values) const;
   /// True on every rank when `mine` is true on every rank.
   bool all(bool mine) const;
   /// Waits for every rank, without keeping a core busy while it waits.
