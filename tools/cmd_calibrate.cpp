@@ -17,6 +17,7 @@
 #include "io/materials_export.hpp"
 #include "io/materials_io.hpp"
 #include "io/recording_io.hpp"
+#include "parallel/team.hpp"
 
 namespace clumpforge::cli {
 namespace {
@@ -25,7 +26,7 @@ namespace fs = std::filesystem;
 struct CalibrateArgs {
   std::vector<std::string> recordings;
   std::string clump_file, clump_name, method = "paper", out, materials, conventions = "edem", export_format;
-  int trials_per_level = 10;
+  int trials_per_level = 10, threads = 0;
   std::uint64_t seed = 1;
   bool json = false;
 };
@@ -157,15 +158,17 @@ std::string joint_markdown(const std::vector<JointSurfaceResult>& results) {
 }
 
 int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<Recording>& recordings,
-              const MaterialTable& table) {
+              const MaterialTable& table, const Team& team) {
   constexpr std::string_view kCommand = "calibrate";
   JointOptions options;
   options.lab.contact = contact_settings(conventions_of(args));
   options.trials = args.trials_per_level;
   options.seed = args.seed;
-  const RunContext context = progress_context(args.json);
-  auto results = calibrate_joint(clump, table, recordings, options, context);
+  const RunContext shown = progress_context(args.json);
+  auto results = calibrate_joint(clump, table, recordings, options,
+                                 team.leader() ? shown : RunContext{.cancelled = shown.cancelled}, team);
   if (!results) return report_error(kCommand, results.error());
+  if (!team.leader()) return kExitOk;
   nlohmann::json report{{"method", "joint"},
                         {"clump", clump.name},
                         {"trials", options.trials},
@@ -250,14 +253,19 @@ int run_calibrate(const CalibrateArgs& args) {
   auto table =
       args.materials.empty() ? Result<MaterialTable>(default_material_table()) : read_materials(args.materials);
   if (!table) return report_error(kCommand, table.error());
-  if (args.method == "joint") return run_joint(args, *clump, recordings, *table);
+  // Under mpirun or srun the ranks share the DEM runs (a sweep's levels, an evaluation's tests).
+  auto team = Team::join({.threads_per_rank = args.threads});
+  if (!team) return report_error(kCommand, team.error());
+  if (args.method == "joint") return run_joint(args, *clump, recordings, *table, *team);
   PaperOptions options;
   options.trials_per_level = args.trials_per_level;
   options.lab.seed = args.seed;
   options.lab.contact = contact_settings(conventions_of(args));
-  const RunContext context = progress_context(args.json);
-  auto calibration = calibrate_paper(*clump, *table, recordings, options, context);
+  const RunContext shown = progress_context(args.json);
+  auto calibration = calibrate_paper(*clump, *table, recordings, options,
+                                     team->leader() ? shown : RunContext{.cancelled = shown.cancelled}, *team);
   if (!calibration) return report_error(kCommand, calibration.error());
+  if (!team->leader()) return kExitOk;
 
   nlohmann::json report{{"method", "paper"},
                         {"clump", clump->name},
@@ -315,6 +323,7 @@ Command add_calibrate_command(CLI::App& app) {
                   "Trials per swept level (joint: orientations per evaluation)")
       ->capture_default_str();
   add_seed_option(*sub, args->seed, "Seed of the trial orientations");
+  add_threads_option(*sub, args->threads);
   add_output_option(*sub, args->out, "Directory for calibration.json, calibration.md and the plots");
   add_materials_option(*sub, args->materials,
                        "Materials file (JSON, see docs/materials.json) overriding the built-in table");

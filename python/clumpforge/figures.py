@@ -368,7 +368,82 @@ def study(directory):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8, frameon=False)
     fig.suptitle(f"Resolution study of {pathlib.Path(report.get('input', '')).name}: lattice against adaptive fill")
-    return _save(fig, directory, "study")
+    written = _save(fig, directory, "study")
+    if "dem" in report:
+        written += study_dem(report, directory)
+    return written
+
+
+def _study_outcome_panel(ax, samples, dem, label):
+    """One test on one surface: each clump's mean outcome with its 95 % CI against sphere count;
+    the reference's interval as a band; hollow markers where the clump differs from it."""
+    reference = next(s for s in samples if s["clump"] == dem["reference"])
+    low, high = reference["mean"] - reference["ci95"], reference["mean"] + reference["ci95"]
+    ax.axhspan(low, high, color="0.5", alpha=0.18, lw=0, label=f"{dem['reference']} (reference), 95 % CI")
+    for method, marker, colour in (("lattice", "s", LAB), ("adaptive", "o", IMPROVED)):
+        chosen = sorted((s for s in samples if s["method"] == method), key=lambda s: s["spheres"])
+        if not chosen:
+            continue
+        n = [s["spheres"] for s in chosen]
+        ax.plot(n, [s["mean"] for s in chosen], "-", color=colour, lw=0.8, alpha=0.6)
+        for s in chosen:
+            differs = s.get("comparison", {}).get("distinguishable", False)
+            ax.errorbar(s["spheres"], s["mean"], yerr=s["ci95"], fmt=marker, color=colour, capsize=2, ms=5,
+                        mfc="white" if differs else colour)
+        ax.plot([], [], marker, color=colour, label=f"{method} (hollow: differs)")
+    best = next(s for s in samples if s["clump"] == dem["coarsest"])
+    ax.annotate(f"coarsest alike:\n{best['clump']}", (best["spheres"], best["mean"]), fontsize=7, xytext=(8, -22),
+                textcoords="offset points", arrowprops={"arrowstyle": "->", "lw": 0.6})
+    ax.set_xscale("log")
+    ax.set_xlabel("spheres")
+    ax.set_ylabel(label)
+    ax.grid(alpha=0.3, which="both")
+
+
+def study_dem(report, directory):
+    """The study's DEM side: every test's outcome against sphere count, and the DEM's cost."""
+    dem = report["dem"]
+    keys = sorted({(s["surface"], s["test"]) for s in dem["samples"]}, key=lambda k: (k[0], list(RESPONSES).index(k[1])
+                                                                                      if k[1] in RESPONSES else 9))
+    columns = min(3, len(keys) + 1)
+    rows = math.ceil((len(keys) + 1) / columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.6 * rows), layout="constrained", squeeze=False)
+    panels = list(axes.ravel())
+    for ax, (surface, test) in zip(panels, keys):
+        samples = [s for s in dem["samples"] if s["surface"] == surface and s["test"] == test]
+        label, _ = OUTCOME_UNITS.get(test, (test, 1.0))
+        _study_outcome_panel(ax, samples, dem, label)
+        ax.set_title(f"{test} on {surface}", fontsize=9)
+    panels[0].legend(fontsize=7, frameon=False)
+    cost = panels[len(keys)]
+    for (surface, test), colour in zip(keys, (LAB, IMPROVED, BASELINE, "#9467bd", "#8c564b", "#e377c2")):
+        for method, marker, style in (("lattice", "s", "--"), ("adaptive", "o", "-")):
+            pts = sorted((s["spheres"], s["seconds_per_trial"]) for s in dem["samples"]
+                         if s["surface"] == surface and s["test"] == test and s["method"] == method)
+            if pts:
+                cost.plot(*zip(*pts), marker + style, ms=4, lw=0.8, color=colour,
+                          label=f"{test} on {surface}" if method == "adaptive" else None)
+    cost.plot([], [], "s--", color="0.4", ms=4, lw=0.8, label="lattice")
+    cost.plot([], [], "o-", color="0.4", ms=4, lw=0.8, label="adaptive")
+    cost.set_xscale("log")
+    cost.set_yscale("log")
+    cost.yaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+    cost.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    cost.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    cost.set_xlabel("spheres")
+    cost.set_ylabel("DEM wall time per trial [s]")
+    cost.grid(alpha=0.3, which="both")
+    cost.legend(fontsize=7, frameon=False)
+    cost.set_title("cost", fontsize=9)
+    for ax in panels[:len(keys) + 1]:
+        ax.xaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    for ax in panels[len(keys) + 1:]:
+        ax.set_visible(False)
+    fig.suptitle(f"DEM outcomes against sphere count ({dem['trials']} release orientations per point, 95 % CI); "
+                 f"{dem['coarsest']} is the coarsest clump alike to {dem['reference']}", fontsize=10)
+    return _save(fig, directory, "study-dem")
 
 
 # ---------------------------------------------------------------- population (batch)

@@ -26,12 +26,6 @@ bool is_scan(const fs::path& p) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext == ".stl" || ext == ".obj" || ext == ".ply" || ext == ".off";
 }
-
-std::uint64_t hash_text(std::uint64_t seed, std::string_view text) {
-  std::uint64_t h = 1469598103934665603ULL ^ seed;  // FNV-1a, then mixed
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
-  return Rng(h).next_u64();
-}
 }  // namespace
 
 Result<std::vector<ScanItem>> list_scans(std::span<const fs::path> inputs) {
@@ -66,7 +60,7 @@ Result<std::vector<ScanItem>> list_scans(std::span<const fs::path> inputs) {
 }
 
 std::uint64_t item_seed(std::uint64_t run_seed, const std::string& sha256) {
-  return hash_text(run_seed, sha256);
+  return seed_for(run_seed, sha256);
 }
 
 namespace {
@@ -162,7 +156,7 @@ Result<ItemResult> run_item(const ScanItem& item, const BatchOptions& options, c
         const auto dem_started = std::chrono::steady_clock::now();
         const Clump& clump = result.clumps.back();
         const std::string key = fmt::format("{}/{}/{}", clump.name, to_string(test), surface);
-        auto summary = run_test(clump, test, surface, options.trials, hash_text(result.seed, key), context);
+        auto summary = run_test(clump, test, surface, options.trials, seed_for(result.seed, key), context);
         if (!summary) return failed(summary.error());
         result.outcomes.push_back(std::move(*summary));
         result.stage_seconds.emplace_back(

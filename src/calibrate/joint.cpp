@@ -28,13 +28,14 @@ struct Model {
   const MaterialTable& table;
   std::array<const Recording*, 3> setups;
   const JointOptions& options;
+  const Team& team;
   int evaluations = 0;
 
-  // Simulated means (study units) and their standard errors at theta = (e, mu_s, mu_r).
+  // Simulated means (study units) and their standard errors at theta = (e, mu_s, mu_r); the
+  // three tests shared among the team's ranks.
   Result<std::pair<Eigen::Vector3d, Eigen::Vector3d>> operator()(const Eigen::Vector3d& theta) {
     ++evaluations;
-    Eigen::Vector3d means, errors;
-    for (int k = 0; k < 3; ++k) {
+    auto test = [&](std::size_t k) -> Result<std::vector<double>> {
       LabOptions lab = options.lab;
       lab.seed = options.seed;
       lab.trials = kTests[k] == LabTest::Tilt ? options.tilt_trials : options.trials;
@@ -43,8 +44,16 @@ struct Model {
       if (!result) return std::unexpected(result.error());
       std::vector<double> values;
       for (double v : result->recording.summaries()) values.push_back(study_units(kTests[k], v));
-      means[k] = mean(values);
-      errors[k] = standard_error(values);
+      return std::vector<double>{mean(values), standard_error(values)};
+    };
+    // The tilt (seconds of a turning plate) first.
+    const std::array<std::size_t, 3> order{1, 0, 2};
+    auto ran = team.map(order, 2, test);
+    if (!ran) return std::unexpected(ran.error());
+    Eigen::Vector3d means, errors;
+    for (int k = 0; k < 3; ++k) {
+      means[k] = (*ran)[k][0];
+      errors[k] = (*ran)[k][1];
     }
     return std::pair{means, errors};
   }
@@ -57,7 +66,8 @@ Eigen::Vector3d clamp(const Eigen::Vector3d& theta) {
 
 Result<std::vector<JointSurfaceResult>> calibrate_joint(const Clump& clump, const MaterialTable& table,
                                                         const std::vector<Recording>& recordings,
-                                                        const JointOptions& options, const RunContext& context) {
+                                                        const JointOptions& options, const RunContext& context,
+                                                        const Team& team) {
   if (options.trials < 2 || options.tilt_trials < 1 || options.iterations < 1 || options.bootstrap < 10) {
     return fail(ErrorCode::InvalidArgument,
                 "joint calibration needs >= 2 trials, >= 1 tilt trial, >= 1 iteration, >= 10 resamples");
@@ -90,7 +100,7 @@ Result<std::vector<JointSurfaceResult>> calibrate_joint(const Clump& clump, cons
       target[k] = mean(measured[k]);
       target_error[k] = standard_error(measured[k]);
     }
-    Model model{clump, table, setups, options};
+    Model model{clump, table, setups, options, team};
     const Interaction start =
         table.interaction(options.lab.particle_material, surface).value_or(Interaction{0.5, 0.5, 0.02});
     // Each mean's uncertainty: its standard error and the simulation's, but never below the

@@ -45,20 +45,47 @@ struct Responses {
   double contacts = 0;              // drop: mean spheres touching at the first impact
 };
 
-Result<Responses> run_responses(const Clump& clump, const MaterialTable& table, const Recording& setup,
-                                const Interaction& interaction, const PaperOptions& options, int trials) {
+// One run of `trials` trials, packed as the trials' responses then the three impact means (the
+// team's map carries numbers only).
+Result<std::vector<double>> run_packed(const Clump& clump, const MaterialTable& table, const Recording& setup,
+                                       const Interaction& interaction, const PaperOptions& options) {
   LabOptions lab = options.lab;
-  lab.trials = trials;
+  lab.trials = options.trials_per_level;
   lab.interaction = interaction;
   auto result = run_lab_test(clump, table, setup, lab);
   if (!result) return std::unexpected(result.error());
-  Responses out;
-  for (double v : result->recording.summaries()) out.values.push_back(study_units(setup.test, v));
+  std::vector<double> out;
+  for (double v : result->recording.summaries()) out.push_back(study_units(setup.test, v));
+  double apparent = 0.0, rotation = 0.0, contacts = 0.0;
   for (const auto& d : result->impacts) {
-    out.apparent_restitution += d.apparent_restitution / static_cast<double>(result->impacts.size());
-    out.rotation_of_impact += d.rotation_of_impact / static_cast<double>(result->impacts.size());
-    out.contacts += d.first_contacts / static_cast<double>(result->impacts.size());
+    apparent += d.apparent_restitution / static_cast<double>(result->impacts.size());
+    rotation += d.rotation_of_impact / static_cast<double>(result->impacts.size());
+    contacts += d.first_contacts / static_cast<double>(result->impacts.size());
   }
+  out.insert(out.end(), {apparent, rotation, contacts});
+  return out;
+}
+
+Responses unpack(const std::vector<double>& packed) {
+  Responses r;
+  r.values.assign(packed.begin(), packed.end() - 3);
+  r.apparent_restitution = packed[packed.size() - 3];
+  r.rotation_of_impact = packed[packed.size() - 2];
+  r.contacts = packed.back();
+  return r;
+}
+
+// Every run of `runs` (one interaction each) shared among the team's ranks, in that order.
+Result<std::vector<Responses>> run_all(const Clump& clump, const MaterialTable& table, const Recording& setup,
+                                       const std::vector<Interaction>& runs, const PaperOptions& options,
+                                       const Team& team) {
+  std::vector<std::size_t> order(runs.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  auto packed = team.map(order, static_cast<std::size_t>(options.trials_per_level) + 3,
+                         [&](std::size_t i) { return run_packed(clump, table, setup, runs[i], options); });
+  if (!packed) return std::unexpected(packed.error());
+  std::vector<Responses> out;
+  for (const auto& p : *packed) out.push_back(unpack(p));
   return out;
 }
 
@@ -107,7 +134,7 @@ std::vector<double> paper_levels(const std::string& parameter, const std::string
 
 Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable& table,
                                          const std::vector<Recording>& recordings, const PaperOptions& options,
-                                         const RunContext& context) {
+                                         const RunContext& context, const Team& team) {
   if (options.trials_per_level < 1) return fail(ErrorCode::InvalidArgument, "trials per level must be at least 1");
   std::vector<std::string> surfaces;
   for (const auto& r : recordings) {
@@ -145,13 +172,16 @@ Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable
       if (parameter == "restitution") p.held.static_friction = p.held.rolling_friction = 0.0;
       if (parameter == "static_friction") p.held.rolling_friction = 0.0;
       std::vector<double> xs, ys;
+      std::vector<Interaction> runs;
       for (double level : paper_levels(parameter, surface)) {
-        Interaction run = p.held;
-        coefficient(run, parameter) = level;
-        auto responses = run_responses(clump, table, *recording, run, options, options.trials_per_level);
-        if (!responses) return std::unexpected(responses.error());
-        p.levels.push_back({level, responses->values, mean(responses->values)});
+        runs.push_back(p.held);
+        coefficient(runs.back(), parameter) = level;
         xs.push_back(level);
+      }
+      auto responses = run_all(clump, table, *recording, runs, options, team);
+      if (!responses) return std::unexpected(responses.error());
+      for (std::size_t i = 0; i < xs.size(); ++i) {
+        p.levels.push_back({xs[i], (*responses)[i].values, mean((*responses)[i].values)});
         ys.push_back(p.levels.back().mean);
       }
       p.fit = fit_quadratic(xs, ys);
@@ -163,8 +193,9 @@ Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable
       Interaction verify = current;
       if (parameter == "static_friction") verify.rolling_friction = 0.0;
       if (parameter == "restitution") verify.static_friction = verify.rolling_friction = 0.0;
-      auto check = run_responses(clump, table, *recording, verify, options, options.trials_per_level);
-      if (!check) return std::unexpected(check.error());
+      auto checked = run_all(clump, table, *recording, {verify}, options, team);
+      if (!checked) return std::unexpected(checked.error());
+      const Responses* check = &checked->front();
       p.verification_mean = mean(check->values);
       p.verification_responses = check->values;
       p.measured = measured;

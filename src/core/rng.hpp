@@ -3,6 +3,7 @@
 /// xoshiro256** (Blackman & Vigna 2018) seeded through SplitMix64.
 #include <cmath>
 #include <cstdint>
+#include <string_view>
 
 namespace clumpforge {
 
@@ -49,5 +50,13 @@ class Rng {
   }
   std::uint64_t state_[4];
 };
+
+/// A seed made from a run's seed and a work item's identity (a name, a digest): the same on
+/// every rank, thread and order, different for every item.
+inline std::uint64_t seed_for(std::uint64_t seed, std::string_view identity) {
+  std::uint64_t h = 1469598103934665603ULL ^ seed;  // FNV-1a, then mixed
+  for (unsigned char c : identity) h = (h ^ c) * 1099511628211ULL;
+  return Rng(h).next_u64();
+}
 
 }  // namespace clumpforge

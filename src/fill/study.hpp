@@ -8,15 +8,16 @@
 namespace clumpforge {
 
 struct StudyOptions {
-  std::vector<double> lattice_diameters{1e-3, 2e-3, 4e-3};           ///< [m]
+  std::vector<double> lattice_diameters{1e-3, 2e-3, 4e-3};             ///< [m]
   std::vector<int> adaptive_budgets{16, 32, 64, 128, 256, 512, 1024};  ///< sphere counts
 };
 
 struct StudyRow {
-  std::string name;         ///< "lattice-2mm", "adaptive-128"
+  std::string name;  ///< "lattice-2mm", "adaptive-128"
   FillMethod method = FillMethod::Lattice;
-  double parameter = 0.0;   ///< diameter [m] or budget
+  double parameter = 0.0;  ///< diameter [m] or budget
   ClumpError error;
+  Clump clump;                ///< the fill itself (for the study's DEM side)
   double fill_seconds = 0.0;  ///< wall time of the fill and its error report
 };
 

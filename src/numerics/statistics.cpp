@@ -126,11 +126,102 @@ double median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  const double h = std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1);
+  const auto low = static_cast<std::size_t>(std::floor(h));
+  const std::size_t high = std::min(low + 1, values.size() - 1);
+  return values[low] + (h - static_cast<double>(low)) * (values[high] - values[low]);
+}
+
 double chi2_upper_tail(double chi2, double n) {
   if (n <= 0.0) return 1.0;
   const double a = 2.0 / (9.0 * n);
   const double z = (std::cbrt(chi2 / n) - (1.0 - a)) / std::sqrt(a);
   return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
+
+double student_t_two_sided_p(double t, double dof) {
+  if (!std::isfinite(t)) return 0.0;
+  // P(|T| >= t) = I_{dof / (dof + t^2)}(dof / 2, 1 / 2).
+  return incomplete_beta(dof / 2.0, 0.5, dof / (dof + t * t));
+}
+
+double student_t_quantile(double two_sided_p, double dof) {
+  double low = 0.0, high = 1.0;
+  while (student_t_two_sided_p(high, dof) > two_sided_p && high < 1e12) high *= 2.0;
+  for (int i = 0; i < 200 && high - low > 1e-12 * high; ++i) {
+    const double mid = 0.5 * (low + high);
+    (student_t_two_sided_p(mid, dof) > two_sided_p ? low : high) = mid;
+  }
+  return 0.5 * (low + high);
+}
+
+WelchTest welch_test(const std::vector<double>& a, const std::vector<double>& b, double confidence) {
+  WelchTest w;
+  if (a.size() < 2 || b.size() < 2) return w;
+  const SampleSpread sa = sample_spread(a), sb = sample_spread(b);
+  const double va = sa.sd * sa.sd / static_cast<double>(a.size());
+  const double vb = sb.sd * sb.sd / static_cast<double>(b.size());
+  w.difference = sa.mean - sb.mean;
+  w.standard_error = std::sqrt(va + vb);
+  const double na = static_cast<double>(a.size()) - 1.0, nb = static_cast<double>(b.size()) - 1.0;
+  w.dof = va + vb > 0.0 ? (va + vb) * (va + vb) / (va * va / na + vb * vb / nb) : na + nb;
+  if (w.standard_error > 0.0) {
+    w.t = w.difference / w.standard_error;
+    w.p_value = student_t_two_sided_p(w.t, w.dof);
+  } else {
+    w.t = w.difference == 0.0 ? 0.0 : std::copysign(INFINITY, w.difference);
+    w.p_value = w.difference == 0.0 ? 1.0 : 0.0;
+  }
+  w.ci_half_width = student_t_quantile(1.0 - confidence, w.dof) * w.standard_error;
+  // Power 0.8 at the two-sided 5 % level: (t_0.975 + t_0.8) standard errors.
+  w.detectable = (student_t_quantile(0.05, w.dof) + student_t_quantile(0.4, w.dof)) * w.standard_error;
+  return w;
+}
+
+double kolmogorov_upper_tail(double lambda) {
+  if (lambda < 0.2) return 1.0;  // the series is 1 to double precision there
+  double sum = 0.0;
+  for (int k = 1; k <= 100; ++k) {
+    const double term = std::exp(-2.0 * k * k * lambda * lambda);
+    sum += (k % 2 == 1 ? 2.0 : -2.0) * term;
+    if (term < 1e-17) break;
+  }
+  return std::clamp(sum, 0.0, 1.0);
+}
+
+KsTest ks_two_sample(std::vector<double> a, std::vector<double> b) {
+  KsTest ks;
+  if (a.empty() || b.empty()) return ks;
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    const double x = std::min(a[i], b[j]);
+    while (i < a.size() && a[i] == x) ++i;  // ties step both functions together
+    while (j < b.size() && b[j] == x) ++j;
+    ks.statistic = std::max(ks.statistic, std::abs(static_cast<double>(i) / na - static_cast<double>(j) / nb));
+  }
+  const double root = std::sqrt(na * nb / (na + nb));
+  ks.p_value = kolmogorov_upper_tail((root + 0.12 + 0.11 / root) * ks.statistic);
+  return ks;
+}
+
+std::vector<double> holm_adjust(const std::vector<double>& p_values) {
+  const std::size_t m = p_values.size();
+  std::vector<std::size_t> order(m);
+  for (std::size_t i = 0; i < m; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return p_values[x] < p_values[y]; });
+  std::vector<double> adjusted(m, 1.0);
+  double running = 0.0;
+  for (std::size_t k = 0; k < m; ++k) {
+    running = std::max(running, std::min(1.0, static_cast<double>(m - k) * p_values[order[k]]));
+    adjusted[order[k]] = running;
+  }
+  return adjusted;
 }
 
 }  // namespace clumpforge

@@ -30,6 +30,9 @@ SampleSpread sample_spread(const std::vector<double>& values);
 double standard_error(const std::vector<double>& values);
 /// The median (the upper of the two middle values for an even count); NaN when empty.
 double median(std::vector<double> values);
+/// The q-quantile (0 <= q <= 1) by linear interpolation between order statistics (Hyndman &
+/// Fan type 7, as R's and numpy's default); NaN when empty.
+double quantile(std::vector<double> values, double q);
 
 /// Regularized incomplete beta function I_x(a, b) (Lentz continued fraction).
 double incomplete_beta(double a, double b, double x);
@@ -37,5 +40,37 @@ double incomplete_beta(double a, double b, double x);
 double f_distribution_upper_tail(double f, double d1, double d2);
 /// Upper tail of chi^2 with n degrees of freedom (Wilson-Hilferty); 1 for n <= 0.
 double chi2_upper_tail(double chi2, double n);
+
+/// Two-sided tail of Student's t: P(|T| >= |t|) with `dof` degrees of freedom.
+double student_t_two_sided_p(double t, double dof);
+/// The t with P(|T| >= t) = `two_sided_p` (0 < p < 1), by bisection on the tail above.
+double student_t_quantile(double two_sided_p, double dof);
+
+/// Welch's two-sample test of equal means (unequal variances, Welch-Satterthwaite degrees
+/// of freedom). Needs two values in each sample.
+struct WelchTest {
+  double difference = 0.0;      ///< mean(a) - mean(b)
+  double standard_error = 0.0;  ///< of the difference
+  double t = 0.0, dof = 0.0;
+  double p_value = 1.0;        ///< two-sided
+  double ci_half_width = 0.0;  ///< of the difference at `confidence`
+  double detectable = 0.0;     ///< the difference found with 80 % power at the test's 5 % level
+};
+WelchTest welch_test(const std::vector<double>& a, const std::vector<double>& b, double confidence = 0.95);
+
+/// Two-sample Kolmogorov-Smirnov test of equal distributions: the largest distance between the
+/// empirical distribution functions, and its p-value from Kolmogorov's limit with Stephens'
+/// small-sample correction, lambda = (sqrt(ne) + 0.12 + 0.11 / sqrt(ne)) D, ne = n m / (n + m).
+struct KsTest {
+  double statistic = 0.0;  ///< D in [0, 1]
+  double p_value = 1.0;
+};
+KsTest ks_two_sample(std::vector<double> a, std::vector<double> b);
+/// Kolmogorov's limiting tail Q(lambda) = 2 sum_k (-1)^(k-1) exp(-2 k^2 lambda^2).
+double kolmogorov_upper_tail(double lambda);
+
+/// Holm's step-down adjustment of a family of p-values (same order as given, each at most 1):
+/// rejecting where the adjusted value is below alpha holds the family-wise error at alpha.
+std::vector<double> holm_adjust(const std::vector<double>& p_values);
 
 }  // namespace clumpforge

@@ -155,6 +155,32 @@ std::vector<double> Team::sum(std::vector<double> values) const {
   return values;
 }
 
+Result<std::vector<std::vector<double>>> Team::map(
+    std::span<const std::size_t> order, std::size_t width,
+    const std::function<Result<std::vector<double>>(std::size_t)>& work,
+    const std::function<void(std::size_t, std::size_t)>& progress) const {
+  const std::size_t count = order.empty() ? 0 : *std::max_element(order.begin(), order.end()) + 1;
+  std::vector<double> packed(count * width, 0.0);
+  auto one = [&](std::size_t i) -> Result<void> {
+    auto values = work(i);
+    if (!values) return std::unexpected(values.error());
+    if (values->size() != width)
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("work item {} gave {} values where {} were expected", i, values->size(), width));
+    std::copy(values->begin(), values->end(), packed.begin() + static_cast<std::ptrdiff_t>(i * width));
+    return {};
+  };
+  auto shared = share(order, one, progress);
+  // Each rank holds the items it ran and zeros elsewhere: the sum is every item, exactly.
+  packed = sum(std::move(packed));
+  if (!shared) return std::unexpected(shared.error());
+  std::vector<std::vector<double>> out(count);
+  for (std::size_t i = 0; i < count; ++i)
+    out[i].assign(packed.begin() + static_cast<std::ptrdiff_t>(i * width),
+                  packed.begin() + static_cast<std::ptrdiff_t>((i + 1) * width));
+  return out;
+}
+
 std::vector<std::string> Team::gather(const std::string& line) const {
 #ifdef CLUMPFORGE_MPI
   if (impl_->mpi) {

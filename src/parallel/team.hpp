@@ -61,6 +61,14 @@ class Team {
   Result<void> share(std::span<const std::size_t> order, const std::function<Result<void>(std::size_t)>& work,
                      const std::function<void(std::size_t handed_out, std::size_t total)>& progress = {}) const;
 
+  /// `share` for work whose result is a few numbers: `work(i)` returns item i's `width` values,
+  /// and every rank gets every item's values (indexed like `order`'s items, exact bits,
+  /// whichever rank ran it). Every rank calls it with the same `order` and `width`.
+  Result<std::vector<std::vector<double>>> map(
+      std::span<const std::size_t> order, std::size_t width,
+      const std::function<Result<std::vector<double>>(std::size_t)>& work,
+      const std::function<void(std::size_t handed_out, std::size_t total)>& progress = {}) const;
+
   /// Every rank's `line`, in rank order, on the leader (the others get an empty list).
   std::vector<std::string> gather(const std::string& line) const;
   /// The element-wise sum of every rank's `values` (the same length on every rank), on every

@@ -37,6 +37,10 @@ Result<void> check_options(std::span<const Clump> clumps, const DemStudyOptions&
                 fmt::format("{} trials per test: the two-sample tests need 5 to 10000", o.trials));
   if (!(o.significance > 0.0 && o.significance <= 0.5))
     return fail(ErrorCode::InvalidArgument, fmt::format("significance {} is not in (0, 0.5]", o.significance));
+  if (!(o.length_tolerance >= 0.0 && o.length_tolerance < 1.0 && o.angle_tolerance >= 0.0 && o.angle_tolerance < 90.0))
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("tolerances {} m and {} deg are not in [0, 1) m and [0, 90) deg", o.length_tolerance,
+                            o.angle_tolerance));
   if (o.tests.empty() || o.surfaces.empty())
     return fail(ErrorCode::InvalidArgument, "the DEM study needs at least one test and one surface");
   if (!o.reference.empty() && !names.contains(o.reference))
@@ -106,8 +110,14 @@ OutcomeSample sample_of(const WorkItem& item, std::span<const double> block) {
   return s;
 }
 
+double largest_decile_shift(const std::vector<double>& a, const std::vector<double>& b) {
+  double shift = 0.0;
+  for (int k = 1; k <= 9; ++k) shift = std::max(shift, std::abs(quantile(a, k / 10.0) - quantile(b, k / 10.0)));
+  return shift;
+}
+
 // Each clump's samples against the reference's, Holm-adjusted within the clump.
-void compare(DemStudyResult& r, std::size_t clumps, double significance) {
+void compare(DemStudyResult& r, std::size_t clumps, const DemStudyOptions& o) {
   std::map<std::pair<LabTest, std::string>, const OutcomeSample*> reference;
   for (const auto& s : r.samples)
     if (s.clump == r.reference) reference[{s.test, s.surface}] = &s;
@@ -120,9 +130,15 @@ void compare(DemStudyResult& r, std::size_t clumps, double significance) {
       const OutcomeSample& ref = *reference.at({s.test, s.surface});
       const WelchTest w = welch_test(s.values, ref.values);
       const KsTest ks = ks_two_sample(s.values, ref.values);
-      r.comparisons.push_back({.clump = c, .test = s.test, .surface = s.surface, .difference = w.difference,
-                               .difference_ci = w.ci_half_width, .detectable = w.detectable,
-                               .welch_p = w.p_value, .ks_p = ks.p_value, .ks_statistic = ks.statistic});
+      r.comparisons.push_back({.clump = c,
+                               .test = s.test,
+                               .surface = s.surface,
+                               .difference = w.difference,
+                               .difference_ci = w.ci_half_width,
+                               .detectable = w.detectable,
+                               .welch_p = w.p_value,
+                               .ks_p = ks.p_value,
+                               .ks_statistic = ks.statistic});
       family.push_back(w.p_value);
       family.push_back(ks.p_value);
     }
@@ -131,7 +147,9 @@ void compare(DemStudyResult& r, std::size_t clumps, double significance) {
       auto& cmp = r.comparisons[k];
       cmp.welch_p_holm = adjusted[2 * (k - first)];
       cmp.ks_p_holm = adjusted[2 * (k - first) + 1];
-      cmp.distinguishable = std::min(cmp.welch_p_holm, cmp.ks_p_holm) < significance;
+      const double tolerance = cmp.test == LabTest::Tilt ? o.angle_tolerance : o.length_tolerance;
+      cmp.distinguishable = (cmp.welch_p_holm < o.significance && std::abs(cmp.difference) > tolerance) ||
+                            (cmp.ks_p_holm < o.significance && cmp.quantile_shift > tolerance);
     }
   }
 }
@@ -177,30 +195,21 @@ Result<DemStudyResult> run_dem_study(std::span<const Clump> clumps, const DemStu
   DemStudyResult result;
   result.reference = reference_of(clumps, options.reference);
   const std::vector<WorkItem> items = work_items(clumps, options);
-  const std::size_t block = static_cast<std::size_t>(options.trials) + 2;
-  std::vector<double> values(items.size() * block, 0.0);
   std::vector<std::size_t> order(items.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return items[a].weight > items[b].weight; });
-  auto work = [&](std::size_t i) -> Result<void> {
+  auto work = [&](std::size_t i) -> Result<std::vector<double>> {
     if (context.should_stop()) return fail(ErrorCode::Cancelled, "DEM study cancelled");
-    auto out = run_item(clumps[items[i].clump], items[i], options, RunContext{.cancelled = context.cancelled});
-    if (!out) return std::unexpected(out.error());
-    std::copy(out->begin(), out->end(), values.begin() + static_cast<std::ptrdiff_t>(i * block));
-    return {};
+    return run_item(clumps[items[i].clump], items[i], options, RunContext{.cancelled = context.cancelled});
   };
   auto progress = [&](std::size_t handed_out, std::size_t total) {
     context.report("DEM study", static_cast<double>(handed_out) / static_cast<double>(total));
   };
-  auto shared = team.share(order, work, progress);
-  // Every rank holds the items it ran; the sum gives every rank all of them.
-  values = team.sum(std::move(values));
-  if (!shared) return std::unexpected(shared.error());
-  for (std::size_t i = 0; i < items.size(); ++i)
-    result.samples.push_back(
-        sample_of(items[i], std::span<const double>(values).subspan(i * block, block)));
-  compare(result, clumps.size(), options.significance);
+  auto values = team.map(order, static_cast<std::size_t>(options.trials) + 2, work, progress);
+  if (!values) return std::unexpected(values.error());
+  for (std::size_t i = 0; i < items.size(); ++i) result.samples.push_back(sample_of(items[i], (*values)[i]));
+  compare(result, clumps.size(), options);
   judge(result, clumps);
   context.report("DEM study", 1.0);
   return result;

@@ -110,5 +110,57 @@ TEST_F(BatchMpi, AJobWithAKilledRankIsFinishedByResumeWithTheSameBytes) {
     EXPECT_EQ(bytes("killed", file), bytes("plain", file)) << "resumed after a kill: " << file;
 }
 
+// clumpforge study under mpirun (issue 14, item 4): two ranks share the DEM runs of the study's
+// clumps and give the outcomes, the tests and the verdict of one process (the wall times per
+// trial are the only values that may differ).
+TEST_F(BatchMpi, StudyOnTwoRanksGivesTheOutcomesOfOneProcess) {
+  const auto body = (dir_ / "tuber.stl").string();
+  ASSERT_EQ(
+      test::run_clumpforge(fmt::format("repair '{}' -o '{}'", (scans() / "tuber-03.stl").string(), body)).exit_code, 0);
+  auto study = [&](const std::string& out) {
+    return fmt::format("study '{}' -o '{}' --diameters 4mm --budgets 16,48 --tests drop,roll --trials 6 --seed 5", body,
+                       (dir_ / out).string());
+  };
+  const auto plain = test::run_clumpforge(study("study-plain"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const auto shared = test::run_command(mpirun(2, study("study-np2")));
+  ASSERT_EQ(shared.exit_code, 0) << shared.err;
+  EXPECT_NE(shared.out.find("2 MPI ranks"), std::string::npos) << shared.out;
+  auto dem = [&](const std::string& out) {
+    auto j = nlohmann::json::parse(test::read_text(dir_ / out / "study.json")).at("dem");
+    for (auto& s : j["samples"]) s.erase("seconds_per_trial");
+    for (auto& c : j["clumps"]) c.erase("seconds_per_trial");
+    j.erase("summary");  // names the times per trial
+    return j;
+  };
+  const auto one = dem("study-plain"), two = dem("study-np2");
+  EXPECT_EQ(one["samples"].size(), 6u);
+  EXPECT_EQ(one, two);
+}
+
+// clumpforge calibrate under mpirun (issue 14, item 2): the ranks share a sweep's levels (paper)
+// or an evaluation's three tests (joint); the report is the same bytes as one process's.
+TEST_F(BatchMpi, CalibrateOnTwoRanksWritesTheReportOfOneProcess) {
+  const fs::path paper = test::shared_dir() / "data" / "paper";
+  const std::string library = (test::source_dir() / "clumps" / "tuber-default.h5").string();
+  for (const char* method : {"paper", "joint"}) {
+    auto calibrate = [&](const std::string& out) {
+      return fmt::format(
+          "calibrate --recordings '{}' '{}' '{}' --library '{}' --clump lattice-4mm --trials-per-level 3 "
+          "--method {} -o '{}' --json",
+          (paper / "drop-Q235").string(), (paper / "tilt-Q235").string(), (paper / "roll-Q235").string(), library,
+          method, (dir_ / out).string());
+    };
+    const std::string one = fmt::format("cal-{}-plain", method), two = fmt::format("cal-{}-np2", method);
+    const auto plain = test::run_clumpforge(calibrate(one));
+    ASSERT_EQ(plain.exit_code, 0) << method << ": " << plain.err;
+    const auto shared = test::run_command(mpirun(2, calibrate(two)));
+    ASSERT_EQ(shared.exit_code, 0) << method << ": " << shared.err;
+    EXPECT_EQ(shared.out, plain.out) << method;  // only the leader prints
+    ASSERT_FALSE(bytes(one, "calibration.json").empty()) << method;
+    EXPECT_EQ(bytes(two, "calibration.json"), bytes(one, "calibration.json")) << method;
+  }
+}
+
 }  // namespace
 }  // namespace clumpforge

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "support/test_support.hpp"
 
@@ -105,8 +106,8 @@ TEST(StudyCli, WritesTablesAndPlots) {
   const auto scan = (test::source_dir() / "meshes" / "tuber-default.stl").string();
   const auto body = (dir / "tuber.stl").string();
   ASSERT_EQ(test::run_clumpforge(fmt::format("repair '{}' -o '{}'", scan, body)).exit_code, 0);
-  const auto run =
-      test::run_clumpforge(fmt::format("study '{}' -o '{}' --budgets 16,64 --json", body, (dir / "out").string()));
+  const auto run = test::run_clumpforge(
+      fmt::format("study '{}' -o '{}' --budgets 16,64 --tests none --json", body, (dir / "out").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   ASSERT_EQ(j["rows"].size(), 5u);  // lattice 1, 2, 4 mm and two budgets
@@ -118,7 +119,47 @@ TEST(StudyCli, WritesTablesAndPlots) {
   EXPECT_EQ(nlohmann::json::parse(test::read_text(dir / "out" / "study.json"))["rows"].size(), 5u);
   const std::string csv = test::read_text(dir / "out" / "study.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 6);
+  EXPECT_FALSE(j.contains("dem"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "study-dem.png"));
   EXPECT_EQ(test::run_clumpforge(fmt::format("study '{}' -o '{}' --budgets 0", body, (dir / "bad").string())).exit_code,
             1);
+}
+
+// The DEM side: every clump's drop and roll from release orientations, compared with the
+// reference (the clump closest to the scan's surface), the coarsest clump alike named, its
+// table and figure written; absurd options refused with nothing written.
+TEST(StudyCli, ComparesEveryClumpsDemOutcomesWithTheFinest) {
+  test::ScratchDir dir("study-dem");
+  const auto scan = (test::source_dir() / "meshes" / "tuber-default.stl").string();
+  const auto body = (dir / "tuber.stl").string();
+  ASSERT_EQ(test::run_clumpforge(fmt::format("repair '{}' -o '{}'", scan, body)).exit_code, 0);
+  const std::string base = fmt::format("study '{}' --diameters 4mm --budgets 16,64", body);
+  const auto run =
+      test::run_clumpforge(fmt::format("{} --tests drop,roll --trials 8 -o '{}'", base, (dir / "out").string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("## DEM outcomes against adaptive-64"), std::string::npos) << run.out;
+  const auto j = nlohmann::json::parse(test::read_text(dir / "out" / "study.json"));
+  const auto& dem = j.at("dem");
+  EXPECT_EQ(dem["reference"], "adaptive-64");
+  EXPECT_EQ(dem["samples"].size(), 6u);
+  EXPECT_EQ(dem["clumps"].size(), 3u);
+  std::set<std::string> names{"lattice-4mm", "adaptive-16", "adaptive-64"};
+  EXPECT_TRUE(names.contains(dem["coarsest"].get<std::string>()));
+  for (const auto& s : dem["samples"]) {
+    EXPECT_EQ(s["values"].size(), 8u);
+    EXPECT_EQ(s["unit"], "mm");
+    EXPECT_EQ(s.contains("comparison"), s["clump"] != "adaptive-64");
+  }
+  const std::string csv = test::read_text(dir / "out" / "study-dem.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7);
+  EXPECT_EQ(test::read_text(dir / "out" / "study-dem.png").substr(1, 3), "PNG");
+  EXPECT_NE(test::read_text(dir / "out" / "study.md").find("DEM outcomes"), std::string::npos);
+  for (const char* bad :
+       {"--trials 2", "--reference lattice-9mm", "--tests drop,jump", "--significance 0.9 --tests roll"}) {
+    const auto refused = test::run_clumpforge(fmt::format("{} {} -o '{}'", base, bad, (dir / "bad").string()));
+    EXPECT_EQ(refused.exit_code, 1) << bad;
+    EXPECT_NE(refused.err.find("error"), std::string::npos) << bad;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad")) << bad;
+  }
 }
 }  // namespace clumpforge
