@@ -1,11 +1,14 @@
 // The blind benchmark of `clumpforge diagnose`: recordings with every effect of the library
 // hidden at a realistic and a strong magnitude, plus effect-free controls with varied base
-// coefficients, each diagnosed by the real command line (it sees only the recordings and
-// the clump); the answers are read only by the scorer here. Prints the confusion matrix,
+// coefficients, each diagnosed in process by the command line's own diagnosis call (it sees
+// only the recordings and the clump); the answers are read only by the scorer here. Under
+// mpirun the ranks share the cases through a dynamic queue (each case's report written
+// atomically into --out, which every rank must see); the leader scores. Prints the confusion matrix,
 // the detection rate per effect, the false-positive rate on the controls and the median
 // held-out improvement; writes summary.json and summary.md into --out. Resumable: a case
 // whose report.json exists is not run again.
-//   bench_diagnose --library clumps/tuber-default-diagnosis.h5 --cli build/tools/clumpforge -o bench-out/diagnose
+//   bench_diagnose --library clumps/tuber-default-diagnosis.h5 -o bench-out/diagnose
+//   mpirun -np 4 bench_diagnose --recordings-set ../shared/data/lab-like -o bench-out/lab-like
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -18,10 +21,13 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_file.hpp"
 #include "core/rng.hpp"
 #include "diagnose/conceal.hpp"
+#include "diagnose_job.hpp"
 #include "io/clump_library.hpp"
 #include "io/recording_io.hpp"
+#include "parallel/team.hpp"
 
 namespace fs = std::filesystem;
 using namespace clumpforge;
@@ -67,11 +73,45 @@ std::optional<std::pair<fs::path, double>> case_particle(const fs::path& case_di
                    j["particle"].value("density_kg_m3", 1085.0)};
 }
 
+/// Runs one diagnosis in process and stores its report as `report` (atomically); a failure is
+/// written to stderr.txt beside it.
+bool diagnose_case(const std::string& id, const cli::DiagnoseJob& job, const fs::path& report) {
+  fs::create_directories(report.parent_path());
+  auto run = cli::run_diagnose_job(job);
+  if (!run) {
+    std::ofstream(report.parent_path() / "stderr.txt") << run.error().message << "\n";
+    std::cerr << id << ": diagnose failed: " << run.error().message << "\n";
+    return false;
+  }
+  if (auto ok = write_files_atomically({{report, run->report.dump(2) + "\n"}}); !ok) {
+    std::cerr << id << ": " << ok.error().message << "\n";
+    return false;
+  }
+  std::cout << fmt::format("{}: {} ({:.0f} s)\n", id, run->report.value("verdict", "?"), run->result.seconds)
+            << std::flush;
+  return true;
+}
+
+/// The cases of `ids` whose report is not stored yet, shared among the team's ranks.
+bool run_missing(const Team& team, const std::vector<std::string>& ids, const std::function<bool(std::size_t)>& missing,
+                 const std::function<bool(std::size_t)>& run) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (missing(i)) order.push_back(i);
+  auto shared = team.share(order, [&](std::size_t i) -> Result<void> {
+    if (!run(i)) return fail(ErrorCode::InvalidArgument, ids[i] + ": diagnose failed");
+    return {};
+  });
+  team.wait_for_all();
+  if (!shared) std::cerr << shared.error().message << "\n";
+  return static_cast<bool>(shared);
+}
+
 /// Diagnoses every case of a recording set made elsewhere (case-NN/ with recordings, the
 /// particle named in their manifests) through the real command line, blind, then scores the
 /// verdicts against the set's ANSWERS.json, read only here.
-int run_recordings_set(const fs::path& set, const fs::path& out, const std::string& cli, const std::string& extra,
-                       bool existing_only) {
+int run_recordings_set(const fs::path& set, const fs::path& out, const cli::DiagnoseJob& base, bool existing_only,
+                       const Team& team) {
   std::ifstream answers_in(set / "ANSWERS.json");
   const auto answers = nlohmann::json::parse(answers_in, nullptr, false);
   if (answers.is_discarded() || !answers.contains("cases")) {
@@ -79,6 +119,26 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const std::stri
     return 1;
   }
   fs::create_directories(out);
+  std::vector<std::string> ids;
+  for (const auto& [id, answer] : answers["cases"].items())
+    if (fs::is_directory(set / id)) ids.push_back(id);
+  const bool ran =
+      existing_only || run_missing(
+                           team, ids, [&](std::size_t i) { return !fs::exists(out / ids[i] / "report.json"); },
+                           [&](std::size_t i) {
+                             const auto particle = case_particle(set / ids[i]);
+                             if (!particle) {
+                               std::cerr << ids[i] << ": no particle mesh named in its manifests\n";
+                               return false;
+                             }
+                             cli::DiagnoseJob job = base;
+                             job.recordings = {(set / ids[i]).string()};
+                             job.mesh = particle->first.string();
+                             job.density = particle->second;
+                             return diagnose_case(ids[i], job, out / ids[i] / "report.json");
+                           });
+  if (!team.leader()) return ran ? 0 : 1;
+  if (!ran) return 1;
   std::string table =
       "| case | particle | truth | verdict | right | held-out RMS before -> after [mm] | improvement | time [s] "
       "|\n|---|---|---|---|---|---|---:|---:|\n";
@@ -86,26 +146,8 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const std::stri
   std::vector<double> seconds, improvements;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
-    const fs::path case_dir = set / id, report = out / id / "report.json";
-    if (!fs::is_directory(case_dir)) continue;
-    if (!fs::exists(report)) {
-      if (existing_only) continue;
-      const auto particle = case_particle(case_dir);
-      if (!particle) {
-        std::cerr << id << ": no particle mesh named in its manifests\n";
-        return 1;
-      }
-      fs::create_directories(out / id);
-      const std::string command =
-          fmt::format("'{}' diagnose --recordings '{}' --mesh '{}' --density {} {} --json > '{}.tmp' 2> '{}'", cli,
-                      case_dir.string(), particle->first.string(), particle->second, extra, report.string(),
-                      (out / id / "stderr.txt").string());
-      if (std::system(command.c_str()) != 0) {
-        std::cerr << id << ": diagnose failed, see " << (out / id / "stderr.txt").string() << "\n";
-        return 1;
-      }
-      fs::rename(report.string() + ".tmp", report);
-    }
+    const fs::path report = out / id / "report.json";
+    if (!fs::exists(report)) continue;
     std::ifstream in(report);
     const auto j = nlohmann::json::parse(in, nullptr, false);
     if (j.is_discarded()) {
@@ -170,14 +212,13 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const std::stri
 int main(int argc, char** argv) {
   CLI::App app{"Blind benchmark of clumpforge diagnose on concealed-effect recordings"};
   std::string clump_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default-diagnosis.h5", clump_name,
-              cli = CLUMPFORGE_CLI, out = "bench-out/diagnose";
+              out = "bench-out/diagnose";
   int controls = 50, trials = 4;
   std::uint64_t seed = 1;
   std::vector<std::string> only;
   bool full_set = false, existing_only = false;
   app.add_option("--library", clump_file, "Clump library the recordings are made with and diagnosed against");
   app.add_option("--clump", clump_name, "Which clump of the library (a name)");
-  app.add_option("--cli", cli, "The clumpforge executable");
   app.add_option("-o,--output,--out", out, "Working directory (recordings, answers, reports, summary)");
   app.add_option("--controls", controls, "Effect-free controls");
   app.add_option("--trials", trials, "Trials per recording");
@@ -187,7 +228,8 @@ int main(int argc, char** argv) {
                "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
   app.add_flag("--existing-only", existing_only,
                "Score only the cases already diagnosed in --out (a partial run's figures), run none");
-  std::string recordings_set, diagnose_options, orientation = "none", generator_file, generator_name;
+  std::string recordings_set, orientation = "none", generator_file, generator_name;
+  int spheres = 0, threads = 0;
   double fps = 1000.0, noise = 1e-4;
   bool no_pre_roll = false;
   app.add_option("--orientation", orientation,
@@ -202,10 +244,19 @@ int main(int argc, char** argv) {
   app.add_option("--recordings-set", recordings_set,
                  "Score a recording set made elsewhere (case-NN/ folders and ANSWERS.json, e.g. "
                  "../shared/data/lab-like) instead of generating one");
-  app.add_option("--diagnose-options", diagnose_options,
-                 "Extra options passed to every diagnose run of --recordings-set (e.g. \"--spheres 64\")");
+  app.add_option("--spheres", spheres,
+                 "With --recordings-set: spheres of the adaptive clump each case's mesh is filled with (0: by "
+                 "convergence to the scan, as diagnose does)");
+  app.add_option("--threads", threads, "Threads per process (0: the cores shared among the MPI ranks on a node)");
   CLI11_PARSE(app, argc, argv);
-  if (!recordings_set.empty()) return run_recordings_set(recordings_set, out, cli, diagnose_options, existing_only);
+  // Under mpirun the ranks share the cases; on its own, one process.
+  auto team = Team::join({.threads_per_rank = threads});
+  if (!team) {
+    std::cerr << team.error().message << "\n";
+    return 1;
+  }
+  if (!recordings_set.empty())
+    return run_recordings_set(recordings_set, out, cli::DiagnoseJob{.spheres = spheres}, existing_only, *team);
 
   auto clumps = read_clump_library(clump_file);
   if (!clumps) {
@@ -303,36 +354,41 @@ int main(int argc, char** argv) {
     bool detected = false;
   };
   std::vector<Outcome> outcomes;
-  for (const auto& c : cases) {
+  std::vector<std::string> ids;
+  for (const auto& c : cases) ids.push_back(c.id);
+  auto make_and_diagnose = [&](std::size_t i) {
+    const Case& c = cases[i];
     const fs::path dir = fs::path(out) / c.id;
-    const fs::path report = dir / "report.json";
-    const std::string truth = c.effect ? effect_spec(library, *c.effect).name : "none";
-    if (!fs::exists(report) && existing_only) continue;
-    if (!fs::exists(report)) {
-      auto made = make_concealed_recordings(generator, table, c.options);
-      if (!made) {
-        std::cerr << c.id << ": " << made.error().message << "\n";
-        return 1;
-      }
-      fs::remove_all(dir);
-      for (std::size_t r = 0; r < made->recordings.size(); ++r) {
-        if (auto ok = write_recording(dir / "recordings" / made->names[r], made->recordings[r]); !ok) {
-          std::cerr << ok.error().message << "\n";
-          return 1;
-        }
-      }
-      std::ofstream(dir / "answer.json") << answer_json(c.options, *made);
-      // Blind: the diagnosis sees the recordings directory and the clump, nothing else.
-      const std::string command = fmt::format(
-          "'{}' diagnose --recordings '{}' --library '{}' {} --json > '{}.tmp' 2> '{}'", cli,
-          (dir / "recordings").string(), clump_file, clump_name.empty() ? "" : "--clump '" + clump_name + "'",
-          report.string(), (dir / "stderr.txt").string());
-      if (std::system(command.c_str()) != 0) {
-        std::cerr << c.id << ": diagnose failed, see " << (dir / "stderr.txt").string() << "\n";
-        return 1;
-      }
-      fs::rename(report.string() + ".tmp", report);
+    auto made = make_concealed_recordings(generator, table, c.options);
+    if (!made) {
+      std::cerr << c.id << ": " << made.error().message << "\n";
+      return false;
     }
+    fs::remove_all(dir);
+    for (std::size_t r = 0; r < made->recordings.size(); ++r) {
+      if (auto ok = write_recording(dir / "recordings" / made->names[r], made->recordings[r]); !ok) {
+        std::cerr << ok.error().message << "\n";
+        return false;
+      }
+    }
+    std::ofstream(dir / "answer.json") << answer_json(c.options, *made);
+    // Blind: the diagnosis sees the recordings directory and the clump, nothing else.
+    return diagnose_case(
+        c.id,
+        cli::DiagnoseJob{
+            .recordings = {(dir / "recordings").string()}, .library = clump_file, .clump_name = clump_name},
+        dir / "report.json");
+  };
+  const bool ran = existing_only ||
+                   run_missing(
+                       *team, ids, [&](std::size_t i) { return !fs::exists(fs::path(out) / ids[i] / "report.json"); },
+                       make_and_diagnose);
+  if (!team->leader()) return ran ? 0 : 1;
+  if (!ran) return 1;
+  for (const auto& c : cases) {
+    const fs::path report = fs::path(out) / c.id / "report.json";
+    const std::string truth = c.effect ? effect_spec(library, *c.effect).name : "none";
+    if (!fs::exists(report)) continue;
     std::ifstream in(report);
     const auto j = nlohmann::json::parse(in, nullptr, false);
     if (j.is_discarded()) {

@@ -181,6 +181,24 @@ Result<std::vector<std::vector<double>>> Team::map(
   return out;
 }
 
+std::string Team::broadcast(const std::string& text) const {
+#ifdef CLUMPFORGE_MPI
+  if (impl_->mpi && impl_->size > 1) {
+    wait_for_all();
+    unsigned long long length = leader() ? text.size() : 0;
+    MPI_Bcast(&length, 1, MPI_UNSIGNED_LONG_LONG, 0, impl_->world);
+    std::string out = leader() ? text : std::string(static_cast<std::size_t>(length), '\0');
+    for (unsigned long long sent = 0; sent < length;) {  // in pieces below MPI's int count
+      const int piece = static_cast<int>(std::min<unsigned long long>(length - sent, 1ULL << 30));
+      MPI_Bcast(out.data() + sent, piece, MPI_CHAR, 0, impl_->world);
+      sent += static_cast<unsigned long long>(piece);
+    }
+    return out;
+  }
+#endif
+  return text;
+}
+
 std::vector<std::string> Team::gather(const std::string& line) const {
 #ifdef CLUMPFORGE_MPI
   if (impl_->mpi) {

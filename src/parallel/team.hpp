@@ -69,6 +69,9 @@ class Team {
       const std::function<Result<std::vector<double>>(std::size_t)>& work,
       const std::function<void(std::size_t handed_out, std::size_t total)>& progress = {}) const;
 
+  /// The leader's `text` on every rank (what the others pass is ignored): work done once, on the
+  /// leader, and shared (a list of inputs and their digests).
+  std::string broadcast(const std::string& text) const;
   /// Every rank's `line`, in rank order, on the leader (the others get an empty list).
   std::vector<std::string> gather(const std::string& line) const;
   /// The element-wise sum of every rank's `values` (the same length on every rank), on every

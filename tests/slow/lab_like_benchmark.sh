@@ -5,10 +5,10 @@
 # controls `none`. The effects named right are printed (the 10-of-14 target is reported, see
 # docs/diagnose.md).
 set -euo pipefail
-bench=$1 cli=$2 set=$3
+bench=$1 set=$2
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-"$bench" --recordings-set "$set" --out "$out" --cli "$cli"
+"$bench" --recordings-set "$set" --out "$out"
 python3 - "$out/summary.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))

@@ -1,0 +1,268 @@
+// The diagnosis as one call (`clumpforge diagnose` and bench_diagnose): recordings, particle
+// model, diagnose(), and the report.
+#include "diagnose_job.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ranges>
+
+#include "cli_common.hpp"
+#include "fill/fill.hpp"
+#include "io/clump_library.hpp"
+#include "io/materials_io.hpp"
+#include "io/recording_io.hpp"
+
+namespace clumpforge::cli {
+namespace {
+
+// A recording directory, or a directory of recording directories (sorted by name).
+Result<void> collect(const std::string& path, std::vector<Recording>& recordings, std::vector<std::string>& names) {
+  auto set = read_recordings(path);
+  if (!set) return std::unexpected(set.error());
+  for (std::size_t i = 0; i < set->recordings.size(); ++i) {
+    recordings.push_back(std::move(set->recordings[i]));
+    names.push_back(std::move(set->names[i]));
+  }
+  return {};
+}
+
+nlohmann::json coefficients_json(const std::vector<SurfaceParameters>& base) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& b : base) {
+    out[b.surface] = {{"restitution", b.interaction.restitution},
+                      {"static_friction", b.interaction.static_friction},
+                      {"rolling_friction", b.interaction.rolling_friction}};
+  }
+  return out;
+}
+
+nlohmann::json quality_json(const FitQuality& q) {
+  nlohmann::json summary = nlohmann::json::object();
+  for (const auto& [name, v] : q.summary_error) summary[name] = v;
+  return {{"train_rms_mm", q.train_rms_mm},
+          {"heldout_rms_mm", q.heldout_rms_mm},
+          {"train_chi2_per_value", q.train_chi2_per_value},
+          {"heldout_chi2_per_value", q.heldout_chi2_per_value},
+          {"summary_error_mm_or_deg", summary}};
+}
+
+// The particle model: the library's clump, or the mesh filled adaptively (with --spheres, or
+// to the surface accuracy by convergence, the resolutions tried in `ladder`).
+Result<std::pair<Clump, std::vector<std::pair<int, double>>>> particle_model(const DiagnoseJob& job,
+                                                                             const RunContext& context) {
+  std::vector<std::pair<int, double>> ladder;  // spheres, surface RMS [m] of each resolution tried
+  if (!job.library.empty()) {
+    auto clumps = read_clump_library(job.library);
+    if (!clumps) return std::unexpected(clumps.error());
+    auto chosen = select_clump(std::move(*clumps), job.clump_name, job.library);
+    if (!chosen) return std::unexpected(chosen.error());
+    return std::pair{std::move(*chosen), ladder};
+  }
+  SdfOptions sdf;
+  sdf.feature_size = 1e-3;
+  auto body = load_closed_body(job.mesh, job.units, job.density, sdf, context);
+  if (!body) return std::unexpected(body.error());
+  FillOptions fill;
+  fill.method = FillMethod::Adaptive;
+  fill.max_spheres = job.spheres;
+  auto filled = job.spheres > 0 ? fill_body(body->body, fill, context)
+                                : fill_to_surface_accuracy(body->body, fill, job.options.model_accuracy_m / 3.0,
+                                                           kMaxAutoSpheres, &ladder, context);
+  if (!filled) return fail(filled.error().code, fmt::format("'{}': {}", job.mesh, filled.error().message));
+  return std::pair{std::move(filled->clump), ladder};
+}
+}  // namespace
+
+nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string& clump_name) {
+  nlohmann::json j;
+  j["format"] = "clumpforge-diagnosis/1";
+  j["clump"] = clump_name;
+  j["verdict"] = verdict_name(r);
+  j["basis"] = std::string(basis_name(r.basis));
+  j["statement"] = r.statement;
+  j["candidates"] = r.candidates;
+  j["experiment"] = r.experiment;
+  j["effect_parameters"] = nlohmann::json::object();
+  for (const auto& p : r.effect_parameters)
+    j["effect_parameters"][p.name] = {{"value", p.value}, {"low", p.low}, {"high", p.high}};
+  j["summaries_only"] = r.summaries_only;
+  j["decidable"] = r.decidable;
+  j["undecidable"] = r.undecidable;
+  j["noise_m"] = nlohmann::json::object();
+  for (const auto& [name, s] : r.noise_m) j["noise_m"][name] = s;
+  j["baseline"] = coefficients_json(r.baseline);
+  j["refitted_on_all"] = r.refitted_on_all.empty() ? nlohmann::json() : coefficients_json(r.refitted_on_all);
+  j["improved"] = coefficients_json(r.improved);
+  j["uncalibrated"] = r.uncalibrated;
+  if (r.ensemble) {
+    const auto& e = *r.ensemble;
+    auto comparisons_json = [&](const std::vector<OutcomeComparison>& list) {
+      nlohmann::json out = nlohmann::json::array();
+      for (const auto& c : list) {
+        out.push_back({{"recording", e.recordings.at(c.recording)},
+                       {"outcome", outcome_name(c.outcome)},
+                       {"recorded_mean", c.recorded_mean},
+                       {"recorded_sd", c.recorded_sd},
+                       {"recorded_n", c.recorded_n},
+                       {"replayed_mean", c.ensemble_mean},
+                       {"replayed_sd", c.ensemble_sd},
+                       {"replays", c.ensemble_n},
+                       {"floor", c.floor},
+                       {"z", c.z}});
+      }
+      return out;
+    };
+    const nlohmann::json outcomes = comparisons_json(e.null_comparisons);
+    nlohmann::json tried = nlohmann::json::array();
+    const auto library = effect_library();
+    for (const auto& h : e.hypotheses) {
+      const EffectSpec& spec = effect_spec(library, h.effect);
+      nlohmann::json values = nlohmann::json::object();
+      for (std::size_t k = 0; k < spec.parameters.size() && k < h.values.size(); ++k)
+        values[spec.parameters[k].name] = h.values[k];
+      tried.push_back({{"name", spec.name},
+                       {"values", values},
+                       {"chi2", h.chi2},
+                       {"delta_bic", h.delta_bic},
+                       {"plausible", h.plausible},
+                       {"comparisons", comparisons_json(h.comparisons)}});
+    }
+    nlohmann::json detect = nlohmann::json::array();
+    for (const auto& d : e.detectability) {
+      detect.push_back(
+          {{"name", effect_spec(library, d.effect).name},
+           {"strong_signal", d.strong_signal},
+           {"needed", d.needed},
+           {"trials_needed", std::isfinite(d.trials_needed) ? nlohmann::json(d.trials_needed) : nlohmann::json()}});
+    }
+    j["ensemble"] = {{"replays", e.replays},
+                     {"trials", e.trials},
+                     {"detectability", detect},
+                     {"outcomes", e.outcomes},
+                     {"null_chi2", e.null_chi2},
+                     {"calibrated", coefficients_json(e.calibrated)},
+                     {"calibrated_here", e.calibrated_here},
+                     {"comparisons", outcomes},
+                     {"hypotheses", tried}};
+  }
+  j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
+  j["phases"] = nlohmann::json::array();
+  for (const auto& p : r.phases) {
+    j["phases"].push_back({{"recording", p.recording},
+                           {"phase", std::string(phase_name(p.phase))},
+                           {"values", p.values},
+                           {"chi2_per_value", p.chi2_per_value},
+                           {"p_value", p.p_value},
+                           {"significant", p.significant},
+                           {"bias_x_mm", p.bias_x_mm},
+                           {"bias_z_mm", p.bias_z_mm},
+                           {"axis", p.axis == Axis::Z ? "z" : "x"},
+                           {"growth_power", p.growth_power},
+                           {"end_residual_mm", p.end_residual_mm},
+                           {"improved_chi2_per_value", p.improved_chi2_per_value},
+                           {"statement", p.statement}});
+  }
+  j["hypotheses"] = nlohmann::json::array();
+  for (const auto& h : r.hypotheses) {
+    nlohmann::json values = nlohmann::json::object();
+    for (const auto& v : h.values) values[v.name] = v.value;
+    j["hypotheses"].push_back(
+        {{"name", h.name},
+         {"values", values},
+         {"coefficients", coefficients_json(h.base)},
+         {"values_used", h.values_used},
+         {"delta_chi2", h.delta_chi2},
+         {"delta_bic", h.delta_bic},
+         {"heldout_delta_chi2", h.heldout_delta_chi2},
+         {"plausible", h.plausible},
+         {"improves_heldout", h.improves_heldout},
+         {"clears_signature", h.clears_signature},
+         {"clears_large_misfit", h.clears_large_misfit},
+         {"all_trials_delta_bic",
+          std::isfinite(h.all_trials_delta_bic) ? nlohmann::json(h.all_trials_delta_bic) : nlohmann::json()},
+         {"beats_refitted_null", h.beats_refitted_null},
+         {"flagged_excess_before", h.flagged_excess_before},
+         {"flagged_excess_after", h.flagged_excess_after},
+         {"worsened_phases", h.worsened_phases},
+         {"passes", h.passes},
+         {"evaluations", h.evaluations},
+         {"smallest_detectable",
+          std::isfinite(h.smallest_detectable) ? nlohmann::json(h.smallest_detectable) : nlohmann::json()}});
+  }
+  auto phases_of = [](const std::vector<PhaseOf>& list) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& u : list) {
+      out.push_back({{"recording", u.recording},
+                     {"phase", std::string(phase_name(u.phase))},
+                     {"chi2_per_value", u.chi2_per_value},
+                     {"where", u.where}});
+    }
+    return out;
+  };
+  j["unexplained"] = phases_of(r.unexplained);
+  j["outliers"] = phases_of(r.outliers);
+  j["notes"] = r.notes;
+  j["tracked_trials"] = r.tracked_trials;
+  j["training_trials"] = r.training_trials;
+  j["trial_replays"] = r.evaluations;
+  j["seconds"] = r.seconds;
+  return j;
+}
+
+// What the figures need beside report.json: each recording's first trial against both models.
+std::string diagnosis_tracks_json(const DiagnoseResult& r) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& t : r.tracks) {
+    out.push_back({{"recording", t.recording},
+                   {"t", t.t},
+                   {"x", t.x},
+                   {"z", t.z},
+                   {"baseline_t", t.baseline_t},
+                   {"baseline_x", t.baseline_x},
+                   {"baseline_z", t.baseline_z},
+                   {"improved_t", t.improved_t},
+                   {"improved_x", t.improved_x},
+                   {"improved_z", t.improved_z},
+                   {"horizon", std::isfinite(t.horizon) ? nlohmann::json(t.horizon) : nlohmann::json()}});
+  }
+  return out.dump() + "\n";
+}
+
+Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& context) {
+  if (job.mesh.empty() == job.library.empty())
+    return fail(ErrorCode::InvalidArgument, "give exactly one of --mesh and --library");
+  std::vector<Recording> recordings;
+  std::vector<std::string> names;
+  for (const auto& path : job.recordings) {
+    if (auto ok = collect(path, recordings, names); !ok) return std::unexpected(ok.error());
+  }
+  auto table = job.materials.empty() ? Result<MaterialTable>(default_material_table()) : read_materials(job.materials);
+  if (!table) return std::unexpected(table.error());
+  for (const auto& r : recordings) {
+    if (auto s = table->find(r.surface); !s) return std::unexpected(s.error());
+  }
+  auto model = particle_model(job, context);
+  if (!model) return std::unexpected(model.error());
+  auto result = diagnose(model->first, *table, recordings, names, job.options, context);
+  if (!result) return std::unexpected(result.error());
+  const auto& ladder = model->second;
+  if (!ladder.empty()) {
+    result->notes.insert(
+        result->notes.begin(),
+        fmt::format("particle model: adaptive clump of {} spheres, the first of {} whose surface lies within {:.3g} "
+                    "mm RMS of the mesh",
+                    model->first.spheres.size(),
+                    fmt::join(ladder | std::views::transform([](const auto& l) {
+                                return fmt::format("{} ({:.3f} mm)", l.first, l.second * 1e3);
+                              }),
+                              ", "),
+                    job.options.model_accuracy_m * 1e3 / 3.0));
+  }
+  DiagnoseRun run{.result = std::move(*result), .clump = std::move(model->first), .report = {}};
+  run.report = diagnosis_report_json(run.result, run.clump.name);
+  return run;
+}
+
+}  // namespace clumpforge::cli

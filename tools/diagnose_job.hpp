@@ -1,0 +1,42 @@
+#pragma once
+/// The diagnosis as one call, shared by `clumpforge diagnose` and bench_diagnose (which runs it
+/// in process for every case): the recordings read, the particle model made (a library's clump,
+/// or the mesh filled to the surface accuracy), diagnose() run, and its report as JSON.
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/clump.hpp"
+#include "core/error.hpp"
+#include "core/run_context.hpp"
+#include "diagnose/diagnose.hpp"
+
+namespace clumpforge::cli {
+
+/// The largest adaptive clump the convergence ladder tries.
+inline constexpr int kMaxAutoSpheres = 256;
+
+struct DiagnoseJob {
+  std::vector<std::string> recordings;  ///< recording folders, or folders of them
+  std::string mesh;                     ///< the particle's closed mesh, or
+  std::string library, clump_name;      ///< a clump library and the clump's name
+  std::string units = "mm";             ///< of the mesh
+  double density = 1085.0;              ///< of the mesh [kg/m^3]
+  int spheres = 0;                      ///< adaptive budget for the mesh; 0: by convergence to the scan
+  std::string materials;                ///< a materials file, or the built-in table
+  DiagnoseOptions options;
+};
+
+struct DiagnoseRun {
+  DiagnoseResult result;
+  Clump clump;            ///< the particle model diagnosed
+  nlohmann::json report;  ///< report.json
+};
+
+Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& context = {});
+
+nlohmann::json diagnosis_report_json(const DiagnoseResult& result, const std::string& clump_name);
+/// tracks.json: each recorded track with the baseline's and the improved model's replays.
+std::string diagnosis_tracks_json(const DiagnoseResult& result);
+
+}  // namespace clumpforge::cli
