@@ -374,12 +374,15 @@ def study(directory):
     return written
 
 
-def _study_outcome_panel(ax, samples, dem, label):
+def _study_outcome_panel(ax, samples, dem, label, tolerance, unit):
     """One test on one surface: each clump's mean outcome with its 95 % CI against sphere count;
-    the reference's interval as a band; hollow markers where the clump differs from it."""
+    the reference's interval and the tolerance around it as bands; hollow markers where the
+    clump differs from the reference."""
     reference = next(s for s in samples if s["clump"] == dem["reference"])
     low, high = reference["mean"] - reference["ci95"], reference["mean"] + reference["ci95"]
-    ax.axhspan(low, high, color="0.5", alpha=0.18, lw=0, label=f"{dem['reference']} (reference), 95 % CI")
+    ax.axhspan(reference["mean"] - tolerance, reference["mean"] + tolerance, color="#ffbf00", alpha=0.15, lw=0,
+               label=f"reference $\\pm$ tolerance ({tolerance:g} {unit})")
+    ax.axhspan(low, high, color="0.5", alpha=0.25, lw=0, label=f"{dem['reference']} (reference), 95 % CI")
     for method, marker, colour in (("lattice", "s", LAB), ("adaptive", "o", IMPROVED)):
         chosen = sorted((s for s in samples if s["method"] == method), key=lambda s: s["spheres"])
         if not chosen:
@@ -391,12 +394,14 @@ def _study_outcome_panel(ax, samples, dem, label):
             ax.errorbar(s["spheres"], s["mean"], yerr=s["ci95"], fmt=marker, color=colour, capsize=2, ms=5,
                         mfc="white" if differs else colour)
         ax.plot([], [], marker, color=colour, label=f"{method} (hollow: differs)")
-    best = next(s for s in samples if s["clump"] == dem["coarsest"])
-    ax.annotate(f"coarsest alike:\n{best['clump']}", (best["spheres"], best["mean"]), fontsize=7, xytext=(8, -22),
-                textcoords="offset points", arrowprops={"arrowstyle": "->", "lw": 0.6})
+    if dem["coarsest"] != dem["reference"]:
+        best = next(s for s in samples if s["clump"] == dem["coarsest"])
+        ax.annotate(f"coarsest alike:\n{best['clump']}", (best["spheres"], best["mean"]), fontsize=7,
+                    xytext=(8, -22), textcoords="offset points", arrowprops={"arrowstyle": "->", "lw": 0.6})
     ax.set_xscale("log")
     ax.set_xlabel("spheres")
     ax.set_ylabel(label)
+    ax.ticklabel_format(axis="y", useOffset=False, style="plain")
     ax.grid(alpha=0.3, which="both")
 
 
@@ -405,18 +410,19 @@ def study_dem(report, directory):
     dem = report["dem"]
     keys = sorted({(s["surface"], s["test"]) for s in dem["samples"]}, key=lambda k: (k[0], list(RESPONSES).index(k[1])
                                                                                       if k[1] in RESPONSES else 9))
-    columns = min(3, len(keys) + 1)
+    columns = 2 if len(keys) + 1 == 4 else min(3, len(keys) + 1)
     rows = math.ceil((len(keys) + 1) / columns)
     fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.6 * rows), layout="constrained", squeeze=False)
     panels = list(axes.ravel())
     for ax, (surface, test) in zip(panels, keys):
         samples = [s for s in dem["samples"] if s["surface"] == surface and s["test"] == test]
         label, _ = OUTCOME_UNITS.get(test, (test, 1.0))
-        _study_outcome_panel(ax, samples, dem, label)
+        tolerance = dem.get("tolerance_deg", 0.2) if test == "tilt" else dem.get("tolerance_mm", 0.5)
+        _study_outcome_panel(ax, samples, dem, label, tolerance, "deg" if test == "tilt" else "mm")
         ax.set_title(f"{test} on {surface}", fontsize=9)
     panels[0].legend(fontsize=7, frameon=False)
     cost = panels[len(keys)]
-    for (surface, test), colour in zip(keys, (LAB, IMPROVED, BASELINE, "#9467bd", "#8c564b", "#e377c2")):
+    for (surface, test), colour in zip(keys, ("#17becf", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#bcbd22")):
         for method, marker, style in (("lattice", "s", "--"), ("adaptive", "o", "-")):
             pts = sorted((s["spheres"], s["seconds_per_trial"]) for s in dem["samples"]
                          if s["surface"] == surface and s["test"] == test and s["method"] == method)
@@ -441,8 +447,10 @@ def study_dem(report, directory):
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     for ax in panels[len(keys) + 1:]:
         ax.set_visible(False)
-    fig.suptitle(f"DEM outcomes against sphere count ({dem['trials']} release orientations per point, 95 % CI); "
-                 f"{dem['coarsest']} is the coarsest clump alike to {dem['reference']}", fontsize=10)
+    verdict = (f"{dem['coarsest']} is the coarsest clump alike to {dem['reference']}"
+               if dem["coarsest"] != dem["reference"] else f"no coarser clump is alike to {dem['reference']}")
+    fig.suptitle(f"DEM outcomes against sphere count ({dem['trials']} release orientations per point, 95 % CI)\n"
+                 f"{verdict}", fontsize=10)
     return _save(fig, directory, "study-dem")
 
 
