@@ -237,6 +237,11 @@ int main(int argc, char** argv) {
   app.add_option("--fps", fps, "Camera frame rate of the generated tracks [Hz] (labs: 1000, 240)");
   app.add_option("--noise", noise, "Camera noise of the generated tracks [m] (1e-4 at 1000 fps, 5e-4 at 240 fps)");
   app.add_flag("--no-pre-roll", no_pre_roll, "Generated tracks begin after the release");
+  std::string camera_target = "silhouette";
+  double pixel_mm = 0.1;
+  app.add_option("--camera", camera_target,
+                 "What the generated tracks follow: silhouette (the side view's centroid, default) or body-point");
+  app.add_option("--pixel", pixel_mm, "Silhouette camera: pixel size [mm]");
   app.add_option("--generator-library", generator_file,
                  "Clump library the recordings are made with (default: --library); a finer clump of the same mesh "
                  "than the diagnosed one");
@@ -288,6 +293,10 @@ int main(int argc, char** argv) {
   camera.frame_rate_hz = fps;
   camera.noise_m = noise;
   camera.pre_roll = !no_pre_roll;
+  if (auto ok = parse_camera(camera_target, pixel_mm, camera); !ok) {
+    std::cerr << ok.error().message << "\n";
+    return 1;
+  }
   if (auto ok = parse_orientation_record(orientation, camera); !ok) {
     std::cerr << ok.error().message << "\n";
     return 1;

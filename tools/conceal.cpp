@@ -2,6 +2,7 @@
 // proving `clumpforge diagnose` blind. The answer goes to a separate file, for the scorer.
 //   clumpforge-conceal CLUMP.h5 [--clump NAME] --effect air_drag|...|none [--magnitude realistic|strong|V[,V]]
 //                      [--surface Q235] [--trials 8] [--seed 1] [--orientation none|noisy:DEG|exact]
+//                      [--camera silhouette|body-point] [--pixel 0.1]
 //                      [--fps 1000] [--noise 1e-4] [--no-pre-roll] --output DIR [--answer FILE]
 #include "diagnose/conceal.hpp"
 
@@ -54,7 +55,8 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   double noise = 1e-4, fps = 1000.0;
   int steps_per_contact = generator_lab_options().steps_per_contact;
-  std::string orientation = "none";
+  std::string orientation = "none", camera = "silhouette";
+  double pixel_mm = 0.1;
   bool no_conceal = false, small = false, no_pre_roll = false;
   std::optional<double> restitution, static_friction, rolling_friction;
   app.add_option("clump_file", input, "Clump library (.h5)")->required();
@@ -71,6 +73,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-pre-roll", no_pre_roll, "Tracks begin 2-20 ms after the release (default: 5-30 ms before it)");
   app.add_option("--orientation", orientation,
                  "Release orientation written into each trial: none (default, as labs), noisy:DEG, or exact");
+  app.add_option("--camera", camera,
+                 "What the camera tracks: silhouette (its centroid in the side view, default, as tracking software "
+                 "does) or body-point (a point fixed in the body)");
+  app.add_option("--pixel", pixel_mm, "Silhouette camera: the image's pixel size [mm]");
   app.add_option("--steps-per-contact", steps_per_contact,
                  "Time steps per Hertz contact of the generating DEM (finer than the diagnosis's)");
   app.add_option("--restitution", restitution, "Baseline e (default: the table's)");
@@ -95,6 +101,7 @@ int main(int argc, char** argv) {
   }
   options.lab.steps_per_contact = steps_per_contact;
   if (auto ok = parse_orientation_record(orientation, options); !ok) return cli::report_error(kCommand, ok.error());
+  if (auto ok = parse_camera(camera, pixel_mm, options); !ok) return cli::report_error(kCommand, ok.error());
   options.conceal = !no_conceal;
   if (small) {
     options.drop_heights = {0.2, 1.0};

@@ -351,6 +351,8 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
       sample.lowest = lowest_height(b);
       sample.along_plate = (b.position - world.walls[0].pivot).dot(world.walls[0].u_axis);
       sample.contacts = active_contacts(world);
+      sample.position = b.position;
+      sample.orientation = b.orientation;
       for (const auto& entry : world.history) {
         if ((entry.first >> 63) == 0 && entry.second.last_step == world.steps)
           sample.wall = std::max(sample.wall, static_cast<int>(entry.first & 0xFFF));  // wall contacts

@@ -72,6 +72,8 @@ struct ReplaySample {
   double along_plate = 0.0;  ///< tilt: centre-of-mass coordinate along the plate's downhill axis [m]
   int contacts = 0;          ///< sphere-wall contacts
   int wall = -1;             ///< the wall touched (roll: 0 incline, 1 flat), -1 none
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();               ///< centre of mass [m]
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< body -> world
 };
 
 struct ReplayOptions {

@@ -8,10 +8,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "numerics/statistics.hpp"
 #include "core/rng.hpp"
 #include "diagnose/model.hpp"
 #include "diagnose/tracks.hpp"
+#include "numerics/statistics.hpp"
 
 namespace clumpforge {
 namespace {
@@ -124,7 +124,21 @@ std::pair<double, double> camera_window(const std::vector<ReplaySample>& replay,
   return {0.0, replay.back().t};
 }
 
-Track film(const std::vector<ReplaySample>& replay, LabTest test, const ConcealOptions& o, Rng& rng) {
+// Where the camera sees the body at time t: a fixed body point (the replay's tracked point) or
+// the silhouette's centroid, from the pose interpolated between the replay's samples.
+Eigen::Vector2d seen(const std::vector<ReplaySample>& replay, const std::vector<Sphere>& shape, double t,
+                     const ConcealOptions& o) {
+  const ReplayPoint p = interpolate(replay, t);
+  if (o.camera == CameraTarget::BodyPoint || shape.empty()) return {p.x, p.z};
+  const ReplaySample& a = replay[p.index];
+  const ReplaySample& b = replay[std::min(p.index + 1, replay.size() - 1)];
+  const double f = b.t > a.t ? std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0) : 0.0;
+  return silhouette_centroid(shape, a.position + f * (b.position - a.position), a.orientation.slerp(f, b.orientation),
+                             o.pixel_m);
+}
+
+Track film(const std::vector<ReplaySample>& replay, const std::vector<Sphere>& shape, LabTest test,
+           const ConcealOptions& o, Rng& rng) {
   const auto [start, end] = camera_window(replay, test, o.pre_roll, rng);
   const double origin = rng.uniform(0.0, 100.0);
   const double x_origin = test == LabTest::Roll ? 0.0 : rng.uniform(-0.01, 0.01);
@@ -142,10 +156,10 @@ Track film(const std::vector<ReplaySample>& replay, LabTest test, const ConcealO
     const double nx = rng.normal(0.0, o.noise_m), nz = rng.normal(0.0, o.noise_m);
     const bool empty_x = rng.uniform() < o.empty_cell_probability, empty_z = rng.uniform() < o.empty_cell_probability;
     if (lost && k != 0 && k != frames) continue;
-    const ReplayPoint p = interpolate(replay, t);
+    const Eigen::Vector2d p = seen(replay, shape, t, o);
     track.t.push_back(std::round((origin + t) * 1e6) / 1e6);
-    track.x.push_back(empty_x ? std::numeric_limits<double>::quiet_NaN() : p.x + x_origin + nx);
-    track.z.push_back(empty_z ? std::numeric_limits<double>::quiet_NaN() : p.z + nz);
+    track.x.push_back(empty_x ? std::numeric_limits<double>::quiet_NaN() : p.x() + x_origin + nx);
+    track.z.push_back(empty_z ? std::numeric_limits<double>::quiet_NaN() : p.y() + nz);
     if (test == LabTest::Tilt) track.tilt.push_back(std::max(0.0, t) * o.tilt_rate_deg_per_s);
   }
   return track;
@@ -171,6 +185,7 @@ std::optional<Eigen::Quaterniond> recorded_orientation(const Eigen::Quaterniond&
 struct Generated {
   std::vector<std::vector<ReplaySample>> replays;  // per trial
   std::vector<double> summaries;
+  std::vector<Sphere> shape;  // the body's spheres, body frame (the composite's in a tilt)
 };
 
 Result<Generated> run_setup(const Clump& clump, const MaterialTable& table, const Recording& setup,
@@ -178,6 +193,7 @@ Result<Generated> run_setup(const Clump& clump, const MaterialTable& table, cons
   auto lab = make_lab_world(clump, table, setup, options);
   if (!lab) return std::unexpected(lab.error());
   Generated g;
+  g.shape = lab->world.bodies[0].spheres;
   g.replays.resize(orientations.size());
   g.summaries.resize(orientations.size());
   const ReplayOptions replay = replay_options(setup);
@@ -196,6 +212,70 @@ std::pair<double, double> coefficient_bounds(LabTest test) {
 }
 
 }  // namespace
+
+Eigen::Vector2d silhouette_centroid(const std::vector<Sphere>& spheres, const Eigen::Vector3d& position,
+                                    const Eigen::Quaterniond& orientation, double pixel) {
+  // Each disc's span on every pixel row it crosses; per row the spans' union, its length and
+  // first moment exact.
+  double low = std::numeric_limits<double>::infinity();
+  std::vector<Eigen::Vector3d> discs;  // x, z, radius
+  for (const Sphere& s : spheres) {
+    const Eigen::Vector3d c = position + orientation * s.centre;
+    discs.emplace_back(c.x(), c.z(), s.radius);
+    low = std::min(low, c.z() - s.radius);
+  }
+  std::vector<std::vector<std::pair<double, double>>> rows;
+  for (const auto& d : discs) {
+    const auto first = static_cast<std::size_t>(std::max(0.0, std::floor((d.y() - d.z() - low) / pixel - 0.5)));
+    const auto last = static_cast<std::size_t>(std::max(0.0, std::ceil((d.y() + d.z() - low) / pixel - 0.5)));
+    if (rows.size() <= last) rows.resize(last + 1);
+    for (std::size_t k = first; k <= last; ++k) {
+      const double dz = low + (static_cast<double>(k) + 0.5) * pixel - d.y();
+      if (std::abs(dz) >= d.z()) continue;
+      const double w = std::sqrt(d.z() * d.z() - dz * dz);
+      rows[k].emplace_back(d.x() - w, d.x() + w);
+    }
+  }
+  double area = 0.0, mx = 0.0, mz = 0.0;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    auto& spans = rows[k];
+    std::sort(spans.begin(), spans.end());
+    const double z = low + (static_cast<double>(k) + 0.5) * pixel;
+    double a = -std::numeric_limits<double>::infinity(), b = a;
+    auto close = [&] {
+      if (b <= a) return;
+      area += b - a;
+      mx += 0.5 * (b * b - a * a);
+      mz += (b - a) * z;
+    };
+    for (const auto& [s0, s1] : spans) {
+      if (s0 > b) {
+        close();
+        a = s0;
+        b = s1;
+      } else {
+        b = std::max(b, s1);
+      }
+    }
+    close();
+  }
+  if (!(area > 0.0)) return {position.x(), position.z()};
+  return {mx / area, mz / area};
+}
+
+Result<void> parse_camera(std::string_view text, double pixel_mm, ConcealOptions& options) {
+  if (text == "silhouette")
+    options.camera = CameraTarget::Silhouette;
+  else if (text == "body-point")
+    options.camera = CameraTarget::BodyPoint;
+  else
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("camera '{}': expected silhouette or body-point", std::string(text)));
+  if (!(pixel_mm > 0.0 && pixel_mm <= 5.0))
+    return fail(ErrorCode::InvalidArgument, fmt::format("pixel size {} mm is not in (0, 5]", pixel_mm));
+  options.pixel_m = pixel_mm * 1e-3;
+  return {};
+}
 
 Result<void> parse_orientation_record(std::string_view text, ConcealOptions& options) {
   if (text == "none") {
@@ -333,7 +413,7 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
       Trial trial;
       trial.id = fmt::format("{:02d}", i + 1);
       trial.summary = g->summaries[static_cast<std::size_t>(i)];
-      trial.track = film(g->replays[static_cast<std::size_t>(i)], rec.test, options, rng);
+      trial.track = film(g->replays[static_cast<std::size_t>(i)], g->shape, rec.test, options, rng);
       trial.release_orientation = recorded_orientation(orientations[r][static_cast<std::size_t>(i)], options, rng);
       rec.trials.push_back(std::move(trial));
     }

@@ -29,6 +29,14 @@ inline LabOptions generator_lab_options() {
 /// eye), or the exact one (only a simulation knows it).
 enum class OrientationRecord { None, Noisy, Exact };
 
+enum class CameraTarget { Silhouette, BodyPoint };
+
+/// The centroid of a body's silhouette in a side view (the x-z plane, seen along y): the union
+/// of its spheres' discs, sampled in rows `pixel` apart (each row's spans exact), at `position`
+/// and `orientation` [m].
+Eigen::Vector2d silhouette_centroid(const std::vector<Sphere>& spheres, const Eigen::Vector3d& position,
+                                    const Eigen::Quaterniond& orientation, double pixel);
+
 struct ConcealOptions {
   std::optional<Effect> effect;  ///< none: an effect-free control
   std::vector<double> values;    ///< the effect's parameters (empty: its realistic magnitude)
@@ -39,6 +47,10 @@ struct ConcealOptions {
   std::vector<double> roll_starts{0.035, 0.10};     ///< [m]; the first is the study's
   bool tilt = true;
   double incline_deg = 30.0, tilt_rate_deg_per_s = 5.0;
+  /// What the camera tracks: the centroid of the body's silhouette (what tracking software
+  /// finds in a side view, default), or a point fixed in the body (its visible centroid).
+  CameraTarget camera = CameraTarget::Silhouette;
+  double pixel_m = 1e-4;          ///< silhouette camera: the image's pixel size [m]
   double noise_m = 1e-4;          ///< camera noise, per coordinate
   double frame_rate_hz = 1000.0;  ///< (0, 1e5]; labs use 240 to 5000
   OrientationRecord orientation = OrientationRecord::None;
@@ -67,6 +79,10 @@ struct ConcealResult {
   std::vector<double> values;           ///< the effect's parameters used
   std::vector<SummaryMatch> summaries;  ///< study set-ups: baseline vs concealed effect
 };
+
+/// Reads what the camera tracks: "silhouette" (its centroid, with rows `pixel_mm` apart) or
+/// "body-point" into `options`.
+Result<void> parse_camera(std::string_view text, double pixel_mm, ConcealOptions& options);
 
 /// Reads what recordings say of the release: "none", "noisy:DEG" or "exact" into `options`.
 Result<void> parse_orientation_record(std::string_view text, ConcealOptions& options);
