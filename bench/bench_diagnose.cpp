@@ -20,6 +20,7 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
@@ -92,23 +93,28 @@ bool diagnose_case(const std::string& id, const cli::DiagnoseJob& job, const fs:
   return true;
 }
 
-/// The cases of `ids` whose report is not stored yet, shared among the team's ranks.
+/// The cases of `ids` whose report is not stored yet, shared among the team's ranks. The leader
+/// alone decides which are missing (a rank that looked later could see a report another rank
+/// already wrote, and the queue needs one list on every rank).
 bool run_missing(const Team& team, const std::vector<std::string>& ids, const std::function<bool(std::size_t)>& missing,
                  const std::function<bool(std::size_t)>& run) {
+  std::string listed;
+  if (team.leader())
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      if (missing(i)) listed += std::to_string(i) + " ";
+  std::istringstream in(team.broadcast(listed));
   std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < ids.size(); ++i)
-    if (missing(i)) order.push_back(i);
+  for (std::size_t i = 0; in >> i;) order.push_back(i);
   auto shared = team.share(order, [&](std::size_t i) -> Result<void> {
     if (!run(i)) return fail(ErrorCode::InvalidArgument, ids[i] + ": diagnose failed");
     return {};
   });
-  team.wait_for_all();
   if (!shared) std::cerr << shared.error().message << "\n";
   return static_cast<bool>(shared);
 }
 
 /// Diagnoses every case of a recording set made elsewhere (case-NN/ with recordings, the
-/// particle named in their manifests) through the real command line, blind, then scores the
+/// particle named in their manifests) in process, blind, then scores the
 /// verdicts against the set's ANSWERS.json, read only here.
 int run_recordings_set(const fs::path& set, const fs::path& out, const cli::DiagnoseJob& base, bool existing_only,
                        const Team& team) {

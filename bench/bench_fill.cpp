@@ -12,10 +12,10 @@
 
 #include "fill/fill.hpp"
 #include "fill/study.hpp"
-#include "mesh/mesh_writer.hpp"
-#include "mesh/load.hpp"
-#include "mesh/repair.hpp"
 #include "large_scan.hpp"
+#include "mesh/load.hpp"
+#include "mesh/mesh_writer.hpp"
+#include "mesh/repair.hpp"
 #include "synth/tuber.hpp"
 
 namespace {
@@ -49,8 +49,12 @@ void sdf_lattice(benchmark::State& state, const TriangleSoup& soup) {
   }
   state.counters["spheres"] = static_cast<double>(spheres);
 }
-void BM_SdfLattice_Default(benchmark::State& state) { sdf_lattice(state, default_body()); }
-void BM_SdfLattice_200k(benchmark::State& state) { sdf_lattice(state, large_body()); }
+void BM_SdfLattice_Default(benchmark::State& state) {
+  sdf_lattice(state, default_body());
+}
+void BM_SdfLattice_200k(benchmark::State& state) {
+  sdf_lattice(state, large_body());
+}
 
 void BM_ErrorReport(benchmark::State& state) {
   const double d = state.range(0) * 1e-6;
@@ -73,7 +77,8 @@ void BM_Repair_Sdf_Fill2mm_200k(benchmark::State& state) {
   }
 }
 
-#define REPEATED ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)->Repetitions(5)->ReportAggregatesOnly(true)
+#define REPEATED \
+  ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)->Repetitions(5)->ReportAggregatesOnly(true)
 BENCHMARK(BM_SdfLattice_Default)->Arg(1000)->Arg(2000)->Arg(4000) REPEATED;
 BENCHMARK(BM_SdfLattice_200k)->Arg(1000)->Arg(2000)->Arg(4000) REPEATED;
 BENCHMARK(BM_ErrorReport)->Arg(1000)->Arg(2000)->Arg(4000) REPEATED;
@@ -85,10 +90,13 @@ void print_study() {
   const auto body = prepare_body(default_body(), 1085.0, sdf);
   const auto rows = run_resolution_study(*body, {});
   fmt::print("\nerror against sphere count, default tuber (lattice 1/2/4 mm, adaptive budgets):\n");
-  fmt::print("{:<15} {:>7} {:>11} {:>22} {:>14} {:>9}\n", "clump", "spheres", "mass error", "worst moment (m-m)", "surface RMS", "time");
+  fmt::print("{:<15} {:>7} {:>11} {:>22} {:>14} {:>9}\n", "clump", "spheres", "mass error", "worst moment (m-m)",
+             "surface RMS", "time");
   for (const auto& r : *rows) {
-    fmt::print("{:<15} {:>7} {:>10.2f}% {:>21.3f}% {:>11.3f} mm {:>8.2f}s\n", r.name, r.error.sphere_count, 100 * r.error.mass_error,
-               100 * r.error.principal_moment_errors_mass_matched.cwiseAbs().maxCoeff(), r.error.surface_rms * 1e3, r.fill_seconds);
+    fmt::print("{:<15} {:>7} {:>10.2f}% {:>21.3f}% {:>11.3f} mm {:>8.2f}s\n", r.name, r.clump.error.sphere_count,
+               100 * r.clump.error.mass_error,
+               100 * r.clump.error.principal_moment_errors_mass_matched.cwiseAbs().maxCoeff(),
+               r.clump.error.surface_rms * 1e3, r.fill_seconds);
   }
 }
 }  // namespace

@@ -105,31 +105,6 @@ int print_summary(const BatchArgs& args, const BatchSummary& s, bool drawn) {
   return s.failed.empty() ? kExitOk : kExitSomeFailed;
 }
 
-// The scans and their digests, read once by the leader (each scan's SHA-256 is its identity)
-// and handed to every rank: a thousand scans are not read by every rank.
-Result<std::vector<ScanItem>> shared_scan_list(const BatchArgs& args, const Team& team) {
-  std::string text;
-  if (team.leader()) {
-    std::vector<fs::path> inputs(args.inputs.begin(), args.inputs.end());
-    auto items = list_scans(inputs);
-    nlohmann::json j;
-    if (!items) {
-      j["error"] = items.error().message;
-    } else {
-      j["items"] = nlohmann::json::array();
-      for (const auto& i : *items) j["items"].push_back({i.name, i.path.string(), i.sha256, i.bytes});
-    }
-    text = j.dump();
-  }
-  const auto j = nlohmann::json::parse(team.broadcast(text));
-  if (j.contains("error")) return fail(ErrorCode::InvalidArgument, j["error"].get<std::string>());
-  std::vector<ScanItem> items;
-  for (const auto& i : j["items"])
-    items.push_back({i[0].get<std::string>(), fs::path(i[1].get<std::string>()), i[2].get<std::string>(),
-                     i[3].get<std::uintmax_t>()});
-  return items;
-}
-
 int run_batch_command(const BatchArgs& args) {
   auto options = options_of(args);
   if (!options) return report_error(kCommand, options.error());
@@ -143,7 +118,8 @@ int run_batch_command(const BatchArgs& args) {
   // Under mpirun or srun the ranks share the scans (docs/cluster.md); on its own, one process.
   auto team = Team::join({.threads_per_rank = args.threads});
   if (!team) return report_error(kCommand, team.error());
-  auto items = shared_scan_list(args, *team);
+  std::vector<fs::path> inputs(args.inputs.begin(), args.inputs.end());
+  auto items = list_scans(inputs, *team);
   if (!items) return team->leader() ? report_error(kCommand, items.error()) : kExitFailure;
   BatchPlan plan{.items = std::move(*items), .output = args.output, .resume = args.resume};
   if (!args.shard.empty()) {

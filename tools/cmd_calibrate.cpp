@@ -31,10 +31,6 @@ struct CalibrateArgs {
   bool json = false;
 };
 
-std::string unit_of(LabTest test) {
-  return test == LabTest::Tilt ? "deg" : "mm";
-}
-
 ContactConventions conventions_of(const CalibrateArgs& args) {
   return args.conventions == "liggghts" ? ContactConventions::Liggghts : ContactConventions::Edem;
 }
@@ -71,7 +67,7 @@ nlohmann::json step_json(const ParameterCalibration& p) {
   nlohmann::json j{{"parameter", p.parameter},
                    {"surface", p.surface},
                    {"test", std::string(to_string(p.test))},
-                   {"units", unit_of(p.test)},
+                   {"units", std::string(study_unit(p.test))},
                    {"held",
                     {{"restitution", p.held.restitution},
                      {"static_friction", p.held.static_friction},
@@ -112,7 +108,7 @@ std::string markdown(const PaperCalibration& c) {
         "|\n",
         p.parameter, p.surface, p.fit.a, p.fit.b, p.fit.c, p.fit.r_squared, p.fit.p_value, p.measured_mean,
         p.calibrated, p.study_value ? fmt::format("{:g}", *p.study_value) : "-", p.verification_mean,
-        100 * p.verification_error, p.flag, fmt::arg("u", unit_of(p.test)));
+        100 * p.verification_error, p.flag, fmt::arg("u", study_unit(p.test)));
   }
   for (const auto& p : c.steps) {
     if (p.parameter != "restitution") continue;
@@ -148,7 +144,7 @@ std::string joint_markdown(const std::vector<JointSurfaceResult>& results) {
     for (const auto& t : r.residuals) {
       text +=
           fmt::format("| {} | {} | {:.4g} {u} | {:.4g} {u} | {:+.3g} {u} | {:+.2f} |\n", r.surface, to_string(t.test),
-                      t.measured_mean, t.simulated_mean, t.residual(), t.z(), fmt::arg("u", unit_of(t.test)));
+                      t.measured_mean, t.simulated_mean, t.residual(), t.z(), fmt::arg("u", study_unit(t.test)));
     }
   }
   for (const auto& r : results) {
@@ -183,7 +179,7 @@ int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<R
     nlohmann::json residuals = nlohmann::json::array();
     for (const auto& t : r.residuals) {
       residuals.push_back({{"test", std::string(to_string(t.test))},
-                           {"units", unit_of(t.test)},
+                           {"units", std::string(study_unit(t.test))},
                            {"measured_mean", t.measured_mean},
                            {"simulated_mean", t.simulated_mean},
                            {"residual", t.residual()},

@@ -84,8 +84,6 @@ void print_text(const DiagnoseResult& r) {
 
 int run_diagnose(const DiagnoseArgs& args) {
   constexpr std::string_view kCommand = "diagnose";
-  if (args.mesh.empty() == args.clump.empty())
-    return report_error(kCommand, {ErrorCode::InvalidArgument, "give exactly one of --mesh and --library"});
   if (args.spheres != 0 && (args.spheres < 1 || args.spheres > 5000)) {
     return report_error(
         kCommand, {ErrorCode::InvalidArgument, "--spheres must be 0 (chosen by convergence) or between 1 and 5000"});

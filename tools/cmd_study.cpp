@@ -36,14 +36,6 @@ struct StudyArgs {
 
 // ---------------------------------------------------------------- the DEM side
 
-// A test's outcome in the report's unit: rebound height and roll distance in mm, slip angle in deg.
-double shown(LabTest test, double value) {
-  return test == LabTest::Tilt ? value : value * 1e3;
-}
-std::string_view unit_of(LabTest test) {
-  return test == LabTest::Tilt ? "deg" : "mm";
-}
-
 Result<std::optional<DemStudyOptions>> dem_options_of(const StudyArgs& a) {
   if (a.tests == "none") return std::optional<DemStudyOptions>();
   DemStudyOptions o{.tests = {},
@@ -72,21 +64,13 @@ std::string dem_headline(const std::vector<StudyRow>& rows, const DemStudyResult
   if (r.coarsest == r.reference) {
     // What keeps the next clump of the reference's method from passing: the outcomes that have
     // not converged at the reference's resolution.
-    const StudyRow* next = nullptr;
-    std::size_t next_index = 0;
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      const bool coarser = rows[i].method == rows[r.reference].method && i != r.reference &&
-                           rows[i].clump.spheres.size() <= rows[r.reference].clump.spheres.size();
-      if (coarser && (!next || rows[i].clump.spheres.size() > next->clump.spheres.size())) {
-        next = &rows[i];
-        next_index = i;
-      }
-    }
+    const StudyRow* next = r.next_coarser ? &rows[*r.next_coarser] : nullptr;
     std::vector<std::string> differing;
     for (const auto& c : r.comparisons)
-      if (next && c.clump == next_index && c.distinguishable)
+      if (next && c.clump == *r.next_coarser && c.distinguishable)
         differing.push_back(fmt::format("{} on {} by {:+.3g} +- {:.2g} {}", to_string(c.test), c.surface,
-                                        shown(c.test, c.difference), shown(c.test, c.difference_ci), unit_of(c.test)));
+                                        study_units(c.test, c.difference), study_units(c.test, c.difference_ci),
+                                        study_unit(c.test)));
     return fmt::format(
         "no clump coarser than {} gives DEM outcomes that cannot be told from its own ({} trials per test, "
         "Holm-adjusted {:g} %){}",
@@ -108,17 +92,15 @@ std::string dem_markdown(const std::vector<StudyRow>& rows, const DemStudyResult
       "| clump | spheres | test | surface | mean (95 % CI) | minus reference (95 % CI) | detectable | p Welch | p KS | "
       "differs | DEM s/trial |\n| --- | ---: | --- | --- | ---: | ---: | ---: | ---: | ---: | --- | ---: |\n";
   for (const auto& s : r.samples) {
-    const SampleComparison* cmp = nullptr;
-    for (const auto& c : r.comparisons)
-      if (c.clump == s.clump && c.test == s.test && c.surface == s.surface) cmp = &c;
-    const auto u = unit_of(s.test);
+    const SampleComparison* cmp = r.comparison(s);
+    const auto u = study_unit(s.test);
     text += fmt::format("| {} | {} | {} | {} | {:.4g} +- {:.2g} {} | ", rows[s.clump].name,
-                        rows[s.clump].clump.spheres.size(), to_string(s.test), s.surface, shown(s.test, s.mean),
-                        shown(s.test, s.ci_half_width), u);
+                        rows[s.clump].clump.spheres.size(), to_string(s.test), s.surface, study_units(s.test, s.mean),
+                        study_units(s.test, s.ci_half_width), u);
     if (cmp)
       text += fmt::format("{:+.3g} +- {:.2g} {} | {:.2g} {} | {:.3g} | {:.3g} | {} | {:.3g} |\n",
-                          shown(s.test, cmp->difference), shown(s.test, cmp->difference_ci), u,
-                          shown(s.test, cmp->detectable), u, cmp->welch_p_holm, cmp->ks_p_holm,
+                          study_units(s.test, cmp->difference), study_units(s.test, cmp->difference_ci), u,
+                          study_units(s.test, cmp->detectable), u, cmp->welch_p_holm, cmp->ks_p_holm,
                           cmp->distinguishable ? "yes" : "no", s.seconds_per_trial);
     else
       text += fmt::format("reference | | | | | {:.3g} |\n", s.seconds_per_trial);
@@ -131,15 +113,14 @@ std::string dem_csv(const std::vector<StudyRow>& rows, const DemStudyResult& r) 
       "clump,spheres,test,surface,unit,trials,mean,sd,ci95,difference,difference_ci95,detectable,welch_p_holm,ks_p_"
       "holm,distinguishable,seconds_per_trial,steps_per_trial\n";
   for (const auto& s : r.samples) {
-    SampleComparison cmp{};
-    for (const auto& c : r.comparisons)
-      if (c.clump == s.clump && c.test == s.test && c.surface == s.surface) cmp = c;
+    const SampleComparison* found = r.comparison(s);
+    const SampleComparison cmp = found ? *found : SampleComparison{};
     text += fmt::format("{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4g},{:.4g},{},{:.4g},{:.6g}\n",
                         rows[s.clump].name, rows[s.clump].clump.spheres.size(), to_string(s.test), s.surface,
-                        unit_of(s.test), s.values.size(), shown(s.test, s.mean), shown(s.test, s.sd),
-                        shown(s.test, s.ci_half_width), shown(s.test, cmp.difference), shown(s.test, cmp.difference_ci),
-                        shown(s.test, cmp.detectable), cmp.welch_p_holm, cmp.ks_p_holm, cmp.distinguishable ? 1 : 0,
-                        s.seconds_per_trial, s.steps_per_trial);
+                        study_unit(s.test), s.values.size(), study_units(s.test, s.mean), study_units(s.test, s.sd),
+                        study_units(s.test, s.ci_half_width), study_units(s.test, cmp.difference),
+                        study_units(s.test, cmp.difference_ci), study_units(s.test, cmp.detectable), cmp.welch_p_holm,
+                        cmp.ks_p_holm, cmp.distinguishable ? 1 : 0, s.seconds_per_trial, s.steps_per_trial);
   }
   return text;
 }
@@ -164,24 +145,24 @@ nlohmann::json dem_json(const std::vector<StudyRow>& rows, const DemStudyResult&
                      {"method", std::string(to_string(rows[s.clump].method))},
                      {"test", std::string(to_string(s.test))},
                      {"surface", s.surface},
-                     {"unit", std::string(unit_of(s.test))},
-                     {"mean", shown(s.test, s.mean)},
-                     {"sd", shown(s.test, s.sd)},
-                     {"ci95", shown(s.test, s.ci_half_width)},
+                     {"unit", std::string(study_unit(s.test))},
+                     {"mean", study_units(s.test, s.mean)},
+                     {"sd", study_units(s.test, s.sd)},
+                     {"ci95", study_units(s.test, s.ci_half_width)},
                      {"seconds_per_trial", s.seconds_per_trial},
                      {"steps_per_trial", s.steps_per_trial}};
-    for (double v : s.values) e["values"].push_back(shown(s.test, v));
-    for (const auto& c : r.comparisons) {
-      if (c.clump != s.clump || c.test != s.test || c.surface != s.surface) continue;
-      e["comparison"] = {{"difference", shown(s.test, c.difference)},
-                         {"difference_ci95", shown(s.test, c.difference_ci)},
-                         {"detectable", shown(s.test, c.detectable)},
+    for (double v : s.values) e["values"].push_back(study_units(s.test, v));
+    if (const SampleComparison* found = r.comparison(s)) {
+      const SampleComparison& c = *found;
+      e["comparison"] = {{"difference", study_units(s.test, c.difference)},
+                         {"difference_ci95", study_units(s.test, c.difference_ci)},
+                         {"detectable", study_units(s.test, c.detectable)},
                          {"welch_p", c.welch_p},
                          {"ks_p", c.ks_p},
                          {"welch_p_holm", c.welch_p_holm},
                          {"ks_p_holm", c.ks_p_holm},
                          {"ks_statistic", c.ks_statistic},
-                         {"decile_shift", shown(s.test, c.quantile_shift)},
+                         {"decile_shift", study_units(s.test, c.quantile_shift)},
                          {"distinguishable", c.distinguishable}};
     }
     j["samples"].push_back(e);
@@ -206,7 +187,7 @@ std::string csv_table(const std::vector<StudyRow>& rows) {
       "moment_error_mm_1,moment_error_mm_2,moment_error_mm_3,axis_error_deg,surface_rms_m,surface_max_m,dice,fill_"
       "seconds\n";
   for (const auto& r : rows) {
-    const auto& e = r.error;
+    const auto& e = r.clump.error;
     text += fmt::format(
         "{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4g},{:.6g},{:.6g},{:.5f},{:.3f}\n",
         r.name, to_string(r.method), e.sphere_count, e.volume_error, e.mass_error, e.com_offset_norm,
@@ -225,7 +206,7 @@ std::string markdown_table(const std::vector<StudyRow>& rows) {
       "axis [deg] | surface RMS [mm] | surface max [mm] | Dice | fill [s] |\n"
       "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   for (const auto& r : rows) {
-    const auto& e = r.error;
+    const auto& e = r.clump.error;
     text += fmt::format(
         "| {} | {} | {:.2f} % | {:.2f} % | {:.3f} % | {:.3f} | {:.2f} | {:.3f} | {:.3f} | {:.4f} | {:.2f} |\n", r.name,
         e.sphere_count, 100 * e.mass_error, 100 * worst(e.principal_moment_errors),
@@ -240,18 +221,19 @@ std::string markdown_table(const std::vector<StudyRow>& rows) {
 std::string headline(const std::vector<StudyRow>& rows) {
   const StudyRow* finest = nullptr;
   for (const auto& r : rows) {
-    if (r.method == FillMethod::Lattice && (!finest || r.error.sphere_count > finest->error.sphere_count)) finest = &r;
+    if (r.method == FillMethod::Lattice && (!finest || r.clump.error.sphere_count > finest->clump.error.sphere_count))
+      finest = &r;
   }
   if (!finest) return {};
-  const double target = worst(finest->error.principal_moment_errors_mass_matched);
+  const double target = worst(finest->clump.error.principal_moment_errors_mass_matched);
   for (const auto& r : rows) {
-    if (r.method == FillMethod::Adaptive && worst(r.error.principal_moment_errors_mass_matched) <= target) {
+    if (r.method == FillMethod::Adaptive && worst(r.clump.error.principal_moment_errors_mass_matched) <= target) {
       return fmt::format(
           "adaptive reaches {}'s worst mass-matched moment error ({:.3f} %) with {} spheres ({:.1f} x fewer than {}), "
           "mass error {:.2f} % against {:.1f} %",
-          finest->name, 100 * target, r.error.sphere_count,
-          static_cast<double>(finest->error.sphere_count) / r.error.sphere_count, finest->error.sphere_count,
-          100 * r.error.mass_error, 100 * finest->error.mass_error);
+          finest->name, 100 * target, r.clump.error.sphere_count,
+          static_cast<double>(finest->clump.error.sphere_count) / r.clump.error.sphere_count,
+          finest->clump.error.sphere_count, 100 * r.clump.error.mass_error, 100 * finest->clump.error.mass_error);
     }
   }
   return fmt::format("no adaptive budget reached {}'s worst mass-matched moment error ({:.3f} %)", finest->name,
@@ -283,12 +265,8 @@ int run_study(const StudyArgs& args) {
   if (!team) return report_error(kCommand, team.error());
   const RunContext shown_context = progress_context(args.json);
   const RunContext context = team->leader() ? shown_context : RunContext{.cancelled = shown_context.cancelled};
-  SdfOptions sdf;
-  sdf.feature_size =
-      options.lattice_diameters.empty()
-          ? 1e-3
-          : std::min(1e-3, *std::min_element(options.lattice_diameters.begin(), options.lattice_diameters.end()));
-  auto loaded = load_closed_body(args.input, args.units, args.density, sdf, context);
+  auto loaded =
+      load_closed_body(args.input, args.units, args.density, sdf_for_lattices(options.lattice_diameters), context);
   if (!loaded) return report_error(kCommand, loaded.error());
   auto rows = run_resolution_study(loaded->body, options, context);
   if (!rows) return report_error(kCommand, rows.error());
@@ -329,11 +307,11 @@ int run_study(const StudyArgs& args) {
                         {"summary", summary},
                         {"rows", nlohmann::json::array()}};
   for (const auto& r : *rows) {
-    nlohmann::json row = error_to_json(r.error);
+    nlohmann::json row = error_to_json(r.clump.error);
     row["name"] = r.name;
     row["method"] = std::string(to_string(r.method));
-    row["spheres"] = r.error.sphere_count;
-    row["worst_moment_error_mass_matched"] = worst(r.error.principal_moment_errors_mass_matched);
+    row["spheres"] = r.clump.error.sphere_count;
+    row["worst_moment_error_mass_matched"] = worst(r.clump.error.principal_moment_errors_mass_matched);
     row["fill_seconds"] = r.fill_seconds;
     report["rows"].push_back(row);
   }

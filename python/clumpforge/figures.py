@@ -338,6 +338,24 @@ def calibration_overview(steps, directory):
 # ---------------------------------------------------------------- resolution study
 
 
+def _plain_log(axis):
+    """A log axis labelled at 1, 2 and 5 x 10^k in plain numbers."""
+    axis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+
+
+def _against_spheres(ax, label, log_y=True):
+    """A panel of a quantity against sphere count: log x with plain labels, log y unless told."""
+    ax.set_xscale("log")
+    _plain_log(ax.xaxis)
+    if log_y:
+        ax.set_yscale("log")
+    ax.set_xlabel("spheres")
+    ax.set_ylabel(label)
+    ax.grid(alpha=0.3, which="both")
+
+
 def study(directory):
     """Geometry error against sphere count, lattice and adaptive: mass, worst principal
     moment (mass-matched), surface RMS distance, and the fill's time."""
@@ -361,11 +379,7 @@ def study(directory):
                 for r, xi, yi in zip(chosen, n, y):
                     ax.annotate(r["name"].replace("lattice-", ""), (xi, yi), fontsize=7, xytext=(4, 3),
                                 textcoords="offset points")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("spheres")
-        ax.set_ylabel(label)
-        ax.grid(alpha=0.3, which="both")
+        _against_spheres(ax, label)
         ax.legend(fontsize=8, frameon=False)
     fig.suptitle(f"Resolution study of {pathlib.Path(report.get('input', '')).name}: lattice against adaptive fill")
     written = _save(fig, directory, "study")
@@ -398,11 +412,8 @@ def _study_outcome_panel(ax, samples, dem, label, tolerance, unit):
         best = next(s for s in samples if s["clump"] == dem["coarsest"])
         ax.annotate(f"coarsest alike:\n{best['clump']}", (best["spheres"], best["mean"]), fontsize=7,
                     xytext=(8, -22), textcoords="offset points", arrowprops={"arrowstyle": "->", "lw": 0.6})
-    ax.set_xscale("log")
-    ax.set_xlabel("spheres")
-    ax.set_ylabel(label)
+    _against_spheres(ax, label, log_y=False)
     ax.ticklabel_format(axis="y", useOffset=False, style="plain")
-    ax.grid(alpha=0.3, which="both")
 
 
 def study_dem(report, directory):
@@ -431,20 +442,10 @@ def study_dem(report, directory):
                           label=f"{test} on {surface}" if method == "adaptive" else None)
     cost.plot([], [], "s--", color="0.4", ms=4, lw=0.8, label="lattice")
     cost.plot([], [], "o-", color="0.4", ms=4, lw=0.8, label="adaptive")
-    cost.set_xscale("log")
-    cost.set_yscale("log")
-    cost.yaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
-    cost.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-    cost.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    cost.set_xlabel("spheres")
-    cost.set_ylabel("DEM wall time per trial [s]")
-    cost.grid(alpha=0.3, which="both")
+    _against_spheres(cost, "DEM wall time per trial [s]")
+    _plain_log(cost.yaxis)
     cost.legend(fontsize=7, frameon=False)
     cost.set_title("cost", fontsize=9)
-    for ax in panels[:len(keys) + 1]:
-        ax.xaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
-        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     for ax in panels[len(keys) + 1:]:
         ax.set_visible(False)
     verdict = (f"{dem['coarsest']} is the coarsest clump alike to {dem['reference']}"
@@ -536,11 +537,7 @@ def population_errors(report, directory):
                    if c["method"] == method and key in c]
             if pts:
                 ax.scatter(*zip(*pts), marker=marker, s=14, color=colour, alpha=0.7, label=method)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("spheres")
-        ax.set_ylabel(label)
-        ax.grid(alpha=0.3, which="both")
+        _against_spheres(ax, label)
         ax.legend(fontsize=8, frameon=False)
     fig.suptitle("Fill error against sphere count, every scan of the population")
     return _save(fig, directory, "population-errors")

@@ -203,15 +203,15 @@ void bind_functions(py::module_& m) {
       .def_readonly("name", &StudyRow::name)
       .def_readonly("method", &StudyRow::method)
       .def_readonly("parameter", &StudyRow::parameter, "diameter [m] or sphere budget")
-      .def_readonly("error", &StudyRow::error)
+      .def_property_readonly("error", [](const StudyRow& r) { return r.clump.error; })
+      .def_readonly("clump", &StudyRow::clump)
       .def_readonly("fill_seconds", &StudyRow::fill_seconds);
   m.def(
       "resolution_study",
       [](const TriangleSoup& mesh, double density, const std::vector<double>& diameters,
          const std::vector<int>& budgets, const py::object& progress) {
         positive(density, "density");
-        SdfOptions sdf;
-        sdf.feature_size = 1e-3;  // as `clumpforge study`
+        const SdfOptions sdf = sdf_for_lattices(diameters);  // as `clumpforge study`
         const StudyOptions options{diameters, budgets};
         return run_released(progress, [&](const RunContext& c) -> Result<std::vector<StudyRow>> {
           auto body = prepare_body(mesh, density, sdf, c);

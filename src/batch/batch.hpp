@@ -53,6 +53,8 @@ struct ScanItem {
 /// The scans among `inputs` (files, or folders whose .stl/.obj/.ply/.off files are taken),
 /// sorted by name. Two scans with one name, a missing input or none at all is an error.
 Result<std::vector<ScanItem>> list_scans(std::span<const std::filesystem::path> inputs);
+/// The same list for every rank of `team`, read and hashed once, by the leader.
+Result<std::vector<ScanItem>> list_scans(std::span<const std::filesystem::path> inputs, const Team& team);
 
 /// The item's seed: a function of the run's seed and the scan's digest only.
 std::uint64_t item_seed(std::uint64_t run_seed, const std::string& sha256);

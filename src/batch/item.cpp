@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <nlohmann/json.hpp>
 
 #include "batch/batch.hpp"
 #include "core/rng.hpp"
@@ -56,6 +57,29 @@ Result<std::vector<ScanItem>> list_scans(std::span<const fs::path> inputs) {
   }
   std::vector<ScanItem> items;
   for (auto& [name, item] : by_name) items.push_back(std::move(item));
+  return items;
+}
+
+Result<std::vector<ScanItem>> list_scans(std::span<const fs::path> inputs, const Team& team) {
+  if (!team.distributed()) return list_scans(inputs);
+  std::string text;
+  if (team.leader()) {
+    auto items = list_scans(inputs);
+    nlohmann::json j;
+    if (!items) {
+      j["error"] = items.error().message;
+    } else {
+      j["items"] = nlohmann::json::array();
+      for (const auto& i : *items) j["items"].push_back({i.name, i.path.string(), i.sha256, i.bytes});
+    }
+    text = j.dump();
+  }
+  const auto j = nlohmann::json::parse(team.broadcast(text));
+  if (j.contains("error")) return fail(ErrorCode::InvalidArgument, j["error"].get<std::string>());
+  std::vector<ScanItem> items;
+  for (const auto& i : j["items"])
+    items.push_back({i[0].get<std::string>(), fs::path(i[1].get<std::string>()), i[2].get<std::string>(),
+                     i[3].get<std::uintmax_t>()});
   return items;
 }
 
@@ -113,12 +137,10 @@ Result<PreparedBody> body_of(const ScanItem& item, const BatchOptions& options, 
   auto repaired = repair_mesh(std::move(loaded->soup), {}, context);
   if (!repaired) return std::unexpected(repaired.error());
   lap("repair");
-  double smallest = 1e-3;
+  std::vector<double> diameters;
   for (const auto& f : options.fills)
-    if (f.method == FillMethod::Lattice) smallest = std::min(smallest, f.diameter);
-  SdfOptions sdf;
-  sdf.feature_size = smallest;
-  auto body = prepare_body(repaired->soup, options.density, sdf, context);
+    if (f.method == FillMethod::Lattice) diameters.push_back(f.diameter);
+  auto body = prepare_body(repaired->soup, options.density, sdf_for_lattices(diameters), context);
   lap("mass properties and signed distance");
   return body;
 }

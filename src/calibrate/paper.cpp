@@ -119,10 +119,6 @@ void choose(ParameterCalibration& p) {
 }
 }  // namespace
 
-double study_units(LabTest test, double value) {
-  return test == LabTest::Tilt ? value : value * 1e3;
-}
-
 std::vector<double> paper_levels(const std::string& parameter, const std::string& surface) {
   const bool steel = surface == "Q235", soil = surface == "soil";
   if (parameter == "restitution")

@@ -70,7 +70,4 @@ Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable
 /// surfaces get the union of both ranges).
 std::vector<double> paper_levels(const std::string& parameter, const std::string& surface);
 
-/// Responses in the study's units: mm for drop and roll, degrees for tilt.
-double study_units(LabTest test, double value);
-
 }  // namespace clumpforge

@@ -23,6 +23,14 @@ Result<LabTest> parse_lab_test(std::string_view name) {
                                               did_you_mean(name, {"drop", "roll", "tilt"}) + " (drop, roll or tilt)");
 }
 
+double study_units(LabTest test, double value) {
+  return test == LabTest::Tilt ? value : value * 1e3;
+}
+
+std::string_view study_unit(LabTest test) {
+  return test == LabTest::Tilt ? "deg" : "mm";
+}
+
 std::string_view summary_key(LabTest test) {
   switch (test) {
     case LabTest::Drop:

@@ -18,6 +18,10 @@ std::string_view to_string(LabTest test);
 /// "drop", "roll" or "tilt"; anything else is an error naming it, with a "did you mean".
 Result<LabTest> parse_lab_test(std::string_view name);
 std::string_view summary_key(LabTest test);  ///< rebound_height_m, roll_distance_m, slip_angle_deg
+/// A test's summary in the study's units, as reports print it: mm for drop and roll, degrees
+/// for tilt (the summary itself is in m or deg).
+double study_units(LabTest test, double value);
+std::string_view study_unit(LabTest test);  ///< "mm" or "deg"
 
 /// One trial's track: a row per video frame; NaN where tracking was lost.
 struct Track {

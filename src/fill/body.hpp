@@ -1,7 +1,9 @@
 #pragma once
 /// A closed body made ready for filling: in its principal frame, with its signed distance.
+#include <algorithm>
 #include <memory>
 #include <mutex>
+#include <span>
 
 #include "core/error.hpp"
 #include "core/run_context.hpp"
@@ -10,6 +12,16 @@
 #include "sdf/signed_distance.hpp"
 
 namespace clumpforge {
+
+/// The signed distance a set of fills needs: features as fine as the finest lattice diameter,
+/// and at most 1 mm (what the adaptive fill needs). `clumpforge study`, `batch` and the Python
+/// package's resolution study use it alike.
+inline SdfOptions sdf_for_lattices(std::span<const double> lattice_diameters) {
+  SdfOptions sdf;
+  sdf.feature_size = 1e-3;
+  for (double d : lattice_diameters) sdf.feature_size = std::min(sdf.feature_size, d);
+  return sdf;
+}
 
 /// Exact distances to a body's surface, built on first use (only error reports need them).
 class LazySurfaceDistance {
@@ -25,10 +37,10 @@ class LazySurfaceDistance {
 };
 
 struct PreparedBody {
-  TriangleSoup soup;             ///< principal frame: centroid at the origin, principal axes along x, y, z
-  MassProperties properties;     ///< in the principal frame (diagonal inertia)
-  MassProperties original;       ///< in the mesh file's frame
-  SignedDistance sdf;            ///< of `soup`
+  TriangleSoup soup;          ///< principal frame: centroid at the origin, principal axes along x, y, z
+  MassProperties properties;  ///< in the principal frame (diagonal inertia)
+  MassProperties original;    ///< in the mesh file's frame
+  SignedDistance sdf;         ///< of `soup`
   std::shared_ptr<LazySurfaceDistance> surface_cache = std::make_shared<LazySurfaceDistance>();
 
   /// Exact unsigned distances to `soup` (an AABB tree, built on the first call).

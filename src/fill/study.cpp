@@ -22,7 +22,6 @@ Result<std::vector<StudyRow>> run_resolution_study(const PreparedBody& body, con
     row.parameter = row.method == FillMethod::Lattice ? runs[i].diameter : runs[i].max_spheres;
     row.name = row.method == FillMethod::Lattice ? fmt::format("lattice-{:g}mm", runs[i].diameter * 1e3)
                                                  : fmt::format("adaptive-{}", runs[i].max_spheres);
-    row.error = filled->clump.error;
     row.clump = std::move(filled->clump);
     row.fill_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     rows.push_back(std::move(row));

@@ -15,9 +15,8 @@ struct StudyOptions {
 struct StudyRow {
   std::string name;  ///< "lattice-2mm", "adaptive-128"
   FillMethod method = FillMethod::Lattice;
-  double parameter = 0.0;  ///< diameter [m] or budget
-  ClumpError error;
-  Clump clump;                ///< the fill itself (for the study's DEM side)
+  double parameter = 0.0;     ///< diameter [m] or budget
+  Clump clump;                ///< the fill, with its error report (`clump.error`)
   double fill_seconds = 0.0;  ///< wall time of the fill and its error report
 };
 

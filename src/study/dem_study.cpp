@@ -186,8 +186,21 @@ void judge(DemStudyResult& r, std::span<const Clump> clumps) {
       if (clumps[c].spheres.size() < clumps[r.coarsest].spheres.size()) r.coarsest = c;
     }
   }
+  const Clump& reference = clumps[r.reference];
+  for (std::size_t c = 0; c < clumps.size(); ++c) {
+    const bool coarser = c != r.reference && clumps[c].method == reference.method &&
+                         clumps[c].spheres.size() <= reference.spheres.size();
+    if (coarser && (!r.next_coarser || clumps[c].spheres.size() > clumps[*r.next_coarser].spheres.size()))
+      r.next_coarser = c;
+  }
 }
 }  // namespace
+
+const SampleComparison* DemStudyResult::comparison(const OutcomeSample& sample) const {
+  for (const auto& c : comparisons)
+    if (c.clump == sample.clump && c.test == sample.test && c.surface == sample.surface) return &c;
+  return nullptr;
+}
 
 Result<DemStudyResult> run_dem_study(std::span<const Clump> clumps, const DemStudyOptions& options,
                                      const RunContext& context, const Team& team) {

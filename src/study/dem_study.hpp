@@ -91,6 +91,12 @@ struct DemStudyResult {
   /// The fewest spheres among clumps that pass together with every finer clump of their
   /// method (the reference when none does).
   std::size_t coarsest = 0;
+  /// The clump of the reference's method with the most spheres below the reference's: when
+  /// nothing coarser passes, its differing outcomes are those that have not converged.
+  std::optional<std::size_t> next_coarser;
+
+  /// A sample's comparison with the reference's (none for the reference's own samples).
+  const SampleComparison* comparison(const OutcomeSample& sample) const;
 };
 
 /// Runs the study on `clumps` (at least two, distinct names). Under a distributed team every

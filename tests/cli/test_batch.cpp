@@ -12,20 +12,11 @@ namespace clumpforge {
 namespace {
 namespace fs = std::filesystem;
 
-// Small options: the path through every stage, quick enough for the default suite.
-const std::string kOptions =
-    "--diameters 4mm --budgets 24 --validate adaptive-24 --tests drop,roll --surfaces Q235 --trials 2 --seed 7";
+const std::string kOptions = test::kBatchTestOptions;
 
 class BatchCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    fs::create_directories(scans());
-    for (const char* name : {"tuber-01", "tuber-03", "tuber-05", "tuber-07"})
-      fs::copy_file(test::source_dir() / "meshes" / (std::string(name) + ".stl"),
-                    scans() / (std::string(name) + ".stl"));
-    // Sorted between the good scans: not a mesh at all.
-    test::write_text(scans() / "tuber-04.stl", "solid broken\n  facet normal 0 0 1\n    outer loop\nendsolid\n");
-  }
+  void SetUp() override { test::write_batch_scans(scans()); }
   fs::path scans() const { return dir_ / "scans"; }
   test::CommandOutput batch(const std::string& arguments) {
     return test::run_clumpforge(fmt::format("batch {} {}", arguments, kOptions));

@@ -22,8 +22,7 @@ namespace clumpforge {
 namespace {
 namespace fs = std::filesystem;
 
-const std::string kOptions =
-    "--diameters 4mm --budgets 24 --validate adaptive-24 --tests drop,roll --surfaces Q235 --trials 2 --seed 7";
+const std::string kOptions = test::kBatchTestOptions;
 
 class BatchMpi : public ::testing::Test {
  protected:
@@ -32,13 +31,7 @@ class BatchMpi : public ::testing::Test {
     ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
     ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
   }
-  void SetUp() override {
-    fs::create_directories(scans());
-    for (const char* name : {"tuber-01", "tuber-03", "tuber-05", "tuber-07"})
-      fs::copy_file(test::source_dir() / "meshes" / (std::string(name) + ".stl"),
-                    scans() / (std::string(name) + ".stl"));
-    test::write_text(scans() / "tuber-04.stl", "solid broken\n  facet normal 0 0 1\n    outer loop\nendsolid\n");
-  }
+  void SetUp() override { test::write_batch_scans(scans()); }
   fs::path scans() const { return dir_ / "scans"; }
   std::string batch_arguments(const std::string& out, const std::string& extra = "") const {
     return fmt::format("batch '{}' -o '{}' {} {}", scans().string(), (dir_ / out).string(), kOptions, extra);

@@ -51,8 +51,8 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
       fmt::format("diagnose --recordings '{}' --library '{}' --mesh x.stl", (dir / "rec").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("exactly one of --mesh and --library"), std::string::npos) << run.err;
-  run =
-      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}'", (dir / "nowhere").string(), clump()));
+  run = test::run_clumpforge(
+      fmt::format("diagnose --recordings '{}' --library '{}'", (dir / "nowhere").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("nowhere"), std::string::npos) << run.err;
   write(dir / "rec" / "trial-01.csv", "t_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n");
@@ -124,6 +124,8 @@ TEST(ConcealCli, BadOptionsAreRefusedAndNothingIsWritten) {
       {"--fps 0", "the frame rate in (0, 100000] Hz"},
       {"--orientation sideways", "is not none, noisy:DEG or exact"},
       {"--orientation noisy:abc", "noisy takes an angle in degrees"},
+      {"--camera fisheye", "camera 'fisheye': expected silhouette or body-point"},
+      {"--pixel 0", "pixel size 0 mm is not in (0, 5]"},
       {"--steps-per-contact 5", "--steps-per-contact must be between 20 and 10000"},
       {"--surface marble", "tuber - marble"},
   };
@@ -144,9 +146,9 @@ TEST(DiagnoseCli, SummariesOnlySayWhatTheyCanDecide) {
   // by the impacts of an irregular body; drag and speed dependence are undecidable.
   test::ScratchDir dir("diagnose-paper");
   const auto paper = test::shared_dir() / "data" / "paper";
-  const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' '{}' --library '{}' --json --output '{}'",
-                                                    (paper / "drop-Q235").string(), (paper / "roll-Q235").string(),
-                                                    clump(), (dir / "out").string()));
+  const auto run = test::run_clumpforge(
+      fmt::format("diagnose --recordings '{}' '{}' --library '{}' --json --output '{}'", (paper / "drop-Q235").string(),
+                  (paper / "roll-Q235").string(), clump(), (dir / "out").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   EXPECT_EQ(j["verdict"], "none");

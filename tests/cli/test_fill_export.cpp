@@ -154,8 +154,8 @@ TEST(StudyCli, ComparesEveryClumpsDemOutcomesWithTheFinest) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7);
   EXPECT_EQ(test::read_text(dir / "out" / "study-dem.png").substr(1, 3), "PNG");
   EXPECT_NE(test::read_text(dir / "out" / "study.md").find("DEM outcomes"), std::string::npos);
-  for (const char* bad :
-       {"--trials 2", "--reference lattice-9mm", "--tests drop,jump", "--significance 0.9 --tests roll"}) {
+  for (const char* bad : {"--trials 2", "--reference lattice-9mm", "--tests drop,jump",
+                          "--significance 0.9 --tests roll", "--tolerance-mm -1 --tests roll"}) {
     const auto refused = test::run_clumpforge(fmt::format("{} {} -o '{}'", base, bad, (dir / "bad").string()));
     EXPECT_EQ(refused.exit_code, 1) << bad;
     EXPECT_NE(refused.err.find("error"), std::string::npos) << bad;

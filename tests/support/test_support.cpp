@@ -1,5 +1,6 @@
 #include "support/test_support.hpp"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <array>
@@ -7,8 +8,6 @@
 #include <fstream>
 #include <random>
 #include <sstream>
-
-#include <fmt/format.h>
 
 #include "core/rng.hpp"
 
@@ -44,7 +43,8 @@ CommandOutput run_command(const std::string& command_line) {
   const fs::path base = fs::temp_directory_path() / fmt::format("clumpforge-run-{}-{}", ::getpid(), counter++);
   const fs::path out_file = base.string() + ".out";
   const fs::path err_file = base.string() + ".err";
-  const std::string full = fmt::format("{} > '{}' 2> '{}' < /dev/null", command_line, out_file.string(), err_file.string());
+  const std::string full =
+      fmt::format("{} > '{}' 2> '{}' < /dev/null", command_line, out_file.string(), err_file.string());
   const int status = std::system(full.c_str());
   CommandOutput result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -90,8 +90,19 @@ TriangleSoup transformed(const TriangleSoup& soup, const Eigen::Isometry3d& moti
   return moved;
 }
 
-fs::path source_dir() { return CLUMPFORGE_SOURCE_DIR; }
-fs::path shared_dir() { return CLUMPFORGE_SHARED_DIR; }
+fs::path source_dir() {
+  return CLUMPFORGE_SOURCE_DIR;
+}
+fs::path shared_dir() {
+  return CLUMPFORGE_SHARED_DIR;
+}
+
+void write_batch_scans(const fs::path& dir) {
+  fs::create_directories(dir);
+  for (const char* name : {"tuber-01", "tuber-03", "tuber-05", "tuber-07"})
+    fs::copy_file(source_dir() / "meshes" / (std::string(name) + ".stl"), dir / (std::string(name) + ".stl"));
+  write_text(dir / "tuber-04.stl", "solid broken\n  facet normal 0 0 1\n    outer loop\nendsolid\n");
+}
 
 int count_files(const fs::path& dir) {
   int n = 0;

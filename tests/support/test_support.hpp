@@ -1,9 +1,8 @@
 #pragma once
 /// Helpers for the test suites: scratch directories, running the CLI, random motions.
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <string>
-
-#include <Eigen/Geometry>
 
 #include "mesh/triangle_mesh.hpp"
 
@@ -47,5 +46,12 @@ std::filesystem::path shared_dir();
 
 /// Files in `dir` (no recursion), for checking that nothing was half-written.
 int count_files(const std::filesystem::path& dir);
+
+/// The batch tests' population in `dir`: four bundled tubers (01, 03, 05, 07) and, sorted
+/// between them, a broken scan (tuber-04.stl, not a mesh at all).
+void write_batch_scans(const std::filesystem::path& dir);
+/// Batch options small enough for the default suite that still pass through every stage.
+inline constexpr const char* kBatchTestOptions =
+    "--diameters 4mm --budgets 24 --validate adaptive-24 --tests drop,roll --surfaces Q235 --trials 2 --seed 7";
 
 }  // namespace clumpforge::test
