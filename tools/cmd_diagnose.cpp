@@ -28,7 +28,7 @@ struct DiagnoseArgs {
   std::string mesh, clump, clump_name, out, materials, units = "mm";
   double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3, impact_accuracy_pct = 1.0;
   int ensemble_replays = 12;
-  int spheres = 0, max_evaluations = 45, release_orientations = 12;
+  int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
   std::uint64_t seed = 1;
   bool json = false;
 };
@@ -88,6 +88,8 @@ int run_diagnose(const DiagnoseArgs& args) {
     return report_error(
         kCommand, {ErrorCode::InvalidArgument, "--spheres must be 0 (chosen by convergence) or between 1 and 5000"});
   }
+  if (args.finer_clumps < 0 || args.finer_clumps > 4)
+    return report_error(kCommand, {ErrorCode::InvalidArgument, "--finer-clumps must be between 0 and 4"});
   if (args.max_evaluations < 5 || args.max_evaluations > 10000)
     return report_error(kCommand, {ErrorCode::InvalidArgument, "--max-evaluations must be between 5 and 10000"});
   DiagnoseJob job{.recordings = args.recordings,
@@ -97,6 +99,7 @@ int run_diagnose(const DiagnoseArgs& args) {
                   .units = args.units,
                   .density = args.density,
                   .spheres = args.spheres,
+                  .finer_clumps = args.finer_clumps,
                   .materials = args.materials,
                   .options = {}};
   DiagnoseOptions& options = job.options;
@@ -150,6 +153,11 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_option("--spheres", args->spheres,
                   "With --mesh: spheres of the adaptive clump; 0 (default) chooses them by convergence to the scan "
                   "(surface RMS within a third of --model-accuracy)");
+  sub->add_option("--finer-clumps", args->finer_clumps,
+                  "Finer clumps of the same body (0-4, default 2): the resolution is raised while the replayed "
+                  "tracks still change with the next one, and a mismatch is refitted with the rest before it is "
+                  "blamed on missing physics (with --mesh: 2x, 4x ... the spheres; with --library: its clumps with "
+                  "more spheres)");
   add_units_option(*sub, args->units, "With --mesh: its length unit (mm, cm, m)");
   add_density_option(*sub, args->density, "With --mesh: bulk density [kg/m^3]");
   sub->add_option("--effects", args->effects, "Candidate effects to test (default: the whole library)");

@@ -48,18 +48,36 @@ nlohmann::json quality_json(const FitQuality& q) {
           {"summary_error_mm_or_deg", summary}};
 }
 
-// The particle model: the library's clump, or the mesh filled adaptively (with --spheres, or
-// to the surface accuracy by convergence, the resolutions tried in `ladder`).
-Result<std::pair<Clump, std::vector<std::pair<int, double>>>> particle_model(const DiagnoseJob& job,
-                                                                             const RunContext& context) {
-  std::vector<std::pair<int, double>> ladder;  // spheres, surface RMS [m] of each resolution tried
-  if (!job.library.empty()) {
-    auto clumps = read_clump_library(job.library);
-    if (!clumps) return std::unexpected(clumps.error());
-    auto chosen = select_clump(std::move(*clumps), job.clump_name, job.library);
-    if (!chosen) return std::unexpected(chosen.error());
-    return std::pair{std::move(*chosen), ladder};
+// The particle model and the finer clumps of the same body the diagnosis may take or check
+// against (DiagnoseOptions::finer_clumps).
+struct ParticleModels {
+  Clump clump;
+  std::vector<std::pair<int, double>> ladder;  ///< spheres, surface RMS [m] of each resolution tried
+  std::vector<Clump> finer;
+};
+
+// From a library: the clump named, and the library's clumps with more spheres (fewest first).
+Result<ParticleModels> library_models(const DiagnoseJob& job) {
+  auto clumps = read_clump_library(job.library);
+  if (!clumps) return std::unexpected(clumps.error());
+  std::vector<Clump> others = *clumps;
+  auto chosen = select_clump(std::move(*clumps), job.clump_name, job.library);
+  if (!chosen) return std::unexpected(chosen.error());
+  ParticleModels out{.clump = std::move(*chosen), .ladder = {}, .finer = {}};
+  std::erase_if(others, [&](const Clump& c) { return c.spheres.size() <= out.clump.spheres.size(); });
+  std::ranges::sort(others, {}, [](const Clump& c) { return c.spheres.size(); });
+  for (auto& c : others) {
+    if (static_cast<int>(out.finer.size()) < job.finer_clumps) out.finer.push_back(std::move(c));
   }
+  return out;
+}
+
+// The mesh filled adaptively (with --spheres, or to the surface accuracy by convergence, the
+// resolutions tried in `ladder`); finer fills with twice, four times ... as many spheres, kept
+// when they lie closer to the mesh.
+Result<ParticleModels> particle_models(const DiagnoseJob& job, const RunContext& context) {
+  if (!job.library.empty()) return library_models(job);
+  ParticleModels out;
   SdfOptions sdf;
   sdf.feature_size = 1e-3;
   auto body = load_closed_body(job.mesh, job.units, job.density, sdf, context);
@@ -69,9 +87,22 @@ Result<std::pair<Clump, std::vector<std::pair<int, double>>>> particle_model(con
   fill.max_spheres = job.spheres;
   auto filled = job.spheres > 0 ? fill_body(body->body, fill, context)
                                 : fill_to_surface_accuracy(body->body, fill, job.options.model_accuracy_m / 3.0,
-                                                           kMaxAutoSpheres, &ladder, context);
+                                                           kMaxAutoSpheres, &out.ladder, context);
   if (!filled) return fail(filled.error().code, fmt::format("'{}': {}", job.mesh, filled.error().message));
-  return std::pair{std::move(filled->clump), ladder};
+  out.clump = std::move(filled->clump);
+  double surface = out.clump.error.surface_rms;
+  int spheres = static_cast<int>(out.clump.spheres.size());
+  for (int k = 0; k < job.finer_clumps && 2 * spheres <= kMaxFinerSpheres; ++k) {
+    fill.max_spheres = 2 * spheres;
+    auto finer = fill_body(body->body, fill, context);
+    if (!finer) return fail(finer.error().code, fmt::format("'{}': {}", job.mesh, finer.error().message));
+    spheres = fill.max_spheres;
+    // A fill no closer to the mesh (a sphere's mesh is one sphere; more add corners) is no finer.
+    if (!(finer->clump.error.surface_rms < surface)) break;
+    surface = finer->clump.error.surface_rms;
+    out.finer.push_back(std::move(finer->clump));
+  }
+  return out;
 }
 }  // namespace
 
@@ -96,6 +127,31 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["refitted_on_all"] = r.refitted_on_all.empty() ? nlohmann::json() : coefficients_json(r.refitted_on_all);
   j["improved"] = coefficients_json(r.improved);
   j["uncalibrated"] = r.uncalibrated;
+  j["particle_model"] = nlohmann::json();
+  if (r.particle_model) {
+    const auto& m = *r.particle_model;
+    nlohmann::json rungs = nlohmann::json::array();
+    auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+    for (const auto& rung : m.rungs) {
+      rungs.push_back(
+          {{"clump", rung.name},
+           {"spheres", rung.spheres},
+           {"track_difference_mm", number(rung.track_difference_m * 1e3)},
+           {"refitted", rung.refitted},
+           {"chi2_per_value", rung.refitted ? number(rung.chi2_per_value) : nlohmann::json()},
+           {"worst_phase_chi2_per_value", rung.refitted ? number(rung.worst_phase_chi2_per_value) : nlohmann::json()},
+           {"explains", rung.explains}});
+    }
+    j["particle_model"] = {
+        {"diagnosed", m.diagnosed},
+        {"spheres", m.spheres},
+        {"track_tolerance_mm", number(m.track_tolerance_m * 1e3)},
+        {"checked", m.checked},
+        {"chi2_per_value", m.checked ? number(m.chi2_per_value) : nlohmann::json()},
+        {"worst_phase_chi2_per_value", m.checked ? number(m.worst_phase_chi2_per_value) : nlohmann::json()},
+        {"resolution_needed_spheres", m.resolution_needed ? nlohmann::json(*m.resolution_needed) : nlohmann::json()},
+        {"rungs", rungs}};
+  }
   if (r.ensemble) {
     const auto& e = *r.ensemble;
     auto comparisons_json = [&](const std::vector<OutcomeComparison>& list) {
@@ -243,24 +299,32 @@ Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& c
   for (const auto& r : recordings) {
     if (auto s = table->find(r.surface); !s) return std::unexpected(s.error());
   }
-  auto model = particle_model(job, context);
+  auto model = particle_models(job, context);
   if (!model) return std::unexpected(model.error());
-  auto result = diagnose(model->first, *table, recordings, names, job.options, context);
+  DiagnoseOptions options = job.options;
+  options.finer_clumps = std::move(model->finer);
+  auto result = diagnose(model->clump, *table, recordings, names, options, context);
   if (!result) return std::unexpected(result.error());
-  const auto& ladder = model->second;
+  const auto& ladder = model->ladder;
   if (!ladder.empty()) {
     result->notes.insert(
         result->notes.begin(),
         fmt::format("particle model: adaptive clump of {} spheres, the first of {} whose surface lies within {:.3g} "
                     "mm RMS of the mesh",
-                    model->first.spheres.size(),
+                    model->clump.spheres.size(),
                     fmt::join(ladder | std::views::transform([](const auto& l) {
                                 return fmt::format("{} ({:.3f} mm)", l.first, l.second * 1e3);
                               }),
                               ", "),
                     job.options.model_accuracy_m * 1e3 / 3.0));
   }
-  DiagnoseRun run{.result = std::move(*result), .clump = std::move(model->first), .report = {}};
+  // The clump diagnosed: the one the replayed tracks converged with.
+  const std::string diagnosed = result->particle_model ? result->particle_model->diagnosed : model->clump.name;
+  Clump clump = std::move(model->clump);
+  for (auto& f : options.finer_clumps) {
+    if (f.name == diagnosed) clump = std::move(f);
+  }
+  DiagnoseRun run{.result = std::move(*result), .clump = std::move(clump), .report = {}};
   run.report = diagnosis_report_json(run.result, run.clump.name);
   return run;
 }

@@ -15,6 +15,8 @@ namespace clumpforge::cli {
 
 /// The largest adaptive clump the convergence ladder tries.
 inline constexpr int kMaxAutoSpheres = 256;
+/// The largest finer clump made to check the particle model against.
+inline constexpr int kMaxFinerSpheres = 1024;
 
 struct DiagnoseJob {
   std::vector<std::string> recordings;  ///< recording folders, or folders of them
@@ -23,13 +25,17 @@ struct DiagnoseJob {
   std::string units = "mm";             ///< of the mesh
   double density = 1085.0;              ///< of the mesh [kg/m^3]
   int spheres = 0;                      ///< adaptive budget for the mesh; 0: by convergence to the scan
-  std::string materials;                ///< a materials file, or the built-in table
+  /// Finer clumps of the same body for the particle-model check (DiagnoseOptions::finer_clumps):
+  /// from a mesh, fills with 2, 4, ... times the spheres (kept while closer to the mesh); from a
+  /// library, its clumps with more spheres. 0: none.
+  int finer_clumps = 2;
+  std::string materials;  ///< a materials file, or the built-in table
   DiagnoseOptions options;
 };
 
 struct DiagnoseRun {
   DiagnoseResult result;
-  Clump clump;            ///< the particle model diagnosed
+  Clump clump;            ///< the particle model diagnosed (a finer one when the replayed tracks needed it)
   nlohmann::json report;  ///< report.json
 };
 

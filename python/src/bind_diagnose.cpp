@@ -17,8 +17,9 @@ void bind_enums(py::module_& m) {
       .value("unexplained", Verdict::Unexplained)
       .value("undecidable", Verdict::Undecidable);
   py::enum_<Basis> basis(m, "Basis");
-  for (Basis b : {Basis::Consistent, Basis::SlightMisfit, Basis::FrameByFrame, Basis::Ensemble,
-                  Basis::UnexplainedPhases, Basis::TooFewTrials, Basis::TooNoisy, Basis::SummariesOnly})
+  for (Basis b :
+       {Basis::Consistent, Basis::SlightMisfit, Basis::FrameByFrame, Basis::Ensemble, Basis::UnexplainedPhases,
+        Basis::TooFewTrials, Basis::TooNoisy, Basis::SummariesOnly, Basis::ParticleModel, Basis::UnexplainedOutcomes})
     basis.value(std::string(basis_name(b)).c_str(), b);
   py::enum_<Phase> phase(m, "Phase");
   for (Phase p : {Phase::Hold, Phase::Flight, Phase::Impact, Phase::Rebound, Phase::SecondFlight, Phase::LaterBounces,
@@ -86,6 +87,23 @@ void bind_parts(py::module_& m) {
       .def_readonly("phase", &PhaseOf::phase)
       .def_readonly("chi2_per_value", &PhaseOf::chi2_per_value)
       .def_readonly("where", &PhaseOf::where);
+  py::class_<ParticleModelRung>(m, "ParticleModelRung", "One clump the particle-model check tried.")
+      .def_readonly("name", &ParticleModelRung::name)
+      .def_readonly("spheres", &ParticleModelRung::spheres)
+      .def_readonly("track_difference_m", &ParticleModelRung::track_difference_m,
+                    "[m] replayed tracks against the clump before it (NaN: not compared)")
+      .def_readonly("refitted", &ParticleModelRung::refitted)
+      .def_readonly("chi2_per_value", &ParticleModelRung::chi2_per_value)
+      .def_readonly("worst_phase_chi2_per_value", &ParticleModelRung::worst_phase_chi2_per_value)
+      .def_readonly("explains", &ParticleModelRung::explains);
+  py::class_<ParticleModelCheck>(m, "ParticleModelCheck",
+                                 "Whether the particle model, not missing physics, explains a mismatch.")
+      .def_readonly("diagnosed", &ParticleModelCheck::diagnosed)
+      .def_readonly("spheres", &ParticleModelCheck::spheres)
+      .def_readonly("track_tolerance_m", &ParticleModelCheck::track_tolerance_m)
+      .def_readonly("rungs", &ParticleModelCheck::rungs)
+      .def_readonly("checked", &ParticleModelCheck::checked)
+      .def_readonly("resolution_needed", &ParticleModelCheck::resolution_needed);
 }
 
 void bind_result(py::module_& m) {
@@ -114,6 +132,7 @@ void bind_result(py::module_& m) {
       .def_readonly("tracks", &DiagnoseResult::tracks)
       .def_readonly("notes", &DiagnoseResult::notes)
       .def_readonly("undecidable", &DiagnoseResult::undecidable)
+      .def_readonly("particle_model", &DiagnoseResult::particle_model)
       .def_readonly("evaluations", &DiagnoseResult::evaluations)
       .def_readonly("seconds", &DiagnoseResult::seconds);
 }
@@ -121,7 +140,7 @@ void bind_result(py::module_& m) {
 DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, const std::vector<std::string>& effects,
                              std::optional<MaterialTable> materials, double orientation_prior_deg,
                              double model_accuracy, int ensemble_replays, int max_evaluations, std::uint64_t seed,
-                             const py::object& progress) {
+                             const std::vector<Clump>& finer_clumps, const py::object& progress) {
   std::vector<Recording> list;
   std::vector<std::string> names;
   for (const auto& [name, recording] : recordings) {
@@ -140,6 +159,7 @@ DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, con
   options.ensemble_replays = ensemble_replays;
   options.max_evaluations = max_evaluations;
   options.seed = seed;
+  options.finer_clumps = finer_clumps;
   return run_released(progress, [&](const RunContext& c) { return diagnose(clump, table, list, names, options, c); });
 }
 
@@ -152,10 +172,12 @@ void bind_diagnose(py::module_& m) {
   m.def("diagnose", &run_diagnosis, py::arg("clump"), py::arg("recordings"),
         py::arg("effects") = std::vector<std::string>{}, py::arg("materials") = py::none(),
         py::arg("orientation_prior_deg") = 15.0, py::arg("model_accuracy") = 3e-4, py::arg("ensemble_replays") = 12,
-        py::arg("max_evaluations") = 45, py::arg("seed") = 1, py::arg("progress") = py::none(),
+        py::arg("max_evaluations") = 45, py::arg("seed") = 1, py::arg("finer_clumps") = std::vector<Clump>{},
+        py::arg("progress") = py::none(),
         "Finds which physics the model leaves out (`clumpforge diagnose`): recordings is {name: Recording} (as "
         "read_recordings returns), effects the candidates (default: every effect of the library), model_accuracy [m] "
-        "how closely any clump follows the real particle.");
+        "how closely any clump follows the real particle, finer_clumps finer clumps of the same body (the "
+        "resolution raised while replayed tracks change; refitted before a mismatch is blamed on missing physics).");
 }
 
 }  // namespace clumpforge::python

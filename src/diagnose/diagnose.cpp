@@ -40,6 +40,9 @@ constexpr double kLargeMisfit = 10.0;
 /// A coefficient whose chi^2 moves by less than this across its whole range is not pinned by
 /// the fitted windows (the delta-BIC margin: no evidence either way).
 constexpr double kUnpinned = 10.0;
+/// Recorded outcomes are consistent with replays while their chi^2 tail is at least this (the
+/// margin a candidate must leave them within, see judge_ensembles).
+constexpr double kConsistentTail = 1e-4;
 
 bool beyond_noise(double chi2, int values, std::size_t groups) {
   return values > 0 && chi2_upper_tail(chi2, values) < 1e-3 / std::max<std::size_t>(1, groups) &&
@@ -313,6 +316,22 @@ struct Context {
   std::vector<std::size_t> training, heldout, all;
   int evaluations = 0;
   const RunContext* run = nullptr;
+  /// Finer clumps of the same body than the one diagnosed (c.ev.clump), coarsest first: what the
+  /// particle-model check refits with before a mismatch is blamed on missing physics.
+  std::vector<const Clump*> finer;
+};
+
+/// Replays run with `clump` while it lives; the clump before it is restored after.
+class ClumpSwap {
+ public:
+  ClumpSwap(Context& c, const Clump* clump) : c_(c), kept_(c.ev.clump) { c.ev.clump = clump; }
+  ~ClumpSwap() { c_.ev.clump = kept_; }
+  ClumpSwap(const ClumpSwap&) = delete;
+  ClumpSwap& operator=(const ClumpSwap&) = delete;
+
+ private:
+  Context& c_;
+  const Clump* kept_;
 };
 
 Result<std::vector<TrialScore>> score(Context& c, const Model& m, const std::vector<std::size_t>& which, bool keep) {
@@ -942,6 +961,10 @@ std::string_view basis_name(Basis basis) {
       return "too_noisy";
     case Basis::SummariesOnly:
       return "summaries_only";
+    case Basis::ParticleModel:
+      return "particle_model";
+    case Basis::UnexplainedOutcomes:
+      return "unexplained_outcomes";
   }
   return "?";
 }
@@ -1211,6 +1234,224 @@ bool large_misfit(const Context& c, const GroupKey& key, const Group& g) {
   return per_value >= kLargeMisfit;
 }
 
+/// Phases beyond the noise that no particle model's inaccuracy leaves: a smooth discrepancy
+/// shared by the trials (delta-BIC on every trial, cross-validated on the held-out ones), or a
+/// misfit of three times hypot(noise, model accuracy) RMS or more that is not one trial's alone.
+std::vector<PhaseOf> smooth_misfits(const Context& c, const Groups& groups, const DiagnoseOptions& options) {
+  const auto& recordings = *c.ev.recordings;
+  std::vector<PhaseOf> found;
+  for (const auto& [key, g] : groups) {
+    if (key.phase == Phase::Hold || g.values < 20) continue;
+    if (!beyond_noise(g.chi2, g.values, groups.size())) continue;
+    // Judged like a named effect: a clear delta-BIC on every trial, and a shape that the
+    // training trials' segments carry over to the held-out ones. A misfit of three times
+    // the noise or more is a mismatch even when it differs from trial to trial, as long as
+    // it is not one trial's alone.
+    const SmoothDiscrepancy d = smooth_discrepancy(g);
+    const std::string where = fmt::format("{} phases of {}", phase_name(key.phase),
+                                          recording_label(recordings[key.recording], c.names[key.recording]));
+    // Either way it is large: three times hypot(noise, model accuracy) RMS or more. A smaller
+    // misfit is within what a particle model's inaccuracy leaves; 'none' names it.
+    if (g.chi2 < kLargeMisfit * g.values) continue;
+    if (d.parameters > 0 && d.gain - d.parameters * std::log(g.values) >= options.min_delta_bic &&
+        d.heldout_gain > 0.0) {
+      found.push_back({c.names[key.recording], key.phase, g.chi2 / g.values, where});
+    } else if (g.chi2 / g.values >= kLargeMisfit && !outlier_trial(g, trial_spread(g))) {
+      found.push_back(
+          {c.names[key.recording], key.phase, g.chi2 / g.values,
+           fmt::format("{} (chi^2/value {:.0f}, not one shape shared by the trials)", where, g.chi2 / g.values)});
+    }
+  }
+  return found;
+}
+
+/// The largest chi^2 per value of a phase (not the hold) and whether any phase keeps a large
+/// misfit (large_misfit, on either axis) that is not one trial's alone.
+std::pair<double, bool> largest_misfit(const Context& c, const Groups& groups) {
+  double worst = 0.0;
+  bool large = false;
+  for (const auto& [key, g] : groups) {
+    if (key.phase == Phase::Hold || g.values < 20) continue;
+    worst = std::max(worst, g.chi2 / g.values);
+    large = large || (large_misfit(c, key, g) && !outlier_trial(g, trial_spread(g)));
+  }
+  return {worst, large};
+}
+
+/// RMS difference [m] of two replays of the same trial within its fitted window (replay time up
+/// to its horizon), the mean difference removed (the camera origins a fit moves absorb it).
+double replay_difference(const TrackedTrial& tt, const std::vector<ReplaySample>& a,
+                         const std::vector<ReplaySample>& b) {
+  double mx = 0.0, mz = 0.0, sx = 0.0, sz = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k < std::min(a.size(), b.size()) && a[k].t <= tt.horizon; ++k) {
+    const double dx = a[k].x - b[k].x, dz = a[k].z - b[k].z;
+    mx += dx;
+    mz += dz;
+    sx += dx * dx;
+    sz += dz * dz;
+    ++n;
+  }
+  if (n == 0) return 0.0;
+  mx /= n;
+  mz /= n;
+  return std::sqrt(std::max(0.0, sx / n - mx * mx + sz / n - mz * mz));
+}
+
+/// Stage 0, the particle model's resolution by convergence of the replayed tracks: the
+/// training trials replayed at the starting coefficients with the clump and with the next finer
+/// one; while they differ by more than half the smallest weight (hypot(noise, model accuracy))
+/// within the fitted windows, the finer clump is taken. The release stage runs with the clump
+/// kept (its horizons are the fitted windows). The finer clumps not taken are left in c.finer.
+Result<void> resolution_stage(Context& c, DiagnoseResult& result, const Model& start, const DiagnoseOptions& options) {
+  ParticleModelCheck check;
+  double tolerance = kNever;
+  for (std::size_t r = 0; r < c.ev.sigma.size(); ++r) {
+    if (std::isfinite(c.ev.sigma[r]) && c.camera_noise.size() > r && std::isfinite(c.camera_noise[r]))
+      tolerance = std::min(tolerance, 0.5 * c.ev.sigma[r]);
+  }
+  check.track_tolerance_m = tolerance;
+  const auto rung_of = [](const Clump& clump) {
+    ParticleModelRung rung;
+    rung.name = clump.name;
+    rung.spheres = static_cast<int>(clump.spheres.size());
+    return rung;
+  };
+  check.rungs.push_back(rung_of(*c.ev.clump));
+  for (const Clump& finer : options.finer_clumps) check.rungs.push_back(rung_of(finer));
+  DiagnoseResult release;
+  if (auto ok = release_stage(c, release, start, options); !ok) return std::unexpected(ok.error());
+  std::size_t k = 0;
+  while (k < options.finer_clumps.size()) {
+    auto coarse = score(c, start, c.training, true);
+    if (!coarse) return std::unexpected(coarse.error());
+    const Clump* kept = c.ev.clump;
+    c.ev.clump = &options.finer_clumps[k];
+    auto fine = score(c, start, c.training, true);
+    if (!fine) return std::unexpected(fine.error());
+    double sum = 0.0;
+    for (std::size_t i = 0; i < c.training.size(); ++i) {
+      const double d = replay_difference(c.ev.trials[c.training[i]], (*coarse)[i].replay, (*fine)[i].replay);
+      sum += d * d;
+    }
+    const double difference = std::sqrt(sum / std::max<std::size_t>(1, c.training.size()));
+    check.rungs[k + 1].track_difference_m = difference;
+    if (difference <= tolerance) {
+      c.ev.clump = kept;
+      break;
+    }
+    ++k;  // the finer clump is kept; its release state and horizons replace the coarser one's
+    release = {};
+    if (auto ok = release_stage(c, release, start, options); !ok) return std::unexpected(ok.error());
+  }
+  result.notes.insert(result.notes.end(), release.notes.begin(), release.notes.end());
+  for (std::size_t j = k; j < options.finer_clumps.size(); ++j) c.finer.push_back(&options.finer_clumps[j]);
+  check.rungs.erase(check.rungs.begin(), check.rungs.begin() + static_cast<std::ptrdiff_t>(k));
+  check.diagnosed = c.ev.clump->name;
+  check.spheres = static_cast<int>(c.ev.clump->spheres.size());
+  if (check.rungs.size() > 1) {
+    result.notes.push_back(fmt::format(
+        "particle model: {} ({} spheres); the training trials' replayed tracks move by {} with the next finer clump "
+        "({}), against {:.3f} mm for convergence",
+        check.diagnosed, check.spheres,
+        std::isfinite(check.rungs[1].track_difference_m)
+            ? fmt::format("{:.3f} mm", check.rungs[1].track_difference_m * 1e3)
+            : std::string("?"),
+        check.rungs[1].name, tolerance * 1e3));
+  }
+  result.particle_model = std::move(check);
+  return {};
+}
+
+/// Before a mismatch is blamed on missing physics: the coefficients refitted on every trial
+/// with each finer clump left (coarsest first, from `null`, the diagnosed clump's own refitted
+/// null); the first that leaves no large misfit explains the mismatch (its index in c.finer
+/// and its fit). The diagnosed clump stays c.ev.clump.
+Result<std::optional<std::pair<std::size_t, Fitted>>> particle_model_check(Context& c, ParticleModelCheck& check,
+                                                                           const Model& null,
+                                                                           const DiagnoseOptions& options) {
+  check.checked = true;
+  auto scored = score(c, null, c.all, true);
+  if (!scored) return std::unexpected(scored.error());
+  const Groups null_groups = phase_groups(c, c.all, *scored);
+  check.worst_phase_chi2_per_value = largest_misfit(c, null_groups).first;
+  check.chi2_per_value = total_chi_squared(*scored) / std::max(1, total_values(*scored));
+  Model from = null;
+  std::optional<std::pair<std::size_t, Fitted>> explained;
+  for (std::size_t k = 0; k < c.finer.size() && !explained; ++k) {
+    const ClumpSwap swap(c, c.finer[k]);
+    auto fitted = refit(c, from, nullptr, c.all, options.max_evaluations);
+    if (!fitted) return std::unexpected(fitted.error());
+    auto fine = score(c, fitted->model, c.all, true);
+    if (!fine) return std::unexpected(fine.error());
+    const auto [worst, large] = largest_misfit(c, phase_groups(c, c.all, *fine));
+    ParticleModelRung& rung = check.rungs.at(k + 1);
+    rung.refitted = true;
+    rung.chi2_per_value = fitted->chi2 / std::max(1, fitted->values);
+    rung.worst_phase_chi2_per_value = worst;
+    rung.explains = !large;
+    if (rung.explains) {
+      check.resolution_needed = rung.spheres;
+      explained = std::pair{k, std::move(*fitted)};
+    } else {
+      from = fitted->model;
+    }
+  }
+  return explained;
+}
+
+/// The verdict when a finer clump explains the mismatch: none, on the particle model's basis,
+/// with what was about to be blamed on missing physics and the resolution needed.
+void say_particle_model(DiagnoseResult& result, const ParticleModelCheck& check, bool outcomes) {
+  std::string blamed;
+  if (outcomes) {
+    blamed = "the recorded outcomes differ from replays over the unknown release orientation beyond the noise";
+  } else if (result.verdict == Verdict::Named && result.effect) {
+    blamed = fmt::format("the misfit {} absorbed is three times the noise or more",
+                         effect_spec(effect_library(), *result.effect).name);
+  } else if (result.verdict == Verdict::Ambiguous) {
+    blamed = fmt::format("the misfit {} absorbed about equally is three times the noise or more",
+                         fmt::join(result.candidates, " and "));
+  } else {
+    blamed = fmt::format(
+        "the misfit in {} is three times the noise or more",
+        fmt::join(result.unexplained | std::views::transform([](const PhaseOf& u) { return u.where; }), "; "));
+  }
+  const auto it = std::find_if(check.rungs.begin(), check.rungs.end(), [](const auto& r) { return r.explains; });
+  if (!result.statement.empty())
+    result.notes.push_back(fmt::format("before the particle model was checked: {}", result.statement));
+  result.verdict = Verdict::None;
+  result.basis = Basis::ParticleModel;
+  result.effect.reset();
+  result.effect_parameters.clear();
+  result.candidates.clear();
+  result.unexplained.clear();
+  const std::string measure = outcomes ? "the largest z^2 of a recorded mean" : "chi^2 per value of the worst phase";
+  result.statement = fmt::format(
+      "No missing physics found: the mismatch is the particle model's. With {} ({} spheres) {} ({} {:.1f}); with {} "
+      "({} spheres) and its coefficients refitted, {} ({:.1f}). This body needs a clump of {} spheres or more; "
+      "diagnose again with it to look for physics beyond the particle model.",
+      check.diagnosed, check.spheres, blamed, measure, check.worst_phase_chi2_per_value, it->name, it->spheres,
+      outcomes ? "they are consistent with the recordings" : "no phase is", it->worst_phase_chi2_per_value,
+      it->spheres);
+  result.experiment =
+      fmt::format("diagnose again with a clump of {} spheres or more (--spheres {})", it->spheres, it->spheres);
+}
+
+/// When no finer clump explains the mismatch, a note saying so (the verdict stands).
+void say_not_particle_model(DiagnoseResult& result, const ParticleModelCheck& check) {
+  std::vector<std::string> tried;
+  for (const auto& r : check.rungs) {
+    if (r.refitted)
+      tried.push_back(fmt::format("{} ({} spheres) leaves chi^2 per value {:.2f}, its worst phase {:.1f}", r.name,
+                                  r.spheres, r.chi2_per_value, r.worst_phase_chi2_per_value));
+  }
+  result.notes.push_back(fmt::format(
+      "not the particle model: with {} ({} spheres) every trial is at chi^2 per value {:.2f}, its worst phase {:.1f}; "
+      "refitted with finer clumps of the same body, {}",
+      check.diagnosed, check.spheres, check.chi2_per_value, check.worst_phase_chi2_per_value, fmt::join(tried, "; ")));
+}
+
 /// Stage 6, candidates: every effect fitted with all base coefficients free on the training
 /// trials, and judged (delta-BIC, held-out trials, plausibility, signature, large misfit);
 /// one report per effect in result.hypotheses, its fit returned in the same order.
@@ -1430,6 +1671,86 @@ void track_plots(const Context& c, DiagnoseResult& result, const std::vector<Tri
   }
 }
 
+/// The largest z^2 of `comparisons`.
+double largest_z2(const std::vector<OutcomeComparison>& comparisons) {
+  double worst = 0.0;
+  for (const auto& o : comparisons) worst = std::max(worst, o.z * o.z);
+  return worst;
+}
+
+/// Nothing named, yet the calibrated null leaves the recorded outcomes inconsistent with the
+/// replays (chi^2 tail below kConsistentTail): a mismatch beyond the release horizon. Before it
+/// is called unexplained, each finer clump left is tried (its null calibrated afresh on the
+/// outcomes, from the same orientations); the first that leaves them consistent explains it,
+/// and the verdict says so with the resolution needed.
+Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Model& baseline,
+                                  const std::vector<FreeCoefficient>& free, const EnsembleOptions& eo,
+                                  int max_evaluations) {
+  const EnsembleReport& e = *result.ensemble;
+  const double dof = std::max(1.0, e.outcomes - static_cast<double>(free.size()));
+  if (chi2_upper_tail(e.null_chi2, dof) >= kConsistentTail) return {};
+  if (result.particle_model && !c.finer.empty()) {
+    ParticleModelCheck& check = *result.particle_model;
+    check.checked = true;
+    check.chi2_per_value = e.null_chi2 / e.outcomes;
+    check.worst_phase_chi2_per_value = largest_z2(e.null_comparisons);
+    for (std::size_t k = 0; k < c.finer.size(); ++k) {
+      // The baseline refitted the baseline's way with the finer clump (the coefficients the
+      // frames pin change with the clump: a coarse clump rolls otherwise), its whole tracks
+      // replayed to put the recordings in its frame, and its null calibrated on the outcomes.
+      const ClumpSwap swap(c, c.finer[k]);
+      const auto unpinned = c.unpinned;
+      auto fitted = fit_coefficients(c, baseline, c.training, max_evaluations);
+      c.unpinned = unpinned;
+      if (!fitted) return std::unexpected(fitted.error());
+      c.ev.full_duration = true;
+      auto scores = score(c, fitted->model, c.all, true);
+      c.ev.full_duration = false;
+      if (!scores) return std::unexpected(scores.error());
+      auto fine = compare_ensembles(c.ev, fitted->model, *scores, free, {}, eo);
+      if (!fine) return std::unexpected(fine.error());
+      c.evaluations += fine->replays;
+      ParticleModelRung& rung = check.rungs.at(k + 1);
+      rung.refitted = true;
+      rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
+      rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
+      rung.explains = fine->outcomes == e.outcomes && chi2_upper_tail(fine->null_chi2, dof) >= kConsistentTail;
+      if (rung.explains) {
+        check.resolution_needed = rung.spheres;
+        say_particle_model(result, check, true);
+        return {};
+      }
+    }
+  }
+  // Unexplained: the outcomes beyond the noise, three standard errors or more.
+  std::vector<std::string> far;
+  for (const auto& o : e.null_comparisons) {
+    if (std::abs(o.z) < 3.0) continue;
+    const bool drop = o.outcome == Outcome::ReboundHeight || o.outcome == Outcome::Drift;
+    const double scale = o.outcome == Outcome::RollTime ? 1.0 : 1e3;
+    const std::string where =
+        fmt::format("{} of {} (recorded {:.3g}, replayed {:.3g} {}, z = {:.1f})", outcome_name(o.outcome),
+                    recording_label((*c.ev.recordings)[o.recording], c.names[o.recording]), o.recorded_mean * scale,
+                    o.ensemble_mean * scale, o.outcome == Outcome::RollTime ? "s" : "mm", o.z);
+    result.unexplained.push_back({c.names[o.recording], drop ? Phase::Rebound : Phase::Rest, o.z * o.z, where});
+    far.push_back(where);
+  }
+  if (!result.statement.empty()) result.notes.push_back(fmt::format("frame by frame: {}", result.statement));
+  result.verdict = Verdict::Unexplained;
+  result.basis = Basis::UnexplainedOutcomes;
+  result.statement = fmt::format(
+      "Mismatch beyond the release horizon not explained by any known effect: the recorded outcomes differ from "
+      "replays over the unknown release orientation (chi^2 {:.1f} over {} recorded means, p = {:.2g}){}; no candidate "
+      "effect leaves them consistent{}.",
+      e.null_chi2, e.outcomes, chi2_upper_tail(e.null_chi2, dof),
+      far.empty() ? std::string() : fmt::format(", most in: {}", fmt::join(far, "; ")),
+      c.finer.empty() ? std::string() : ", nor does a finer clump of the same body");
+  result.experiment =
+      "compare the recorded and replayed outcomes in the report's ensemble section; more trials per set-up, or "
+      "recorded release orientations, would narrow the cause";
+  return {};
+}
+
 /// Beyond the release horizons: the recorded trials against replays from the release prior
 /// (diagnose/ensemble.hpp). The coefficients the frame fits left unpinned are calibrated on
 /// the outcomes; a candidate is named when its replays beat that null by the delta-BIC
@@ -1505,7 +1826,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   std::vector<const EnsembleHypothesis*> passing;
   for (const auto& h : ens->hypotheses) {
     const double dof = ens->outcomes - static_cast<double>(h.values.size());
-    const bool consistent = chi2_upper_tail(h.chi2, dof) >= 1e-4;
+    const bool consistent = chi2_upper_tail(h.chi2, dof) >= kConsistentTail;
     if (h.plausible && h.delta_bic >= options.min_delta_bic && consistent) passing.push_back(&h);
     if (h.plausible && h.delta_bic >= options.min_delta_bic && !consistent) {
       result.notes.push_back(fmt::format(
@@ -1516,6 +1837,8 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   }
   if (!ens->outcomes || ens->hypotheses.empty() || passing.empty()) {
     result.ensemble = std::move(report);
+    if (ens->outcomes > 0 && result.verdict == Verdict::None)
+      return outcomes_beyond_null(c, result, baseline, free, eo, options.max_evaluations);
     return {};
   }
   const EnsembleHypothesis& best = *passing.front();
@@ -1567,6 +1890,15 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   if (recordings.empty()) return fail(ErrorCode::InvalidArgument, "no recordings to diagnose");
   if (names.size() != recordings.size()) return fail(ErrorCode::InvalidArgument, "one name per recording is needed");
   if (auto ok = check_options(options); !ok) return std::unexpected(ok.error());
+  for (const Clump& finer : options.finer_clumps) {
+    // The same body: a finer clump of another particle would "explain" any mismatch.
+    if (finer.spheres.empty() || !(std::abs(finer.mass - clump.mass) <= 0.05 * clump.mass)) {
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("the finer clump '{}' ({} spheres, {:.4g} g) is not a model of the body of '{}' "
+                              "({:.4g} g): the particle-model check needs clumps of one body",
+                              finer.name, finer.spheres.size(), finer.mass * 1e3, clump.name, clump.mass * 1e3));
+    }
+  }
   bool any_track = false;
   for (const auto& r : recordings) {
     for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
@@ -1611,7 +1943,10 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   }
   auto start = starting_model(c, table, recordings, options);
   if (!start) return std::unexpected(start.error());
-  if (auto ok = release_stage(c, result, *start, options); !ok) return std::unexpected(ok.error());
+  if (auto ok = options.finer_clumps.empty() ? release_stage(c, result, *start, options)
+                                             : resolution_stage(c, result, *start, options);
+      !ok)
+    return std::unexpected(ok.error());
   auto fitted = baseline_stage(c, result, *start, options);
   if (!fitted) return std::unexpected(fitted.error());
   const Model baseline = std::move(*fitted);
@@ -1752,35 +2087,9 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
         report.delta_chi2, report.delta_bic, report.heldout_delta_chi2, next);
   }
   // A smooth discrepancy the named effect (or the baseline) leaves, phase by phase.
-  auto smooth_misfits = [&](const Groups& groups) {
-    std::vector<PhaseOf> found;
-    for (const auto& [key, g] : groups) {
-      if (key.phase == Phase::Hold || g.values < 20) continue;
-      if (!beyond_noise(g.chi2, g.values, groups.size())) continue;
-      // Judged like a named effect: a clear delta-BIC on every trial, and a shape that the
-      // training trials' segments carry over to the held-out ones. A misfit of three times
-      // the noise or more is a mismatch even when it differs from trial to trial, as long as
-      // it is not one trial's alone.
-      const SmoothDiscrepancy d = smooth_discrepancy(g);
-      const std::string where = fmt::format("{} phases of {}", phase_name(key.phase),
-                                            recording_label(recordings[key.recording], c.names[key.recording]));
-      // Either way it is large: three times hypot(noise, model accuracy) RMS or more. A smaller
-      // misfit is within what a particle model's inaccuracy leaves; 'none' names it.
-      if (g.chi2 < kLargeMisfit * g.values) continue;
-      if (d.parameters > 0 && d.gain - d.parameters * std::log(g.values) >= options.min_delta_bic &&
-          d.heldout_gain > 0.0) {
-        found.push_back({c.names[key.recording], key.phase, g.chi2 / g.values, where});
-      } else if (g.chi2 / g.values >= kLargeMisfit && !outlier_trial(g, trial_spread(g))) {
-        found.push_back(
-            {c.names[key.recording], key.phase, g.chi2 / g.values,
-             fmt::format("{} (chi^2/value {:.0f}, not one shape shared by the trials)", where, g.chi2 / g.values)});
-      }
-    }
-    return found;
-  };
   Groups final_groups = phase_groups(c, c.all, improved_scores);
   bool recalibrated = false;  // nothing named, and the coefficients refitted on every trial shown as the improvement
-  result.unexplained = smooth_misfits(final_groups);
+  result.unexplained = smooth_misfits(c, final_groups, options);
   if (!named && !result.unexplained.empty()) {
     // Without an effect, what the coefficients refitted on every trial still leave: a
     // miscalibration seen only on the held-out trials is not an unexplained mismatch.
@@ -1788,7 +2097,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     auto s = score(c, null_all->model, c.all, true);
     if (!s) return std::unexpected(s.error());
     final_groups = phase_groups(c, c.all, *s);
-    result.unexplained = smooth_misfits(final_groups);
+    result.unexplained = smooth_misfits(c, final_groups, options);
     if (result.unexplained.empty()) {
       result.notes.push_back(
           "the baseline's misfit on the held-out trials goes once its coefficients are refitted on every trial: a "
@@ -1800,6 +2109,30 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
       recalibrated = true;
     }
   }
+  // Before the mismatch is blamed on missing physics: is it the particle model?
+  const Clump* const diagnosed = c.ev.clump;
+  const Clump* improved_clump = diagnosed;
+  const bool blamed = named || result.verdict == Verdict::Ambiguous || !result.unexplained.empty();
+  bool particle = false;
+  if (blamed && !c.finer.empty()) {
+    if (auto ok = refitted_null(); !ok) return std::unexpected(ok.error());
+    run.report("particle model", 0.85);
+    auto explained = particle_model_check(c, *result.particle_model, null_all->model, options);
+    if (!explained) return std::unexpected(explained.error());
+    if (*explained) {
+      particle = true;
+      improved_clump = c.finer[(*explained)->first];
+      improved = (*explained)->second.model;
+      const ClumpSwap swap(c, improved_clump);
+      auto s = score(c, improved, c.all, true);
+      if (!s) return std::unexpected(s.error());
+      improved_scores = std::move(*s);
+      say_particle_model(result, *result.particle_model, false);
+      named.reset();
+    } else {
+      say_not_particle_model(result, *result.particle_model);
+    }
+  }
   if (null_all) {
     result.refitted_on_all = null_all->model.base;
   }
@@ -1809,7 +2142,11 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   c.ev.full_duration = true;
   auto full_base = score(c, baseline, c.all, true);
   if (!full_base) return std::unexpected(full_base.error());
-  auto full_improved = named || recalibrated ? score(c, improved, c.all, true) : full_base;
+  auto full_improved = full_base;
+  if (named || recalibrated || particle) {
+    const ClumpSwap swap(c, improved_clump);
+    full_improved = score(c, improved, c.all, true);
+  }
   if (!full_improved) return std::unexpected(full_improved.error());
   c.ev.full_duration = false;
   result.before = quality(c, *full_base);
@@ -1820,7 +2157,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
         p.improved_chi2_per_value = g.chi2 / g.values;
     }
   }
-  if (!named && result.verdict != Verdict::Ambiguous) {
+  if (!named && !particle && result.verdict != Verdict::Ambiguous) {
     if (!result.unexplained.empty()) {
       result.verdict = Verdict::Unexplained;
       result.basis = Basis::UnexplainedPhases;
@@ -1891,7 +2228,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
       }
     }
   }
-  if (!named && result.verdict != Verdict::Ambiguous && options.ensemble_replays > 0) {
+  if (!named && !particle && result.verdict != Verdict::Ambiguous && options.ensemble_replays > 0) {
     run.report("ensembles", 0.9);
     if (auto ok = judge_ensembles(c, result, baseline, *full_base, effects, options); !ok)
       return std::unexpected(ok.error());

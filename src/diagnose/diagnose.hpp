@@ -15,6 +15,7 @@
 ///    "unexplained" (a smooth per-phase discrepancy the library cannot account for), "none"
 ///    (with the smallest effect the data would have shown) or "undecidable" (too little or
 ///    too noisy data).
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,7 +49,40 @@ struct DiagnoseOptions {
   /// Replays per drop and roll recording, from release orientations drawn from the prior,
   /// for the comparison beyond the release horizon (see diagnose/ensemble.hpp); 0 skips it.
   int ensemble_replays = 12;
+  /// Finer particle models of the same body (more spheres, or built another way), coarsest
+  /// first; the clump diagnosed is the coarsest of all. They serve twice (see
+  /// ParticleModelCheck): the resolution is raised while the replayed tracks still change
+  /// beyond half the weight from one clump to the next, and before a mismatch is blamed on
+  /// missing physics the coefficients are refitted with the finer clumps left. Empty: the
+  /// clump is taken as it is.
+  std::vector<Clump> finer_clumps;
   std::uint64_t seed = 1;
+};
+
+/// One finer clump tried by the particle-model check.
+struct ParticleModelRung {
+  std::string name;
+  int spheres = 0;
+  /// [m] RMS difference of the training trials' replayed tracks (within their fitted
+  /// windows, camera origins removed) from the previous clump's, at the starting coefficients;
+  /// NaN when not compared.
+  double track_difference_m = std::numeric_limits<double>::quiet_NaN();
+  bool refitted = false;                    ///< the coefficients were refitted with it on every trial
+  double chi2_per_value = 0.0;              ///< every trial, its refitted null
+  double worst_phase_chi2_per_value = 0.0;  ///< the largest phase misfit it leaves
+  bool explains = false;                    ///< it leaves no large misfit: the mismatch was the particle model's
+};
+
+/// Whether the particle model, not missing physics, explains a mismatch.
+struct ParticleModelCheck {
+  std::string diagnosed;  ///< the clump the diagnosis ran with (after the track convergence)
+  int spheres = 0;
+  double track_tolerance_m = 0.0;        ///< half of the smallest weight: tracks closer than this converged
+  std::vector<ParticleModelRung> rungs;  ///< the clumps tried, coarsest first (the diagnosed one included)
+  double chi2_per_value = 0.0;           ///< every trial, the diagnosed clump's refitted null (when checked)
+  double worst_phase_chi2_per_value = 0.0;
+  bool checked = false;                  ///< a mismatch was found and the finer clumps refitted
+  std::optional<int> resolution_needed;  ///< spheres of the first finer clump that explains the mismatch
 };
 
 enum class Axis { X, Z };
@@ -140,14 +174,17 @@ struct PhaseOf {
 
 /// What a verdict rests on, beside the verdict itself.
 enum class Basis {
-  Consistent,         ///< none: every phase at the noise level once the coefficients are fitted
-  SlightMisfit,       ///< none: a small misfit with no shape the trials share remains
-  FrameByFrame,       ///< named or ambiguous from the trials' tracks within the release horizon
-  Ensemble,           ///< named or ambiguous from the recorded outcomes against replays over the release
-  UnexplainedPhases,  ///< unexplained: phases beyond the noise no candidate explains
-  TooFewTrials,       ///< undecidable: fewer than two usable tracked trials
-  TooNoisy,           ///< undecidable: the tracks' noise hides what the effects would do
-  SummariesOnly,      ///< no tracks: what the summaries decide
+  Consistent,           ///< none: every phase at the noise level once the coefficients are fitted
+  SlightMisfit,         ///< none: a small misfit with no shape the trials share remains
+  FrameByFrame,         ///< named or ambiguous from the trials' tracks within the release horizon
+  Ensemble,             ///< named or ambiguous from the recorded outcomes against replays over the release
+  UnexplainedPhases,    ///< unexplained: phases beyond the noise no candidate explains
+  UnexplainedOutcomes,  ///< unexplained: recorded outcomes beyond the release horizon no candidate (nor a finer
+                        ///< clump) brings within the noise of replays over the release
+  TooFewTrials,         ///< undecidable: fewer than two usable tracked trials
+  TooNoisy,             ///< undecidable: the tracks' noise hides what the effects would do
+  SummariesOnly,        ///< no tracks: what the summaries decide
+  ParticleModel,        ///< none: the mismatch goes with a finer clump of the same body (see ParticleModelCheck)
 };
 std::string_view basis_name(Basis basis);
 
@@ -174,6 +211,7 @@ struct DiagnoseResult {
   bool summaries_only = false;  ///< no tracks: what summaries can and cannot decide (in `decidable`, `undecidable`)
   std::vector<std::string> decidable, undecidable;
   std::optional<EnsembleReport> ensemble;
+  std::optional<ParticleModelCheck> particle_model;  ///< when finer clumps were given
   int tracked_trials = 0, training_trials = 0, evaluations = 0;
   double seconds = 0.0;
 };

@@ -11,8 +11,11 @@
 #include "diagnose/conceal.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/tracks.hpp"
+#include "fill/fill.hpp"
 #include "io/clump_library.hpp"
 #include "io/recording_io.hpp"
+#include "mesh/load.hpp"
+#include "mesh/repair.hpp"
 #include "support/test_support.hpp"
 
 namespace clumpforge {
@@ -316,6 +319,76 @@ TEST(DiagnoseBlind, TooShortOrTooNoisyIsUndecidable) {
   ASSERT_TRUE(result) << result.error().message;
   EXPECT_EQ(result->verdict, Verdict::Undecidable);
   EXPECT_EQ(result->basis, Basis::TooFewTrials) << result->statement;
+}
+
+TEST(DiagnoseParticleModel, AControlMadeFromAFinerBodyIsTheClumpsNotMissingPhysics) {
+  // Recordings of bundled tuber 01 made from its 394-sphere clump, diagnosed with a 4-sphere
+  // fill of its scan: the tumbling tuber's rebounds and rolls beyond the release horizon
+  // differ from the coarse clump's replays far beyond their scatter, and no effect explains
+  // that. Alone, the coarse clump must say `unexplained` (not name an effect); given a finer
+  // clump of the same scan (the library's 66 spheres, not the generator's), it must find the
+  // mismatch is the particle model's: `none`, and the resolution needed.
+  auto loaded = load_mesh(test::source_dir() / "meshes" / "tuber-01.stl", {.unit = LengthUnit::Millimetre});
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  auto repaired = repair_mesh(std::move(loaded->soup));  // the bundled scans are damaged, as scans are
+  ASSERT_TRUE(repaired) << repaired.error().message;
+  SdfOptions sdf;
+  sdf.feature_size = 1e-3;
+  auto body = prepare_body(repaired->soup, 1085.0, sdf);
+  ASSERT_TRUE(body) << body.error().message;
+  FillOptions fill;
+  fill.method = FillMethod::Adaptive;
+  fill.max_spheres = 4;
+  auto coarse = fill_body(*body, fill);
+  ASSERT_TRUE(coarse) << coarse.error().message;
+  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-01.h5");
+  ASSERT_TRUE(library) << library.error().message;
+  auto generator = select_clump(*library, "adaptive-394", "tuber-01.h5");
+  auto finer = select_clump(*library, "adaptive-66", "tuber-01.h5");
+  ASSERT_TRUE(generator && finer);
+  const MaterialTable table = default_material_table();
+  ConcealOptions conceal;
+  conceal.trials = 6;
+  conceal.drop_heights = {0.5, 1.0};
+  conceal.roll_starts = {0.035};
+  conceal.tilt = false;
+  conceal.seed = 5;
+  auto made = make_concealed_recordings(*generator, table, conceal);
+  ASSERT_TRUE(made) << made.error().message;
+  DiagnoseOptions options;
+  options.effects = {Effect::AirDrag, Effect::ViscousRolling};
+  options.max_evaluations = 30;
+  auto alone = diagnose(coarse->clump, table, made->recordings, made->names, options);
+  ASSERT_TRUE(alone) << alone.error().message;
+  EXPECT_EQ(alone->verdict, Verdict::Unexplained) << alone->statement;
+  EXPECT_FALSE(alone->particle_model.has_value());
+  options.finer_clumps = {*finer};
+  auto checked = diagnose(coarse->clump, table, made->recordings, made->names, options);
+  ASSERT_TRUE(checked) << checked.error().message;
+  EXPECT_EQ(checked->verdict, Verdict::None) << checked->statement;
+  EXPECT_EQ(checked->basis, Basis::ParticleModel) << checked->statement;
+  ASSERT_TRUE(checked->particle_model.has_value());
+  EXPECT_TRUE(checked->particle_model->checked);
+  EXPECT_EQ(checked->particle_model->resolution_needed, 66);
+}
+
+TEST(DiagnoseParticleModel, AFinerClumpOfAnotherBodyIsRefused) {
+  const Clump clump = diagnosis_clump();
+  Clump other = clump;
+  other.name = "a-heavier-body";
+  other.mass *= 1.5;
+  Recording rec;
+  rec.test = LabTest::Drop;
+  rec.surface = "Q235";
+  Trial trial;
+  trial.track = falling_track(10.05, 1e-4, 3);
+  rec.trials = {trial, trial};
+  DiagnoseOptions options;
+  options.finer_clumps = {other};
+  auto result = diagnose(clump, default_material_table(), {rec}, {"drop"}, options);
+  ASSERT_FALSE(result);
+  EXPECT_EQ(result.error().code, ErrorCode::InvalidArgument);
+  EXPECT_NE(result.error().message.find("a-heavier-body"), std::string::npos) << result.error().message;
 }
 
 TEST(DiagnoseOptions, AbsurdImpactAccuracyOrEnsembleSizeIsRefusedByName) {

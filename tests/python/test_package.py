@@ -158,6 +158,18 @@ def test_recordings_read_and_absurd_ones_are_refused(tmp_path):
         cf.read_recording(str(bad))
 
 
+def test_diagnose_takes_finer_clumps_of_the_same_body_only():
+    """The particle-model check needs clumps of one body: a finer clump of another is refused by
+    name before anything runs; the result carries the check (None without finer clumps)."""
+    recordings = cf.read_recordings(str(ROOT / "clumps/tuber-default-diagnosis/recordings"))
+    small = cf.fill(box(0.01, 0.01, 0.01), method="lattice", diameter=0.002, density=1085.0)
+    big = cf.fill(box(0.02, 0.02, 0.02), method="lattice", diameter=0.002, density=1085.0)
+    with pytest.raises(cf.InvalidArgumentError, match="not a model of the body"):
+        cf.diagnose(small, recordings, finer_clumps=[big])
+    assert "particle_model" in dir(cf.DiagnoseResult)
+    assert cf.Basis.particle_model != cf.Basis.unexplained_outcomes
+
+
 def test_materials_export_names_its_conventions():
     text = cf.export_materials(cf.default_materials(), "liggghts", conventions="liggghts")
     assert "coefficientRestitution" in text and "Tsuji" in text
