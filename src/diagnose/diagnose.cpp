@@ -1883,15 +1883,256 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   return {};
 }
 
-Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
-                                const std::vector<Recording>& recordings, const std::vector<std::string>& names,
-                                const DiagnoseOptions& options, const RunContext& run) {
-  const auto started = std::chrono::steady_clock::now();
+/// The second null: the coefficients refitted on every trial, the held-out ones included,
+/// computed once, when first needed. When the training trials pin a coefficient poorly (a
+/// roll fitted only up to its short horizon), the held-out trials show a miscalibration, which
+/// an effect with a free parameter can absorb; it must beat the coefficients doing the same
+/// before it is named.
+class SecondNull {
+ public:
+  SecondNull(const Model& baseline, int max_evaluations) : baseline_(baseline), max_evaluations_(max_evaluations) {}
+  Result<const Fitted*> get(Context& c) {
+    if (!fit_) {
+      // The baseline's own procedure on every trial (grids, so a coefficient stuck in the
+      // wrong dip of an irregular body's chi^2 can leave it), and a local polish from the
+      // baseline; the better is the null.
+      auto global = fit_coefficients(c, baseline_, c.all, max_evaluations_);
+      if (!global) return std::unexpected(global.error());
+      auto local = refit(c, baseline_, nullptr, c.all, max_evaluations_);
+      if (!local) return std::unexpected(local.error());
+      fit_ = global->chi2 <= local->chi2 ? std::move(*global) : std::move(*local);
+    }
+    return &*fit_;
+  }
+  const std::optional<Fitted>& fit() const { return fit_; }
+
+ private:
+  const Model& baseline_;
+  int max_evaluations_;
+  std::optional<Fitted> fit_;
+};
+
+/// Stage 7a, every trial: each candidate that passed on the training trials refitted on every
+/// trial, from its training fit and from the second null's coefficients with the effect's
+/// training values (an effect and a coefficient trade off along a valley, so the training fit
+/// alone can be stuck on the wrong side); it passes when it beats the second null by the
+/// margin. The candidate contains the null (its parameter at the null value), so it does no
+/// worse than the null.
+Result<void> every_trial_stage(Context& c, DiagnoseResult& result, const std::vector<Fitted>& fits, SecondNull& second,
+                               const DiagnoseOptions& options) {
+  const auto library = effect_library();
+  for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
+    HypothesisReport& report = result.hypotheses[h];
+    if (!report.passes) continue;
+    auto null_all = second.get(c);
+    if (!null_all) return std::unexpected(null_all.error());
+    const Fitted& null = **null_all;
+    const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
+    Model from_null = null.model;
+    from_null.effect = fits[h].model.effect;
+    from_null.values = fits[h].model.values;
+    double chi2_all = null.chi2;
+    for (const Model* start : {&fits[h].model, static_cast<const Model*>(&from_null)}) {
+      auto on_all = refit(c, *start, &spec, c.all, options.max_evaluations);
+      if (!on_all) return std::unexpected(on_all.error());
+      report.evaluations += on_all->evaluations;
+      chi2_all = std::min(chi2_all, on_all->chi2);
+    }
+    report.all_trials_delta_bic =
+        null.chi2 - chi2_all - static_cast<double>(spec.parameters.size()) * std::log(std::max(1, null.values));
+    report.beats_refitted_null = report.all_trials_delta_bic >= options.min_delta_bic;
+    report.passes = report.beats_refitted_null;
+  }
+  return {};
+}
+
+/// Ambiguous frame by frame: the candidates within the margin, and the experiment that would
+/// separate them.
+void say_ambiguous(DiagnoseResult& result, const Decision& decision) {
+  const auto& best = result.hypotheses[*decision.best];
+  const auto& other = result.hypotheses[decision.close.front()];
+  result.verdict = Verdict::Ambiguous;
+  result.basis = Basis::FrameByFrame;
+  result.candidates.push_back(best.name);
+  for (std::size_t k : decision.close) result.candidates.push_back(result.hypotheses[k].name);
+  result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
+  result.statement = fmt::format(
+      "The recordings disagree with the baseline, and {} explain it about equally well ({}); "
+      "no single effect can be named. To separate them: {}.",
+      fmt::join(result.candidates, " and "),
+      other.passes ? fmt::format("delta-BIC refitted on every trial {:.1f} vs {:.1f}", best.all_trials_delta_bic,
+                                 other.all_trials_delta_bic)
+                   : fmt::format("training delta-BIC {:.1f} vs {:.1f}", best.delta_bic, other.delta_bic),
+      result.experiment);
+}
+
+/// Named frame by frame: the effect's parameters with 95 % intervals from the chi^2 curvature
+/// (others held, scaled by the fit's reduced chi^2 when it is above 1), and the statement with
+/// the runner-up (the next candidate on every trial when another passed, else the next by
+/// training delta-BIC).
+Result<void> say_named(Context& c, DiagnoseResult& result, const Fitted& fit, const Decision& decision) {
+  HypothesisReport& report = result.hypotheses[*decision.best];
+  const Model& improved = fit.model;
+  result.verdict = Verdict::Named;
+  result.basis = Basis::FrameByFrame;
+  result.effect = *improved.effect;
+  const EffectSpec& spec = effect_spec(effect_library(), *improved.effect);
+  for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
+    const auto& p = spec.parameters[k];
+    const double v = improved.values[k];
+    const double step = p.log_scale ? v * 0.1 : std::max(0.05 * std::abs(v), 0.01 * (p.upper - p.lower));
+    auto chi2_at = [&](double value) -> Result<double> {
+      Model m = improved;
+      m.values[k] = value;
+      auto s = score(c, m, c.training, false);
+      if (!s) return std::unexpected(s.error());
+      return total_chi_squared(*s);
+    };
+    auto lo = chi2_at(v - step), hi = chi2_at(v + step);
+    if (!lo || !hi) return std::unexpected(!lo ? lo.error() : hi.error());
+    const double curvature = (*lo + *hi - 2.0 * fit.chi2) / (step * step);
+    const double inflation = std::sqrt(std::max(1.0, fit.chi2 / std::max(1, report.values_used)));
+    const double se = curvature > 0.0 ? inflation * std::sqrt(2.0 / curvature) : kNever;
+    report.values[k].low = std::max(p.lower, v - 1.96 * se);
+    report.values[k].high = std::min(p.upper, v + 1.96 * se);
+  }
+  result.effect_parameters = report.values;
+  std::string next = "none";
+  if (decision.runner_up) {
+    const auto& r = result.hypotheses[*decision.runner_up];
+    next = fmt::format("{}, {:.1f} behind when both are refitted on every trial (training delta-BIC {:.1f})", r.name,
+                       report.all_trials_delta_bic - r.all_trials_delta_bic, r.delta_bic);
+  } else if (decision.training_next) {
+    next = fmt::format("{} at training delta-BIC {:.1f}", result.hypotheses[*decision.training_next].name,
+                       result.hypotheses[*decision.training_next].delta_bic);
+  }
+  result.statement = fmt::format(
+      "Missing physics found: {} ({}), {}; it improves the training fit by delta-chi^2 {:.0f} (delta-BIC {:.1f}) "
+      "and the held-out trials by delta-chi^2 {:.0f}; next best: {}.",
+      report.name, spec.description,
+      fmt::join(report.values | std::views::transform([](const ParameterValue& p) {
+                  return fmt::format("{} = {:.4g} [{:.4g}, {:.4g}]", p.name, p.value, p.low, p.high);
+                }),
+                ", "),
+      report.delta_chi2, report.delta_bic, report.heldout_delta_chi2, next);
+  return {};
+}
+
+/// Unexplained frame by frame: the phases no candidate explains.
+void say_unexplained_phases(DiagnoseResult& result, const DiagnoseOptions& options) {
+  result.verdict = Verdict::Unexplained;
+  result.basis = Basis::UnexplainedPhases;
+  result.statement = fmt::format(
+      "Mismatch not explained by any known effect in: {}. Each is beyond the noise after the coefficients are "
+      "refitted on every trial: a smooth per-phase shape shared by the trials removes it (delta-BIC >= {:g}, "
+      "cross-validated), or it is three times the noise or more; none of the {} candidate effects passes every "
+      "check.",
+      fmt::join(result.unexplained | std::views::transform([](const PhaseOf& u) { return u.where; }), "; "),
+      options.min_delta_bic, result.hypotheses.size());
+  result.experiment = "look at the residual plots of these phases; add set-ups that isolate them";
+}
+
+/// None frame by frame: what is left (phases slightly beyond the noise with no shape the trials
+/// share, outlier trials: said, not hidden), the smallest effects the recordings would have
+/// shown, and the candidates their predictable parts cannot decide.
+Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline, const std::vector<Fitted>& fits,
+                      const Groups& final_groups, const DiagnoseOptions& options) {
+  result.verdict = Verdict::None;
+  auto detection = detection_limits(c, result, baseline, fits, options);
+  if (!detection) return std::unexpected(detection.error());
+  const auto& [limits, untestable] = *detection;
+  std::vector<std::string> slight, outliers;
+  for (const auto& [key, g] : final_groups) {
+    if (key.phase == Phase::Hold || g.values < 20 || !beyond_noise(g.chi2, g.values, final_groups.size())) continue;
+    if (const TrialSpread spread = trial_spread(g); outlier_trial(g, spread)) {
+      outliers.push_back(fmt::format("{} phases of {} (one trial at chi^2/value {:.0f}, the other {} at {:.2f})",
+                                     phase_name(key.phase), c.names[key.recording], spread.worst, spread.trials - 1,
+                                     spread.rest));
+      result.outliers.push_back({c.names[key.recording], key.phase, spread.worst, outliers.back()});
+    } else {
+      slight.push_back(fmt::format("{} phases of {} (chi^2/value {:.2f})", phase_name(key.phase),
+                                   c.names[key.recording], g.chi2 / g.values));
+    }
+  }
+  std::string residual_state =
+      slight.empty()
+          ? std::string("the residuals are consistent with the estimated noise level once the coefficients are fitted")
+          : fmt::format(
+                "the residuals are at the noise level except for a small misfit, below three times the noise and "
+                "with no shape the trials share, in {}",
+                fmt::join(slight, ", "));
+  if (!outliers.empty()) {
+    residual_state += fmt::format(
+        "; one trial alone misfits in {}: an outlier (a tumble the fitted coefficients do not reproduce), not a "
+        "mismatch the trials share",
+        fmt::join(outliers, ", "));
+    result.notes.push_back(fmt::format("outlier trials, not counted as a mismatch: {}", fmt::join(outliers, ", ")));
+  }
+  result.basis = slight.empty() ? Basis::Consistent : Basis::SlightMisfit;
+  result.statement = fmt::format(
+      "No missing physics found: no candidate passes every check and {}. Smallest effects these recordings would "
+      "have revealed (at delta-BIC {:g}, after the coefficients absorb what they can, to first order): {}.",
+      residual_state, options.min_delta_bic, fmt::join(limits, "; "));
+  if (!untestable.empty()) {
+    // What the frame-by-frame fit cannot reach: the effects that act after the release
+    // horizon of an irregular body (its contacts) need more than these tracks.
+    result.undecidable = untestable;
+    result.statement += fmt::format(
+        " Not decidable from the predictable parts of these tracks (even at their strong magnitude): {}; they act "
+        "where the unknown release orientation decides the path.",
+        fmt::join(untestable, ", "));
+    result.experiment =
+        "record each trial's release orientation to a few degrees (a marked particle, a release jig), or repeat the "
+        "tests with a sphere of the same material, whose path does not depend on it";
+  }
+  return {};
+}
+
+/// What the diagnosis shows as the improvement: the model, the clump it replays with, and its
+/// scores on every trial within the horizons.
+struct Improvement {
+  Model model;
+  const Clump* clump = nullptr;
+  std::vector<TrialScore> scores;
+  bool changed = false;  ///< not the baseline: an effect, recalibrated coefficients or a finer clump
+};
+
+/// Stage 7b, is it the particle model? When the verdict so far blames missing physics and finer
+/// clumps are left (see particle_model_check): the first that explains the mismatch becomes the
+/// improvement and the verdict none; else a note says it is not the particle model.
+Result<bool> particle_model_stage(Context& c, DiagnoseResult& result, SecondNull& second, Improvement& improvement,
+                                  const DiagnoseOptions& options) {
+  const bool blamed =
+      result.verdict == Verdict::Named || result.verdict == Verdict::Ambiguous || !result.unexplained.empty();
+  if (!blamed || c.finer.empty()) return false;
+  auto null_all = second.get(c);
+  if (!null_all) return std::unexpected(null_all.error());
+  c.run->report("particle model", 0.85);
+  auto explained = particle_model_check(c, *result.particle_model, (*null_all)->model, options);
+  if (!explained) return std::unexpected(explained.error());
+  if (!*explained) {
+    say_not_particle_model(result, *result.particle_model);
+    return false;
+  }
+  improvement.clump = c.finer[(*explained)->first];
+  improvement.model = (*explained)->second.model;
+  const ClumpSwap swap(c, improvement.clump);
+  auto s = score(c, improvement.model, c.all, true);
+  if (!s) return std::unexpected(s.error());
+  improvement.scores = std::move(*s);
+  improvement.changed = true;
+  say_particle_model(result, *result.particle_model, false);
+  return true;
+}
+
+/// Refuses what no diagnosis can run on: no recordings, names not one per recording, absurd
+/// options, a finer clump of another body (it would "explain" any mismatch).
+Result<void> check_inputs(const Clump& clump, const std::vector<Recording>& recordings,
+                          const std::vector<std::string>& names, const DiagnoseOptions& options) {
   if (recordings.empty()) return fail(ErrorCode::InvalidArgument, "no recordings to diagnose");
   if (names.size() != recordings.size()) return fail(ErrorCode::InvalidArgument, "one name per recording is needed");
   if (auto ok = check_options(options); !ok) return std::unexpected(ok.error());
   for (const Clump& finer : options.finer_clumps) {
-    // The same body: a finer clump of another particle would "explain" any mismatch.
     if (finer.spheres.empty() || !(std::abs(finer.mass - clump.mass) <= 0.05 * clump.mass)) {
       return fail(ErrorCode::InvalidArgument,
                   fmt::format("the finer clump '{}' ({} spheres, {:.4g} g) is not a model of the body of '{}' "
@@ -1899,6 +2140,38 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
                               finer.name, finer.spheres.size(), finer.mass * 1e3, clump.name, clump.mass * 1e3));
     }
   }
+  return {};
+}
+
+/// Why nothing can be decided from these tracks (too few usable trials, too noisy), if so.
+std::optional<std::pair<Basis, std::string>> undecidable_tracks(const Context& c,
+                                                                const std::vector<double>& camera_noise) {
+  double worst_sigma = 0.0;
+  for (double s : camera_noise) {
+    if (std::isfinite(s)) worst_sigma = std::max(worst_sigma, s);
+  }
+  if (c.ev.trials.size() < 2 || c.training.empty() || c.heldout.empty()) {
+    return std::pair{Basis::TooFewTrials, fmt::format("only {} usable tracked trial(s): at least two (one to fit, "
+                                                      "one held out), each with 30 or more frames, are "
+                                                      "needed to decide anything",
+                                                      c.ev.trials.size())};
+  }
+  if (worst_sigma > 1e-3) {
+    return std::pair{
+        Basis::TooNoisy,
+        fmt::format(
+            "the tracks are too noisy to decide anything: {:.2f} mm of camera noise, where the effects in the "
+            "library move the tracked point by 0.1 to a few mm; track with sub-pixel centroids (0.02 to 0.1 mm)",
+            worst_sigma * 1000.0)};
+  }
+  return std::nullopt;
+}
+
+Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
+                                const std::vector<Recording>& recordings, const std::vector<std::string>& names,
+                                const DiagnoseOptions& options, const RunContext& run) {
+  const auto started = std::chrono::steady_clock::now();
+  if (auto ok = check_inputs(clump, recordings, names, options); !ok) return std::unexpected(ok.error());
   bool any_track = false;
   for (const auto& r : recordings) {
     for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
@@ -1916,30 +2189,14 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   c.ev.lab = options.lab;
   c.ev.impact_accuracy = options.impact_accuracy;
   const std::vector<double> camera_noise = load_tracks(c, result, recordings, names, options);
-  double worst_sigma = 0.0;
-  for (double s : camera_noise) {
-    if (std::isfinite(s)) worst_sigma = std::max(worst_sigma, s);
-  }
-  auto undecidable = [&](Basis basis, std::string why) {
-    result.verdict = Verdict::Undecidable;
-    result.basis = basis;
-    result.statement = std::move(why);
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    return result;
+  const auto seconds = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   };
-  if (c.ev.trials.size() < 2 || c.training.empty() || c.heldout.empty()) {
-    return undecidable(Basis::TooFewTrials, fmt::format("only {} usable tracked trial(s): at least two (one to fit, "
-                                                        "one held out), each with 30 or more frames, are "
-                                                        "needed to decide anything",
-                                                        c.ev.trials.size()));
-  }
-  if (worst_sigma > 1e-3) {
-    return undecidable(
-        Basis::TooNoisy,
-        fmt::format(
-            "the tracks are too noisy to decide anything: {:.2f} mm of camera noise, where the effects in the "
-            "library move the tracked point by 0.1 to a few mm; track with sub-pixel centroids (0.02 to 0.1 mm)",
-            worst_sigma * 1000.0));
+  if (auto why = undecidable_tracks(c, camera_noise)) {
+    result.verdict = Verdict::Undecidable;
+    std::tie(result.basis, result.statement) = std::move(*why);
+    result.seconds = seconds();
+    return result;
   }
   auto start = starting_model(c, table, recordings, options);
   if (!start) return std::unexpected(start.error());
@@ -1951,201 +2208,69 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   if (!fitted) return std::unexpected(fitted.error());
   const Model baseline = std::move(*fitted);
   run.report("locating", 0.2);
-
   auto located = locate_stage(c, result, baseline);
   if (!located) return std::unexpected(located.error());
-  const auto& base_scores = located->base_scores;
   // Name: every candidate, on the tests it acts in.
-  const auto library = effect_library();
   std::vector<Effect> effects = options.effects;
   if (effects.empty()) {
-    for (const auto& spec : library) effects.push_back(spec.effect);
+    for (const auto& spec : effect_library()) effects.push_back(spec.effect);
   }
   auto candidate_fits = candidates_stage(c, result, baseline, *located, effects, options);
   if (!candidate_fits) return std::unexpected(candidate_fits.error());
   const std::vector<Fitted>& fits = *candidate_fits;
-
-  // A second null: the coefficients refitted on every trial, the held-out ones included. When
-  // the training trials pin a coefficient poorly (a roll fitted only up to its short horizon),
-  // the held-out trials show a miscalibration, which an effect with a free parameter can
-  // absorb; it must beat the coefficients doing the same before it is named.
-  std::optional<Fitted> null_all;
-  auto refitted_null = [&]() -> Result<void> {
-    if (null_all) return {};
-    // The baseline's own procedure on every trial (grids, so a coefficient stuck in the
-    // wrong dip of an irregular body's chi^2 can leave it), and a local polish from the
-    // baseline; the better is the null.
-    auto global = fit_coefficients(c, baseline, c.all, options.max_evaluations);
-    if (!global) return std::unexpected(global.error());
-    auto local = refit(c, baseline, nullptr, c.all, options.max_evaluations);
-    if (!local) return std::unexpected(local.error());
-    null_all = global->chi2 <= local->chi2 ? std::move(*global) : std::move(*local);
-    return {};
-  };
-  for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
-    HypothesisReport& report = result.hypotheses[h];
-    if (!report.passes) continue;
-    if (auto ok = refitted_null(); !ok) return std::unexpected(ok.error());
-    const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
-    // From its training fit, and from the refitted null's coefficients with the effect's
-    // training values (an effect and a coefficient trade off along a valley, so the training
-    // fit alone can be stuck on the wrong side). The candidate contains the null (its
-    // parameter at the null value), so it does no worse than the null.
-    Model from_null = null_all->model;
-    from_null.effect = fits[h].model.effect;
-    from_null.values = fits[h].model.values;
-    double chi2_all = null_all->chi2;
-    for (const Model* start : {&fits[h].model, static_cast<const Model*>(&from_null)}) {
-      auto on_all = refit(c, *start, &spec, c.all, options.max_evaluations);
-      if (!on_all) return std::unexpected(on_all.error());
-      report.evaluations += on_all->evaluations;
-      chi2_all = std::min(chi2_all, on_all->chi2);
-    }
-    report.all_trials_delta_bic = null_all->chi2 - chi2_all -
-                                  static_cast<double>(spec.parameters.size()) * std::log(std::max(1, null_all->values));
-    report.beats_refitted_null = report.all_trials_delta_bic >= options.min_delta_bic;
-    report.passes = report.beats_refitted_null;
-  }
+  SecondNull second(baseline, options.max_evaluations);
+  if (auto ok = every_trial_stage(c, result, fits, second, options); !ok) return std::unexpected(ok.error());
 
   // Decide.
   const Decision decision = decide(result.hypotheses, options.min_delta_bic);
-  std::optional<std::size_t> named;
+  Improvement improved{.model = baseline, .clump = c.ev.clump, .scores = located->base_scores, .changed = false};
   if (decision.named()) {
-    named = decision.best;
-  } else if (decision.best) {
-    const auto& best = result.hypotheses[*decision.best];
-    const auto& other = result.hypotheses[decision.close.front()];
-    result.verdict = Verdict::Ambiguous;
-    result.basis = Basis::FrameByFrame;
-    result.candidates.push_back(best.name);
-    for (std::size_t k : decision.close) result.candidates.push_back(result.hypotheses[k].name);
-    result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
-    result.statement = fmt::format(
-        "The recordings disagree with the baseline, and {} explain it about equally well ({}); "
-        "no single effect can be named. To separate them: {}.",
-        fmt::join(result.candidates, " and "),
-        other.passes ? fmt::format("delta-BIC refitted on every trial {:.1f} vs {:.1f}", best.all_trials_delta_bic,
-                                   other.all_trials_delta_bic)
-                     : fmt::format("training delta-BIC {:.1f} vs {:.1f}", best.delta_bic, other.delta_bic),
-        result.experiment);
-  }
-
-  Model improved = baseline;
-  std::vector<TrialScore> improved_scores = base_scores;
-  if (named) {
-    const std::size_t h = *named;
-    HypothesisReport& report = result.hypotheses[h];
-    improved = fits[h].model;
-    result.verdict = Verdict::Named;
-    result.basis = Basis::FrameByFrame;
-    result.effect = *improved.effect;
-    // 95 % intervals of the effect's parameters from the chi^2 curvature (others held).
-    const EffectSpec& spec = effect_spec(library, *improved.effect);
-    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
-      const auto& p = spec.parameters[k];
-      const double v = improved.values[k];
-      const double step = p.log_scale ? v * 0.1 : std::max(0.05 * std::abs(v), 0.01 * (p.upper - p.lower));
-      auto chi2_at = [&](double value) -> Result<double> {
-        Model m = improved;
-        m.values[k] = value;
-        auto s = score(c, m, c.training, false);
-        if (!s) return std::unexpected(s.error());
-        return total_chi_squared(*s);
-      };
-      auto lo = chi2_at(v - step), hi = chi2_at(v + step);
-      if (!lo || !hi) return std::unexpected(!lo ? lo.error() : hi.error());
-      const double curvature = (*lo + *hi - 2.0 * fits[h].chi2) / (step * step);
-      // Scaled by the fit's reduced chi^2 when it is above 1 (a misfit the noise does not explain).
-      const double inflation = std::sqrt(std::max(1.0, fits[h].chi2 / std::max(1, report.values_used)));
-      const double se = curvature > 0.0 ? inflation * std::sqrt(2.0 / curvature) : kNever;
-      report.values[k].low = std::max(p.lower, v - 1.96 * se);
-      report.values[k].high = std::min(p.upper, v + 1.96 * se);
-    }
-    result.effect_parameters = report.values;
-    auto s = score(c, improved, c.all, true);
+    if (auto ok = say_named(c, result, fits[*decision.best], decision); !ok) return std::unexpected(ok.error());
+    improved.model = fits[*decision.best].model;
+    auto s = score(c, improved.model, c.all, true);
     if (!s) return std::unexpected(s.error());
-    improved_scores = std::move(*s);
-    // The runner-up: the next candidate on every trial when another passed, else the next by
-    // training delta-BIC.
-    std::string next = "none";
-    if (decision.runner_up) {
-      const auto& r = result.hypotheses[*decision.runner_up];
-      next = fmt::format("{}, {:.1f} behind when both are refitted on every trial (training delta-BIC {:.1f})", r.name,
-                         report.all_trials_delta_bic - r.all_trials_delta_bic, r.delta_bic);
-    } else if (decision.training_next) {
-      next = fmt::format("{} at training delta-BIC {:.1f}", result.hypotheses[*decision.training_next].name,
-                         result.hypotheses[*decision.training_next].delta_bic);
-    }
-    result.statement = fmt::format(
-        "Missing physics found: {} ({}), {}; it improves the training fit by delta-chi^2 {:.0f} (delta-BIC {:.1f}) "
-        "and the held-out trials by delta-chi^2 {:.0f}; next best: {}.",
-        report.name, spec.description,
-        fmt::join(report.values | std::views::transform([](const ParameterValue& p) {
-                    return fmt::format("{} = {:.4g} [{:.4g}, {:.4g}]", p.name, p.value, p.low, p.high);
-                  }),
-                  ", "),
-        report.delta_chi2, report.delta_bic, report.heldout_delta_chi2, next);
+    improved.scores = std::move(*s);
+    improved.changed = true;
+  } else if (decision.best) {
+    say_ambiguous(result, decision);
   }
   // A smooth discrepancy the named effect (or the baseline) leaves, phase by phase.
-  Groups final_groups = phase_groups(c, c.all, improved_scores);
-  bool recalibrated = false;  // nothing named, and the coefficients refitted on every trial shown as the improvement
+  Groups final_groups = phase_groups(c, c.all, improved.scores);
   result.unexplained = smooth_misfits(c, final_groups, options);
-  if (!named && !result.unexplained.empty()) {
+  if (!decision.named() && !result.unexplained.empty()) {
     // Without an effect, what the coefficients refitted on every trial still leave: a
     // miscalibration seen only on the held-out trials is not an unexplained mismatch.
-    if (auto ok = refitted_null(); !ok) return std::unexpected(ok.error());
-    auto s = score(c, null_all->model, c.all, true);
+    auto null_all = second.get(c);
+    if (!null_all) return std::unexpected(null_all.error());
+    auto s = score(c, (*null_all)->model, c.all, true);
     if (!s) return std::unexpected(s.error());
     final_groups = phase_groups(c, c.all, *s);
     result.unexplained = smooth_misfits(c, final_groups, options);
     if (result.unexplained.empty()) {
       result.notes.push_back(
           "the baseline's misfit on the held-out trials goes once its coefficients are refitted on every trial: a "
-          "miscalibration, "
-          "not missing physics; 'improved' and the fit after are those coefficients");
+          "miscalibration, not missing physics; 'improved' and the fit after are those coefficients");
       // The recalibrated coefficients are what the user should take away: shown as the improvement.
-      improved = null_all->model;
-      improved_scores = std::move(*s);
-      recalibrated = true;
+      improved.model = (*null_all)->model;
+      improved.scores = std::move(*s);
+      improved.changed = true;
     }
   }
   // Before the mismatch is blamed on missing physics: is it the particle model?
-  const Clump* const diagnosed = c.ev.clump;
-  const Clump* improved_clump = diagnosed;
-  const bool blamed = named || result.verdict == Verdict::Ambiguous || !result.unexplained.empty();
-  bool particle = false;
-  if (blamed && !c.finer.empty()) {
-    if (auto ok = refitted_null(); !ok) return std::unexpected(ok.error());
-    run.report("particle model", 0.85);
-    auto explained = particle_model_check(c, *result.particle_model, null_all->model, options);
-    if (!explained) return std::unexpected(explained.error());
-    if (*explained) {
-      particle = true;
-      improved_clump = c.finer[(*explained)->first];
-      improved = (*explained)->second.model;
-      const ClumpSwap swap(c, improved_clump);
-      auto s = score(c, improved, c.all, true);
-      if (!s) return std::unexpected(s.error());
-      improved_scores = std::move(*s);
-      say_particle_model(result, *result.particle_model, false);
-      named.reset();
-    } else {
-      say_not_particle_model(result, *result.particle_model);
-    }
-  }
-  if (null_all) {
-    result.refitted_on_all = null_all->model.base;
-  }
-  result.improved = improved.base;
-  const Groups improved_groups = phase_groups(c, c.all, improved_scores);
+  auto particle = particle_model_stage(c, result, second, improved, options);
+  if (!particle) return std::unexpected(particle.error());
+  const bool named = decision.named() && !*particle;
+  if (second.fit()) result.refitted_on_all = second.fit()->model.base;
+  result.improved = improved.model.base;
+  const Groups improved_groups = phase_groups(c, c.all, improved.scores);
   // Whole tracks (beyond the horizons) for the summaries and the plots.
   c.ev.full_duration = true;
   auto full_base = score(c, baseline, c.all, true);
   if (!full_base) return std::unexpected(full_base.error());
   auto full_improved = full_base;
-  if (named || recalibrated || particle) {
-    const ClumpSwap swap(c, improved_clump);
-    full_improved = score(c, improved, c.all, true);
+  if (improved.changed) {
+    const ClumpSwap swap(c, improved.clump);
+    full_improved = score(c, improved.model, c.all, true);
   }
   if (!full_improved) return std::unexpected(full_improved.error());
   c.ev.full_duration = false;
@@ -2157,85 +2282,20 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
         p.improved_chi2_per_value = g.chi2 / g.values;
     }
   }
-  if (!named && !particle && result.verdict != Verdict::Ambiguous) {
-    if (!result.unexplained.empty()) {
-      result.verdict = Verdict::Unexplained;
-      result.basis = Basis::UnexplainedPhases;
-      result.statement = fmt::format(
-          "Mismatch not explained by any known effect in: {}. Each is beyond the noise after the coefficients are "
-          "refitted "
-          "on every trial: a smooth per-phase shape shared by the trials removes it (delta-BIC >= {:g}, "
-          "cross-validated), "
-          "or it is three times the noise or more; none of the {} candidate effects passes every check.",
-          fmt::join(result.unexplained | std::views::transform([](const PhaseOf& u) { return u.where; }), "; "),
-          options.min_delta_bic, result.hypotheses.size());
-      result.experiment = "look at the residual plots of these phases; add set-ups that isolate them";
-    } else {
-      result.verdict = Verdict::None;
-      auto detection = detection_limits(c, result, baseline, fits, options);
-      if (!detection) return std::unexpected(detection.error());
-      const auto& [limits, untestable] = *detection;
-      // Phases still beyond the noise, but by less than kLargeMisfit and with no shape the
-      // trials share: said, not hidden.
-      std::vector<std::string> slight, outliers;
-      for (const auto& [key, g] : final_groups) {
-        if (key.phase == Phase::Hold || g.values < 20 || !beyond_noise(g.chi2, g.values, final_groups.size())) continue;
-        if (const TrialSpread spread = trial_spread(g); outlier_trial(g, spread)) {
-          outliers.push_back(fmt::format("{} phases of {} (one trial at chi^2/value {:.0f}, the other {} at {:.2f})",
-                                         phase_name(key.phase), c.names[key.recording], spread.worst, spread.trials - 1,
-                                         spread.rest));
-          result.outliers.push_back({c.names[key.recording], key.phase, spread.worst, outliers.back()});
-        } else {
-          slight.push_back(fmt::format("{} phases of {} (chi^2/value {:.2f})", phase_name(key.phase),
-                                       c.names[key.recording], g.chi2 / g.values));
-        }
-      }
-      std::string residual_state =
-          slight.empty()
-              ? std::string(
-                    "the residuals are consistent with the estimated noise level once the coefficients are fitted")
-              : fmt::format(
-                    "the residuals are at the noise level except for a small misfit, below three times the noise and "
-                    "with no "
-                    "shape the trials share, in {}",
-                    fmt::join(slight, ", "));
-      if (!outliers.empty()) {
-        residual_state += fmt::format(
-            "; one trial alone misfits in {}: an outlier (a tumble the fitted coefficients do not reproduce), "
-            "not a mismatch the trials share",
-            fmt::join(outliers, ", "));
-        result.notes.push_back(fmt::format("outlier trials, not counted as a mismatch: {}", fmt::join(outliers, ", ")));
-      }
-      result.basis = slight.empty() ? Basis::Consistent : Basis::SlightMisfit;
-      result.statement = fmt::format(
-          "No missing physics found: no candidate passes every check and {}. Smallest effects these recordings would "
-          "have revealed (at delta-BIC {:g}, "
-          "after the coefficients absorb what they can, to first order): {}.",
-          residual_state, options.min_delta_bic, fmt::join(limits, "; "));
-      if (!untestable.empty()) {
-        // What the frame-by-frame fit cannot reach: the effects that act after the release
-        // horizon of an irregular body (its contacts) need more than these tracks.
-        result.undecidable = untestable;
-        result.statement += fmt::format(
-            " Not decidable from the predictable parts of these tracks (even at their strong magnitude): {}; they act "
-            "where the "
-            "unknown release orientation decides the path.",
-            fmt::join(untestable, ", "));
-        result.experiment =
-            "record each trial's release orientation to a few degrees (a marked particle, a release jig), or repeat "
-            "the tests "
-            "with a sphere of the same material, whose path does not depend on it";
-      }
-    }
+  const bool open = !named && !*particle && result.verdict != Verdict::Ambiguous;
+  if (open && !result.unexplained.empty()) {
+    say_unexplained_phases(result, options);
+  } else if (open) {
+    if (auto ok = say_none(c, result, baseline, fits, final_groups, options); !ok) return std::unexpected(ok.error());
   }
-  if (!named && !particle && result.verdict != Verdict::Ambiguous && options.ensemble_replays > 0) {
+  if (open && options.ensemble_replays > 0) {
     run.report("ensembles", 0.9);
     if (auto ok = judge_ensembles(c, result, baseline, *full_base, effects, options); !ok)
       return std::unexpected(ok.error());
   }
   track_plots(c, result, *full_base, *full_improved);
   result.evaluations = c.evaluations;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  result.seconds = seconds();
   run.report("done", 1.0);
   return result;
 }
