@@ -234,7 +234,11 @@ int main(int argc, char** argv) {
                "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
   app.add_flag("--existing-only", existing_only,
                "Score only the cases already diagnosed in --out (a partial run's figures), run none");
-  std::string recordings_set, orientation = "none", generator_file, generator_name;
+  // The recordings come from a finer clump of the same scan than the one diagnosed (340 spheres
+  // against the diagnosis's 32), as real data never comes from the diagnoser's own model.
+  std::string recordings_set, orientation = "none",
+                              generator_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default.h5",
+                              generator_name = "adaptive-340";
   int spheres = 0, threads = 0;
   double fps = 1000.0, noise = 1e-4;
   bool no_pre_roll = false;
@@ -249,8 +253,8 @@ int main(int argc, char** argv) {
                  "What the generated tracks follow: silhouette (the side view's centroid, default) or body-point");
   app.add_option("--pixel", pixel_mm, "Silhouette camera: pixel size [mm]");
   app.add_option("--generator-library", generator_file,
-                 "Clump library the recordings are made with (default: --library); a finer clump of the same mesh "
-                 "than the diagnosed one");
+                 "Clump library the recordings are made with (default: clumps/tuber-default.h5, its adaptive-340: "
+                 "a finer clump of the same scan than the diagnosed one; empty: --library's clump)");
   app.add_option("--generator-clump", generator_name, "Which clump of the generator's library (a name)");
   app.add_option("--recordings-set", recordings_set,
                  "Score a recording set made elsewhere (case-NN/ folders and ANSWERS.json, e.g. "
