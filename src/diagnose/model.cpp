@@ -91,7 +91,14 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
     const TrackedTrial& tt = ev.trials[which[k]];
     const Recording& recording = recordings[tt.recording];
     ReplayOptions replay;
-    replay.duration = ev.full_duration ? tt.duration : std::min(tt.duration, tt.horizon + 0.02);
+    // Up to the horizon, and no later than the frames scored need (the cutoff, in the track's
+    // time, less the time shift, which the alignment below moves by at most its window): the
+    // first stage of a fit scores only the early window, and a sphere's horizon is the end.
+    const double window = recording.test == LabTest::Tilt ? ev.shift_window : 5.0 * ev.shift_window;
+    double until = std::min(tt.duration, tt.horizon + 0.02);
+    if (ev.shift.size() == ev.trials.size() && std::isfinite(tt.cutoff))
+      until = std::min(until, tt.cutoff - ev.shift[which[k]] + window + 0.02);
+    replay.duration = ev.full_duration ? tt.duration : std::max(until, 0.02);
     replay.sample_interval = ev.sample_interval;
     replay.record_from = tt.record_from;
     auto samples = replay_trial(*worlds[tt.recording], recording, tt.orientation, options[tt.recording], replay);
@@ -104,7 +111,6 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
     if (ev.shift.size() == ev.trials.size()) {
       // Wide enough for a model that falls or rolls milliseconds later than the first one
       // (strong drag); the first phase's chi^2 is a single bowl in the shift.
-      const double window = recording.test == LabTest::Tilt ? ev.shift_window : 5.0 * ev.shift_window;
       score.alignment = align(track, samples, sigma, tt.origins, ev.shift[which[k]], window, window, tt.cutoff,
                               ev.shift[which[k]] + first_phase_end);
     } else {
