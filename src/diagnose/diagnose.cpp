@@ -1718,6 +1718,7 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
       if (rung.explains) {
         check.resolution_needed = rung.spheres;
         say_particle_model(result, check, true);
+        result.improved = fine->calibrated;  // the finer clump's coefficients, calibrated on the outcomes
         return {};
       }
     }
