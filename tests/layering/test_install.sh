@@ -36,7 +36,9 @@ grep -q "^drop on Q235, 2 trials" <<< "$out"
 
 # The installed command line runs from the prefix and finds its libraries there.
 "$prefix/bin/clumpforge" --version
-ldd "$prefix/bin/clumpforge" | grep -q "libclumpforge_core.so => $prefix/" \
+# (ldd's output kept first: with pipefail, grep -q quitting early would fail the pipe on SIGPIPE)
+linked=$(ldd "$prefix/bin/clumpforge")
+grep -q "libclumpforge_core.so => $prefix/" <<< "$linked" \
   || { echo "installed clumpforge does not use the installed libraries"; exit 1; }
 # The installed Python package imports from the prefix alone.
 if [ -d "$prefix/lib/python3/dist-packages/clumpforge" ]; then
