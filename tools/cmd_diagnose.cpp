@@ -60,6 +60,10 @@ void print_text(const DiagnoseResult& r) {
   if (shown == 0) std::cout << "  (none: every phase is within the noise)\n";
   std::cout << "\ncandidate effects (training delta-chi^2, delta-BIC, held-out delta-chi^2, checks):\n";
   for (const auto& h : r.hypotheses) {
+    if (!h.fitted) {
+      std::cout << fmt::format("  {:28s} not fitted (no large misfit to clear)\n", h.name);
+      continue;
+    }
     std::string values;
     for (const auto& v : h.values) values += fmt::format(" {}={:.3g}", v.name, v.value);
     const std::string refitted = std::isfinite(h.all_trials_delta_bic) && !h.beats_refitted_null

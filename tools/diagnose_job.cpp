@@ -226,6 +226,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
     for (const auto& v : h.values) values[v.name] = v.value;
     j["hypotheses"].push_back(
         {{"name", h.name},
+         {"fitted", h.fitted},
          {"values", values},
          {"coefficients", coefficients_json(h.base)},
          {"values_used", h.values_used},

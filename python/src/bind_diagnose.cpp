@@ -59,6 +59,7 @@ void bind_parts(py::module_& m) {
       .def_readonly("statement", &PhaseReport::statement);
   py::class_<HypothesisReport>(m, "HypothesisReport", "One candidate effect as fitted and tested.")
       .def_readonly("name", &HypothesisReport::name)
+      .def_readonly("fitted", &HypothesisReport::fitted)
       .def_readonly("values", &HypothesisReport::values)
       .def_readonly("delta_chi2", &HypothesisReport::delta_chi2)
       .def_readonly("delta_bic", &HypothesisReport::delta_bic)

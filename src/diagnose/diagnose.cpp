@@ -1462,6 +1462,39 @@ Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result,
   const auto& recordings = *c.ev.recordings;
   const auto library = effect_library();
   std::vector<Fitted> fits;
+  // A candidate passes only when it clears a large misfit among the flagged phases
+  // (clears_large_misfit). With none, no candidate can pass, and their fits would only cost
+  // time (nine fits are most of a diagnosis); each is listed unfitted, and its detection
+  // limit is still probed (detection_limits).
+  bool any_large = false;
+  for (const auto& key : located.flagged) {
+    const auto b = located.base_train_groups.find(key);
+    any_large = any_large || (b != located.base_train_groups.end() && large_misfit(c, key, b->second));
+  }
+  if (!any_large) {
+    int values = 0;
+    for (std::size_t k = 0; k < c.all.size(); ++k) {
+      if (c.ev.trials[c.all[k]].training) values += located.base_scores[k].alignment.values;
+    }
+    for (Effect effect : effects) {
+      const EffectSpec& spec = effect_spec(library, effect);
+      HypothesisReport report;
+      report.name = spec.name;
+      report.fitted = false;
+      report.base = baseline.base;
+      report.values_used = values;
+      result.hypotheses.push_back(std::move(report));
+      Fitted unfitted{.model = baseline, .chi2 = located.sum(c.training), .evaluations = 0, .values = values};
+      unfitted.model.effect = effect;
+      for (const auto& parameter : spec.parameters)
+        unfitted.model.values.push_back(spec.effect == Effect::ComOffset ? 0.0 : parameter.lower);
+      fits.push_back(std::move(unfitted));
+    }
+    result.notes.push_back(
+        "candidate effects not fitted: no flagged phase misfits by three times hypot(noise, model accuracy) or more, "
+        "and an effect is named only when it clears such a misfit");
+    return fits;
+  }
   for (std::size_t h = 0; h < effects.size(); ++h) {
     const EffectSpec& spec = effect_spec(library, effects[h]);
     run.report("fitting effects", 0.2 + 0.65 * static_cast<double>(h) / static_cast<double>(effects.size()));

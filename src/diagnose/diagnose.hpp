@@ -109,6 +109,9 @@ struct ParameterValue {
 
 struct HypothesisReport {
   std::string name;
+  /// False when no flagged phase had a large misfit for any candidate to clear: then none can
+  /// pass, none is fitted, and only its detection limit is probed.
+  bool fitted = true;
   std::vector<ParameterValue> values;
   std::vector<SurfaceParameters> base;
   int values_used = 0;              ///< training residual cells in its tests
