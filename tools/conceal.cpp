@@ -111,7 +111,8 @@ int main(int argc, char** argv) {
     auto effect = parse_effect(effect_name);
     if (!effect) return cli::report_error(kCommand, effect.error());
     options.effect = *effect;
-    auto values = parse_values(magnitude, effect_spec(effect_library(), *effect));
+    const auto library = effect_library();
+    auto values = parse_values(magnitude, effect_spec(library, *effect));
     if (!values) return cli::report_error(kCommand, values.error());
     options.values = *values;
   }

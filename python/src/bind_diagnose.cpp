@@ -5,10 +5,6 @@
 namespace clumpforge::python {
 namespace {
 
-std::string effect_name(Effect e) {
-  return effect_spec(effect_library(), e).name;
-}
-
 void bind_enums(py::module_& m) {
   py::enum_<Verdict>(m, "Verdict")
       .value("none", Verdict::None)

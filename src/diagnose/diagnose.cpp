@@ -974,7 +974,7 @@ std::string verdict_name(const DiagnoseResult& result) {
     case Verdict::None:
       return "none";
     case Verdict::Named:
-      return result.effect ? effect_spec(effect_library(), *result.effect).name : "none";
+      return result.effect ? effect_name(*result.effect) : "none";
     case Verdict::Ambiguous:
       return "ambiguous";
     case Verdict::Unexplained:
@@ -1407,8 +1407,7 @@ void say_particle_model(DiagnoseResult& result, const ParticleModelCheck& check,
   if (outcomes) {
     blamed = "the recorded outcomes differ from replays over the unknown release orientation beyond the noise";
   } else if (result.verdict == Verdict::Named && result.effect) {
-    blamed = fmt::format("the misfit {} absorbed is three times the noise or more",
-                         effect_spec(effect_library(), *result.effect).name);
+    blamed = fmt::format("the misfit {} absorbed is three times the noise or more", effect_name(*result.effect));
   } else if (result.verdict == Verdict::Ambiguous) {
     blamed = fmt::format("the misfit {} absorbed about equally is three times the noise or more",
                          fmt::join(result.candidates, " and "));
@@ -1866,7 +1865,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
       result.notes.push_back(fmt::format(
           "beyond the release horizon {} improves the outcomes by delta-BIC {:.1f} but leaves chi^2 {:.1f} over {} "
           "recorded means: not an explanation",
-          effect_spec(effect_library(), h.effect).name, h.delta_bic, h.chi2, ens->outcomes));
+          effect_name(h.effect), h.delta_bic, h.chi2, ens->outcomes));
     }
   }
   if (!ens->outcomes || ens->hypotheses.empty() || passing.empty()) {
@@ -2010,7 +2009,8 @@ Result<void> say_named(Context& c, DiagnoseResult& result, const Fitted& fit, co
   result.verdict = Verdict::Named;
   result.basis = Basis::FrameByFrame;
   result.effect = *improved.effect;
-  const EffectSpec& spec = effect_spec(effect_library(), *improved.effect);
+  const auto library = effect_library();
+  const EffectSpec& spec = effect_spec(library, *improved.effect);
   for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
     const auto& p = spec.parameters[k];
     const double v = improved.values[k];

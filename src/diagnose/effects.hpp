@@ -46,6 +46,10 @@ struct EffectSpec {
 /// The whole library, in a fixed order.
 std::vector<EffectSpec> effect_library();
 const EffectSpec& effect_spec(const std::vector<EffectSpec>& library, Effect effect);
+/// Not on a temporary library: the reference would dangle once the statement ends.
+const EffectSpec& effect_spec(std::vector<EffectSpec>&& library, Effect effect) = delete;
+/// The effect's name as verdicts write it, e.g. "air_drag".
+std::string effect_name(Effect effect);
 Result<Effect> parse_effect(std::string_view name);
 
 /// Switches `effect` on in `options` with parameter values `values` (one per parameter).
