@@ -146,8 +146,8 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   if (!team.leader()) return ran ? 0 : 1;
   if (!ran) return 1;
   std::string table =
-      "| case | particle | truth | verdict | right | held-out RMS before -> after [mm] | improvement | time [s] "
-      "|\n|---|---|---|---|---|---|---:|---:|\n";
+      "| case | particle | truth | verdict | basis | right | held-out RMS before -> after [mm] | improvement | time "
+      "[s] |\n|---|---|---|---|---|---|---|---:|---:|\n";
   int effects = 0, effects_right = 0, controls = 0, controls_none = 0, controls_named = 0;
   std::vector<double> seconds, improvements;
   nlohmann::json rows = nlohmann::json::array();
@@ -178,12 +178,13 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       if (is_right) improvements.push_back(gain);
     }
     seconds.push_back(j.value("seconds", NAN));
-    table += fmt::format("| {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} |\n", id,
-                         answer.value("particle", "?"), answer.value("label", effect), verdict, is_right ? "yes" : "no",
-                         before, after, 100.0 * gain, j.value("seconds", NAN));
+    table += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} |\n", id,
+                         answer.value("particle", "?"), answer.value("label", effect), verdict, j.value("basis", "?"),
+                         is_right ? "yes" : "no", before, after, 100.0 * gain, j.value("seconds", NAN));
     rows.push_back({{"case", id},
                     {"truth", effect},
                     {"verdict", verdict},
+                    {"basis", j.value("basis", "?")},
                     {"right", is_right},
                     {"heldout_rms_before_mm", before},
                     {"heldout_rms_after_mm", after},
