@@ -28,6 +28,11 @@ Result<void> collect(const std::string& path, std::vector<Recording>& recordings
   return {};
 }
 
+// A number, or null when it is not finite (JSON has no infinity or NaN).
+nlohmann::json finite_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
 nlohmann::json coefficients_json(const std::vector<SurfaceParameters>& base) {
   nlohmann::json out = nlohmann::json::object();
   for (const auto& b : base) {
@@ -131,24 +136,23 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   if (r.particle_model) {
     const auto& m = *r.particle_model;
     nlohmann::json rungs = nlohmann::json::array();
-    auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
     for (const auto& rung : m.rungs) {
-      rungs.push_back(
-          {{"clump", rung.name},
-           {"spheres", rung.spheres},
-           {"track_difference_mm", number(rung.track_difference_m * 1e3)},
-           {"refitted", rung.refitted},
-           {"chi2_per_value", rung.refitted ? number(rung.chi2_per_value) : nlohmann::json()},
-           {"worst_phase_chi2_per_value", rung.refitted ? number(rung.worst_phase_chi2_per_value) : nlohmann::json()},
-           {"explains", rung.explains}});
+      rungs.push_back({{"clump", rung.name},
+                       {"spheres", rung.spheres},
+                       {"track_difference_mm", finite_or_null(rung.track_difference_m * 1e3)},
+                       {"refitted", rung.refitted},
+                       {"chi2_per_value", rung.refitted ? finite_or_null(rung.chi2_per_value) : nlohmann::json()},
+                       {"worst_phase_chi2_per_value",
+                        rung.refitted ? finite_or_null(rung.worst_phase_chi2_per_value) : nlohmann::json()},
+                       {"explains", rung.explains}});
     }
     j["particle_model"] = {
         {"diagnosed", m.diagnosed},
         {"spheres", m.spheres},
-        {"track_tolerance_mm", number(m.track_tolerance_m * 1e3)},
+        {"track_tolerance_mm", finite_or_null(m.track_tolerance_m * 1e3)},
         {"checked", m.checked},
-        {"chi2_per_value", m.checked ? number(m.chi2_per_value) : nlohmann::json()},
-        {"worst_phase_chi2_per_value", m.checked ? number(m.worst_phase_chi2_per_value) : nlohmann::json()},
+        {"chi2_per_value", m.checked ? finite_or_null(m.chi2_per_value) : nlohmann::json()},
+        {"worst_phase_chi2_per_value", m.checked ? finite_or_null(m.worst_phase_chi2_per_value) : nlohmann::json()},
         {"resolution_needed_spheres", m.resolution_needed ? nlohmann::json(*m.resolution_needed) : nlohmann::json()},
         {"rungs", rungs}};
   }
@@ -187,11 +191,10 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
     }
     nlohmann::json detect = nlohmann::json::array();
     for (const auto& d : e.detectability) {
-      detect.push_back(
-          {{"name", effect_spec(library, d.effect).name},
-           {"strong_signal", d.strong_signal},
-           {"needed", d.needed},
-           {"trials_needed", std::isfinite(d.trials_needed) ? nlohmann::json(d.trials_needed) : nlohmann::json()}});
+      detect.push_back({{"name", effect_spec(library, d.effect).name},
+                        {"strong_signal", d.strong_signal},
+                        {"needed", d.needed},
+                        {"trials_needed", finite_or_null(d.trials_needed)}});
     }
     j["ensemble"] = {{"replays", e.replays},
                      {"trials", e.trials},
@@ -224,29 +227,26 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   for (const auto& h : r.hypotheses) {
     nlohmann::json values = nlohmann::json::object();
     for (const auto& v : h.values) values[v.name] = v.value;
-    j["hypotheses"].push_back(
-        {{"name", h.name},
-         {"fitted", h.fitted},
-         {"values", values},
-         {"coefficients", coefficients_json(h.base)},
-         {"values_used", h.values_used},
-         {"delta_chi2", h.delta_chi2},
-         {"delta_bic", h.delta_bic},
-         {"heldout_delta_chi2", h.heldout_delta_chi2},
-         {"plausible", h.plausible},
-         {"improves_heldout", h.improves_heldout},
-         {"clears_signature", h.clears_signature},
-         {"clears_large_misfit", h.clears_large_misfit},
-         {"all_trials_delta_bic",
-          std::isfinite(h.all_trials_delta_bic) ? nlohmann::json(h.all_trials_delta_bic) : nlohmann::json()},
-         {"beats_refitted_null", h.beats_refitted_null},
-         {"flagged_excess_before", h.flagged_excess_before},
-         {"flagged_excess_after", h.flagged_excess_after},
-         {"worsened_phases", h.worsened_phases},
-         {"passes", h.passes},
-         {"evaluations", h.evaluations},
-         {"smallest_detectable",
-          std::isfinite(h.smallest_detectable) ? nlohmann::json(h.smallest_detectable) : nlohmann::json()}});
+    j["hypotheses"].push_back({{"name", h.name},
+                               {"fitted", h.fitted},
+                               {"values", values},
+                               {"coefficients", coefficients_json(h.base)},
+                               {"values_used", h.values_used},
+                               {"delta_chi2", h.delta_chi2},
+                               {"delta_bic", h.delta_bic},
+                               {"heldout_delta_chi2", h.heldout_delta_chi2},
+                               {"plausible", h.plausible},
+                               {"improves_heldout", h.improves_heldout},
+                               {"clears_signature", h.clears_signature},
+                               {"clears_large_misfit", h.clears_large_misfit},
+                               {"all_trials_delta_bic", finite_or_null(h.all_trials_delta_bic)},
+                               {"beats_refitted_null", h.beats_refitted_null},
+                               {"flagged_excess_before", h.flagged_excess_before},
+                               {"flagged_excess_after", h.flagged_excess_after},
+                               {"worsened_phases", h.worsened_phases},
+                               {"passes", h.passes},
+                               {"evaluations", h.evaluations},
+                               {"smallest_detectable", finite_or_null(h.smallest_detectable)}});
   }
   auto phases_of = [](const std::vector<PhaseOf>& list) {
     nlohmann::json out = nlohmann::json::array();
@@ -282,7 +282,7 @@ std::string diagnosis_tracks_json(const DiagnoseResult& r) {
                    {"improved_t", t.improved_t},
                    {"improved_x", t.improved_x},
                    {"improved_z", t.improved_z},
-                   {"horizon", std::isfinite(t.horizon) ? nlohmann::json(t.horizon) : nlohmann::json()}});
+                   {"horizon", finite_or_null(t.horizon)}});
   }
   return out.dump() + "\n";
 }

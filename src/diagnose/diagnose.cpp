@@ -1325,9 +1325,10 @@ Result<void> resolution_stage(Context& c, DiagnoseResult& result, const Model& s
   while (k < options.finer_clumps.size()) {
     auto coarse = score(c, start, c.training, true);
     if (!coarse) return std::unexpected(coarse.error());
-    const Clump* kept = c.ev.clump;
-    c.ev.clump = &options.finer_clumps[k];
-    auto fine = score(c, start, c.training, true);
+    auto fine = [&] {
+      const ClumpSwap swap(c, &options.finer_clumps[k]);
+      return score(c, start, c.training, true);
+    }();
     if (!fine) return std::unexpected(fine.error());
     double sum = 0.0;
     for (std::size_t i = 0; i < c.training.size(); ++i) {
@@ -1336,11 +1337,8 @@ Result<void> resolution_stage(Context& c, DiagnoseResult& result, const Model& s
     }
     const double difference = std::sqrt(sum / std::max<std::size_t>(1, c.training.size()));
     check.rungs[k + 1].track_difference_m = difference;
-    if (difference <= tolerance) {
-      c.ev.clump = kept;
-      break;
-    }
-    ++k;  // the finer clump is kept; its release state and horizons replace the coarser one's
+    if (difference <= tolerance) break;
+    c.ev.clump = &options.finer_clumps[k++];  // kept: its release state and horizons replace the coarser one's
     release = {};
     if (auto ok = release_stage(c, release, start, options); !ok) return std::unexpected(ok.error());
   }
@@ -1485,8 +1483,7 @@ Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result,
       result.hypotheses.push_back(std::move(report));
       Fitted unfitted{.model = baseline, .chi2 = located.sum(c.training), .evaluations = 0, .values = values};
       unfitted.model.effect = effect;
-      for (const auto& parameter : spec.parameters)
-        unfitted.model.values.push_back(spec.effect == Effect::ComOffset ? 0.0 : parameter.lower);
+      unfitted.model.values = effect_off(spec);  // the baseline itself
       fits.push_back(std::move(unfitted));
     }
     result.notes.push_back(
@@ -1644,7 +1641,7 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
                            ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.realistic)
                            : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.realistic));
     } else {
-      const double null_value = spec.effect == Effect::ComOffset ? 0.0 : first.lower;
+      const double null_value = effect_off(spec)[0];
       const double probed = 0.2 * first.realistic;
       report.smallest_detectable =
           signal > 0.0 ? null_value + (probed - null_value) * std::sqrt(needed / signal) : kNever;

@@ -67,10 +67,12 @@ struct ParticleModelRung {
   /// windows, camera origins removed) from the previous clump's, at the starting coefficients;
   /// NaN when not compared.
   double track_difference_m = std::numeric_limits<double>::quiet_NaN();
-  bool refitted = false;                    ///< the coefficients were refitted with it on every trial
-  double chi2_per_value = 0.0;              ///< every trial, its refitted null
-  double worst_phase_chi2_per_value = 0.0;  ///< the largest phase misfit it leaves
-  bool explains = false;                    ///< it leaves no large misfit: the mismatch was the particle model's
+  bool refitted = false;        ///< the coefficients were refitted with it on every trial
+  double chi2_per_value = 0.0;  ///< its refitted null: per value on every trial, or per recorded mean
+  /// The largest misfit it leaves: a phase's chi^2 per value (frames), or a recorded mean's
+  /// z^2 (outcomes beyond the release horizon), as chi2_per_value is per value or per mean.
+  double worst_phase_chi2_per_value = 0.0;
+  bool explains = false;  ///< it leaves no large misfit: the mismatch was the particle model's
 };
 
 /// Whether the particle model, not missing physics, explains a mismatch.
@@ -79,10 +81,10 @@ struct ParticleModelCheck {
   int spheres = 0;
   double track_tolerance_m = 0.0;        ///< half of the smallest weight: tracks closer than this converged
   std::vector<ParticleModelRung> rungs;  ///< the clumps tried, coarsest first (the diagnosed one included)
-  double chi2_per_value = 0.0;           ///< every trial, the diagnosed clump's refitted null (when checked)
-  double worst_phase_chi2_per_value = 0.0;
-  bool checked = false;                  ///< a mismatch was found and the finer clumps refitted
-  std::optional<int> resolution_needed;  ///< spheres of the first finer clump that explains the mismatch
+  double chi2_per_value = 0.0;  ///< the diagnosed clump's null: per value (frames) or per recorded mean (outcomes)
+  double worst_phase_chi2_per_value = 0.0;  ///< as in ParticleModelRung
+  bool checked = false;                     ///< a mismatch was found and the finer clumps refitted
+  std::optional<int> resolution_needed;     ///< spheres of the first finer clump that explains the mismatch
 };
 
 enum class Axis { X, Z };

@@ -48,6 +48,9 @@ std::vector<EffectSpec> effect_library();
 const EffectSpec& effect_spec(const std::vector<EffectSpec>& library, Effect effect);
 /// Not on a temporary library: the reference would dangle once the statement ends.
 const EffectSpec& effect_spec(std::vector<EffectSpec>&& library, Effect effect) = delete;
+/// The parameter values at which `spec`'s effect is switched off (zero, or a log-scale
+/// parameter's upper end: an elastic-plastic yield speed no impact reaches).
+std::vector<double> effect_off(const EffectSpec& spec);
 /// The effect's name as verdicts write it, e.g. "air_drag".
 std::string effect_name(Effect effect);
 Result<Effect> parse_effect(std::string_view name);

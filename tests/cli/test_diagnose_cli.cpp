@@ -60,6 +60,12 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
       fmt::format("diagnose --recordings '{}' --library '{}' --effects air_drga", (dir / "rec").string(), clump()));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("did you mean 'air_drag'"), std::string::npos) << run.err;
+  // An absurd number of finer clumps: refused by name, nothing written.
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --finer-clumps 9 --output '{}'",
+                                         (dir / "rec").string(), clump(), (dir / "finer").string()));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("--finer-clumps must be between 0 and 4"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "finer"));
   // A track too short to decide anything: that verdict, not a guess.
   run = test::run_clumpforge(
       fmt::format("diagnose --recordings '{}' --library '{}' --json", (dir / "rec").string(), clump()));
