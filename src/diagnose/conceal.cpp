@@ -124,17 +124,31 @@ std::pair<double, double> camera_window(const std::vector<ReplaySample>& replay,
   return {0.0, replay.back().t};
 }
 
+// The silhouette's centroid less the body's position hangs on the orientation alone (the pixel
+// rows are laid from the body's lowest point): while the body does not turn (before the
+// release, a free fall from rest, at rest) one computation serves every frame.
+struct SilhouetteCache {
+  Eigen::Quaterniond orientation{0.0, 0.0, 0.0, 0.0};
+  Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+};
+
 // Where the camera sees the body at time t: a fixed body point (the replay's tracked point) or
 // the silhouette's centroid, from the pose interpolated between the replay's samples.
 Eigen::Vector2d seen(const std::vector<ReplaySample>& replay, const std::vector<Sphere>& shape, double t,
-                     const ConcealOptions& o) {
+                     const ConcealOptions& o, SilhouetteCache& cache) {
   const ReplayPoint p = interpolate(replay, t);
   if (o.camera == CameraTarget::BodyPoint || shape.empty()) return {p.x, p.z};
   const ReplaySample& a = replay[p.index];
   const ReplaySample& b = replay[std::min(p.index + 1, replay.size() - 1)];
   const double f = b.t > a.t ? std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0) : 0.0;
-  return silhouette_centroid(shape, a.position + f * (b.position - a.position), a.orientation.slerp(f, b.orientation),
-                             o.pixel_m);
+  const Eigen::Vector3d position = a.position + f * (b.position - a.position);
+  const Eigen::Quaterniond q = a.orientation.slerp(f, b.orientation);
+  // Turned by less than 1e-12 rad: the silhouette moves by less than 1e-14 m.
+  if ((q.coeffs() - cache.orientation.coeffs()).norm() > 1e-12) {
+    cache.orientation = q;
+    cache.offset = silhouette_centroid(shape, Eigen::Vector3d::Zero(), q, o.pixel_m);
+  }
+  return Eigen::Vector2d(position.x(), position.z()) + cache.offset;
 }
 
 Track film(const std::vector<ReplaySample>& replay, const std::vector<Sphere>& shape, LabTest test,
@@ -150,13 +164,14 @@ Track film(const std::vector<ReplaySample>& replay, const std::vector<Sphere>& s
     gap_length = 3 + static_cast<long>(rng.below(13));
   }
   Track track;
+  SilhouetteCache cache;
   for (long k = 0; k <= frames; ++k) {
     const double t = start + static_cast<double>(k) * interval;
     const bool lost = rng.uniform() < o.drop_frame_probability || (k >= gap_start && k < gap_start + gap_length);
     const double nx = rng.normal(0.0, o.noise_m), nz = rng.normal(0.0, o.noise_m);
     const bool empty_x = rng.uniform() < o.empty_cell_probability, empty_z = rng.uniform() < o.empty_cell_probability;
     if (lost && k != 0 && k != frames) continue;
-    const Eigen::Vector2d p = seen(replay, shape, t, o);
+    const Eigen::Vector2d p = seen(replay, shape, t, o, cache);
     track.t.push_back(std::round((origin + t) * 1e6) / 1e6);
     track.x.push_back(empty_x ? std::numeric_limits<double>::quiet_NaN() : p.x() + x_origin + nx);
     track.z.push_back(empty_z ? std::numeric_limits<double>::quiet_NaN() : p.y() + nz);
@@ -216,30 +231,57 @@ std::pair<double, double> coefficient_bounds(LabTest test) {
 Eigen::Vector2d silhouette_centroid(const std::vector<Sphere>& spheres, const Eigen::Vector3d& position,
                                     const Eigen::Quaterniond& orientation, double pixel) {
   // Each disc's span on every pixel row it crosses; per row the spans' union, its length and
-  // first moment exact.
+  // first moment exact. A disc inside a larger one adds nothing to the union: the largest
+  // are taken first and the discs they hide are dropped (most of a clump's, in a side view).
+  struct Disc {
+    double x, z, r;
+  };
+  std::vector<Disc> discs;
+  discs.reserve(spheres.size());
   double low = std::numeric_limits<double>::infinity();
-  std::vector<Eigen::Vector3d> discs;  // x, z, radius
   for (const Sphere& s : spheres) {
     const Eigen::Vector3d c = position + orientation * s.centre;
-    discs.emplace_back(c.x(), c.z(), s.radius);
+    discs.push_back({c.x(), c.z(), s.radius});
     low = std::min(low, c.z() - s.radius);
   }
-  std::vector<std::vector<std::pair<double, double>>> rows;
-  for (const auto& d : discs) {
-    const auto first = static_cast<std::size_t>(std::max(0.0, std::floor((d.y() - d.z() - low) / pixel - 0.5)));
-    const auto last = static_cast<std::size_t>(std::max(0.0, std::ceil((d.y() + d.z() - low) / pixel - 0.5)));
-    if (rows.size() <= last) rows.resize(last + 1);
+  std::stable_sort(discs.begin(), discs.end(), [](const Disc& a, const Disc& b) { return a.r > b.r; });
+  std::vector<Disc> shown;
+  for (const Disc& d : discs) {
+    const bool hidden = std::any_of(shown.begin(), shown.end(),
+                                    [&](const Disc& s) { return std::hypot(d.x - s.x, d.z - s.z) + d.r <= s.r; });
+    if (!hidden) shown.push_back(d);
+  }
+  // The spans, grouped by row (a counting sort), each row's sorted by its left end.
+  auto rows_of = [&](const Disc& d) {
+    const auto first = static_cast<std::size_t>(std::max(0.0, std::floor((d.z - d.r - low) / pixel - 0.5)));
+    const auto last = static_cast<std::size_t>(std::max(0.0, std::ceil((d.z + d.r - low) / pixel - 0.5)));
+    return std::pair{first, last};
+  };
+  std::size_t row_count = 0;
+  for (const Disc& d : shown) row_count = std::max(row_count, rows_of(d).second + 1);
+  std::vector<std::size_t> begin(row_count + 1, 0);
+  for (const Disc& d : shown) {
+    const auto [first, last] = rows_of(d);
+    for (std::size_t k = first; k <= last; ++k) ++begin[k + 1];
+  }
+  for (std::size_t k = 0; k < row_count; ++k) begin[k + 1] += begin[k];
+  std::vector<std::pair<double, double>> spans(
+      begin.back(), {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()});
+  std::vector<std::size_t> fill(begin.begin(), begin.end() - 1);
+  for (const Disc& d : shown) {
+    const auto [first, last] = rows_of(d);
     for (std::size_t k = first; k <= last; ++k) {
-      const double dz = low + (static_cast<double>(k) + 0.5) * pixel - d.y();
-      if (std::abs(dz) >= d.z()) continue;
-      const double w = std::sqrt(d.z() * d.z() - dz * dz);
-      rows[k].emplace_back(d.x() - w, d.x() + w);
+      const double dz = low + (static_cast<double>(k) + 0.5) * pixel - d.z;
+      if (std::abs(dz) >= d.r) continue;  // the row misses the disc: its slot stays empty (b < a)
+      const double w = std::sqrt(d.r * d.r - dz * dz);
+      spans[fill[k]++] = {d.x - w, d.x + w};
     }
   }
   double area = 0.0, mx = 0.0, mz = 0.0;
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    auto& spans = rows[k];
-    std::sort(spans.begin(), spans.end());
+  for (std::size_t k = 0; k < row_count; ++k) {
+    const auto row_begin = spans.begin() + static_cast<std::ptrdiff_t>(begin[k]);
+    const auto row_end = spans.begin() + static_cast<std::ptrdiff_t>(fill[k]);
+    std::sort(row_begin, row_end);
     const double z = low + (static_cast<double>(k) + 0.5) * pixel;
     double a = -std::numeric_limits<double>::infinity(), b = a;
     auto close = [&] {
@@ -248,13 +290,13 @@ Eigen::Vector2d silhouette_centroid(const std::vector<Sphere>& spheres, const Ei
       mx += 0.5 * (b * b - a * a);
       mz += (b - a) * z;
     };
-    for (const auto& [s0, s1] : spans) {
-      if (s0 > b) {
+    for (auto it = row_begin; it != row_end; ++it) {
+      if (it->first > b) {
         close();
-        a = s0;
-        b = s1;
+        a = it->first;
+        b = it->second;
       } else {
-        b = std::max(b, s1);
+        b = std::max(b, it->second);
       }
     }
     close();
