@@ -20,6 +20,7 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <sstream>
 
 #include "core/atomic_file.hpp"
@@ -372,6 +373,7 @@ int main(int argc, char** argv) {
     std::string truth, magnitude, verdict;
     double heldout_before = NAN, heldout_after = NAN, seconds = NAN;
     bool detected = false;
+    std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
   };
   std::vector<Outcome> outcomes;
   std::vector<std::string> ids;
@@ -423,6 +425,10 @@ int main(int argc, char** argv) {
     o.heldout_before = j["fit"]["before"].value("heldout_rms_mm", NAN);
     o.heldout_after = j["fit"]["after"].value("heldout_rms_mm", NAN);
     o.seconds = j.value("seconds", NAN);
+    if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
+      for (const auto& cmp : j["ensemble"]["comparisons"])
+        o.ensemble_z.emplace_back(cmp.value("outcome", "?"), cmp.value("z", NAN));
+    }
     std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id,
                              truth, o.verdict, o.heldout_before, o.heldout_after, o.seconds)
               << std::flush;
@@ -485,6 +491,28 @@ int main(int argc, char** argv) {
   md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
                     100.0 * median(improvements));
   md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
+  // On the controls the calibrated null's replays should sit on the recorded outcomes within
+  // their standard errors (z about 0 +- 1): a mean z away from 0 is a bias of the diagnosed
+  // particle model against the generator's, which the ensemble stage may blame on an effect.
+  std::map<std::string, std::vector<double>> control_z;
+  for (const auto& o : outcomes) {
+    if (o.truth != "none") continue;
+    for (const auto& [name, z] : o.ensemble_z) {
+      if (std::isfinite(z)) control_z[name].push_back(z);
+    }
+  }
+  if (!control_z.empty()) {
+    md +=
+        "\n| outcome (controls, calibrated null) | comparisons | mean z | z > 2 | z < -2 |\n"
+        "|---|---:|---:|---:|---:|\n";
+    for (const auto& [name, zs] : control_z) {
+      const double mean = std::accumulate(zs.begin(), zs.end(), 0.0) / static_cast<double>(zs.size());
+      const auto above = std::count_if(zs.begin(), zs.end(), [](double z) { return z > 2.0; });
+      const auto below = std::count_if(zs.begin(), zs.end(), [](double z) { return z < -2.0; });
+      md += fmt::format("| {} | {} | {:+.2f} | {} | {} |\n", name, zs.size(), mean, above, below);
+      summary["control_ensemble_bias"][name] = {{"comparisons", zs.size()}, {"mean_z", mean}};
+    }
+  }
   std::cout << "\n" << md;
   summary["false_positive_rate"] = fpr;
   summary["controls"] = control_count;
