@@ -219,14 +219,18 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
 
 int main(int argc, char** argv) {
   CLI::App app{"Blind benchmark of clumpforge diagnose on concealed-effect recordings"};
-  std::string clump_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default-diagnosis.h5", clump_name,
-              out = "bench-out/diagnose";
+  // The diagnosed clump (adaptive-32) with finer fills of the same scan (64, 128), against
+  // which the diagnosis checks its particle model before it blames missing physics.
+  std::string clump_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default-ladder.h5",
+              clump_name = "adaptive-32", out = "bench-out/diagnose";
   int controls = 50, trials = 4;
   std::uint64_t seed = 1;
   std::vector<std::string> only;
   bool full_set = false, existing_only = false;
-  app.add_option("--library", clump_file, "Clump library the recordings are made with and diagnosed against");
-  app.add_option("--clump", clump_name, "Which clump of the library (a name)");
+  app.add_option("--library", clump_file,
+                 "Clump library diagnosed against (default clumps/tuber-default-ladder.h5: its clumps with more "
+                 "spheres than --clump are the finer clumps of the particle-model check)");
+  app.add_option("--clump", clump_name, "Which clump of the library is diagnosed (default adaptive-32)");
   app.add_option("-o,--output,--out", out, "Working directory (recordings, answers, reports, summary)");
   app.add_option("--controls", controls, "Effect-free controls");
   app.add_option("--trials", trials, "Trials per recording");

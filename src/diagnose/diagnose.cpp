@@ -1707,51 +1707,64 @@ double largest_z2(const std::vector<OutcomeComparison>& comparisons) {
   return worst;
 }
 
+/// The calibrated null leaves the recorded outcomes inconsistent with the replays (chi^2 tail
+/// below kConsistentTail): before the mismatch is blamed on missing physics, each finer clump
+/// left is tried (its null calibrated afresh on the outcomes, from the same orientations); the
+/// first that leaves them consistent explains it, and the verdict says so with the resolution
+/// needed. Returns whether one did.
+Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
+                                           const std::vector<FreeCoefficient>& free, const EnsembleOptions& eo,
+                                           int max_evaluations) {
+  const EnsembleReport& e = *result.ensemble;
+  const double dof = std::max(1.0, e.outcomes - static_cast<double>(free.size()));
+  if (!result.particle_model || c.finer.empty()) return false;
+  ParticleModelCheck& check = *result.particle_model;
+  check.checked = true;
+  check.chi2_per_value = e.null_chi2 / e.outcomes;
+  check.worst_phase_chi2_per_value = largest_z2(e.null_comparisons);
+  for (std::size_t k = 0; k < c.finer.size(); ++k) {
+    // The baseline refitted the baseline's way with the finer clump (the coefficients the
+    // frames pin change with the clump: a coarse clump rolls otherwise), its whole tracks
+    // replayed to put the recordings in its frame, and its null calibrated on the outcomes.
+    const ClumpSwap swap(c, c.finer[k]);
+    const auto unpinned = c.unpinned;
+    auto fitted = fit_coefficients(c, baseline, c.training, max_evaluations);
+    c.unpinned = unpinned;
+    if (!fitted) return std::unexpected(fitted.error());
+    c.ev.full_duration = true;
+    auto scores = score(c, fitted->model, c.all, true);
+    c.ev.full_duration = false;
+    if (!scores) return std::unexpected(scores.error());
+    auto fine = compare_ensembles(c.ev, fitted->model, *scores, free, {}, eo);
+    if (!fine) return std::unexpected(fine.error());
+    c.evaluations += fine->replays;
+    ParticleModelRung& rung = check.rungs.at(k + 1);
+    rung.refitted = true;
+    rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
+    rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
+    rung.explains = fine->outcomes == e.outcomes && chi2_upper_tail(fine->null_chi2, dof) >= kConsistentTail;
+    if (rung.explains) {
+      check.resolution_needed = rung.spheres;
+      say_particle_model(result, check, true);
+      result.improved = fine->calibrated;  // the finer clump's coefficients, calibrated on the outcomes
+      return true;
+    }
+  }
+  return false;
+}
+
 /// Nothing named, yet the calibrated null leaves the recorded outcomes inconsistent with the
-/// replays (chi^2 tail below kConsistentTail): a mismatch beyond the release horizon. Before it
-/// is called unexplained, each finer clump left is tried (its null calibrated afresh on the
-/// outcomes, from the same orientations); the first that leaves them consistent explains it,
-/// and the verdict says so with the resolution needed.
+/// replays: a mismatch beyond the release horizon. Unless a finer clump explains it
+/// (finer_clump_explains_outcomes), the verdict is unexplained.
 Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Model& baseline,
                                   const std::vector<FreeCoefficient>& free, const EnsembleOptions& eo,
                                   int max_evaluations) {
   const EnsembleReport& e = *result.ensemble;
   const double dof = std::max(1.0, e.outcomes - static_cast<double>(free.size()));
   if (chi2_upper_tail(e.null_chi2, dof) >= kConsistentTail) return {};
-  if (result.particle_model && !c.finer.empty()) {
-    ParticleModelCheck& check = *result.particle_model;
-    check.checked = true;
-    check.chi2_per_value = e.null_chi2 / e.outcomes;
-    check.worst_phase_chi2_per_value = largest_z2(e.null_comparisons);
-    for (std::size_t k = 0; k < c.finer.size(); ++k) {
-      // The baseline refitted the baseline's way with the finer clump (the coefficients the
-      // frames pin change with the clump: a coarse clump rolls otherwise), its whole tracks
-      // replayed to put the recordings in its frame, and its null calibrated on the outcomes.
-      const ClumpSwap swap(c, c.finer[k]);
-      const auto unpinned = c.unpinned;
-      auto fitted = fit_coefficients(c, baseline, c.training, max_evaluations);
-      c.unpinned = unpinned;
-      if (!fitted) return std::unexpected(fitted.error());
-      c.ev.full_duration = true;
-      auto scores = score(c, fitted->model, c.all, true);
-      c.ev.full_duration = false;
-      if (!scores) return std::unexpected(scores.error());
-      auto fine = compare_ensembles(c.ev, fitted->model, *scores, free, {}, eo);
-      if (!fine) return std::unexpected(fine.error());
-      c.evaluations += fine->replays;
-      ParticleModelRung& rung = check.rungs.at(k + 1);
-      rung.refitted = true;
-      rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
-      rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
-      rung.explains = fine->outcomes == e.outcomes && chi2_upper_tail(fine->null_chi2, dof) >= kConsistentTail;
-      if (rung.explains) {
-        check.resolution_needed = rung.spheres;
-        say_particle_model(result, check, true);
-        result.improved = fine->calibrated;  // the finer clump's coefficients, calibrated on the outcomes
-        return {};
-      }
-    }
-  }
+  auto explained = finer_clump_explains_outcomes(c, result, baseline, free, eo, max_evaluations);
+  if (!explained) return std::unexpected(explained.error());
+  if (*explained) return {};
   // Unexplained: the outcomes beyond the noise, three standard errors or more.
   std::vector<std::string> far;
   for (const auto& o : e.null_comparisons) {
@@ -1870,6 +1883,15 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
     if (ens->outcomes > 0 && result.verdict == Verdict::None)
       return outcomes_beyond_null(c, result, baseline, free, eo, options.max_evaluations);
     return {};
+  }
+  // Before an effect is named beyond the horizon: a null inconsistent with the outcomes may be
+  // the particle model's (a coarse clump rolls and bounces otherwise), which a finer clump shows.
+  if (chi2_upper_tail(ens->null_chi2, std::max(1.0, ens->outcomes - static_cast<double>(free.size()))) <
+      kConsistentTail) {
+    result.ensemble = report;
+    auto explained = finer_clump_explains_outcomes(c, result, baseline, free, eo, options.max_evaluations);
+    if (!explained) return std::unexpected(explained.error());
+    if (*explained) return {};
   }
   const EnsembleHypothesis& best = *passing.front();
   const EffectSpec& spec = effect_spec(library, best.effect);
