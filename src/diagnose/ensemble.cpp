@@ -142,7 +142,7 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
     plan.sigma = ev.sigma[r];
     plan.moved = std::max(1e-3, 6.0 * ev.sigma[r]);
     plan.recorded.resize(plan.outcomes.size());
-    std::optional<Eigen::Quaterniond> shared;
+    std::vector<Eigen::Quaterniond> recorded_orientations;
     bool every_recorded = true;
     for (std::size_t i = 0; i < ev.trials.size(); ++i) {
       const TrackedTrial& tt = ev.trials[i];
@@ -153,15 +153,12 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
       const auto measured = measure_outcomes(rec.test, recorded_path(track, scores[i]), plan.moved);
       for (std::size_t k = 0; k < measured.size(); ++k) plan.recorded[k].push_back(measured[k].second);
       every_recorded = every_recorded && rec.trials[tt.trial].release_orientation.has_value();
-      if (!shared && rec.trials[tt.trial].release_orientation) shared = rec.trials[tt.trial].release_orientation;
+      if (rec.trials[tt.trial].release_orientation)
+        recorded_orientations.push_back(*rec.trials[tt.trial].release_orientation);
     }
     if (plan.recorded.front().size() < 2) continue;
-    // The prior: uniform unless every trial carries a recorded orientation (then a ball
-    // about the first, a lab's orientations being alike; never exact).
-    OrientationPrior prior;
-    prior.spread = options.orientation_prior_deg * std::numbers::pi / 180.0;
-    if (every_recorded) prior.recorded = shared;
-    plan.orientations = draw_release_orientations(rec.test, prior, options.replays, options.seed, 90000 + r);
+    plan.orientations = ensemble_orientations(
+        rec.test, every_recorded ? recorded_orientations : std::vector<Eigen::Quaterniond>{}, options, 90000 + r);
     plans.push_back(std::move(plan));
   }
   return plans;
@@ -388,6 +385,23 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
 }
 
 }  // namespace
+
+std::vector<Eigen::Quaterniond> ensemble_orientations(LabTest test, const std::vector<Eigen::Quaterniond>& recorded,
+                                                      const EnsembleOptions& options, std::uint64_t stream) {
+  OrientationPrior prior;
+  prior.spread = options.orientation_prior_deg * std::numbers::pi / 180.0;
+  if (recorded.empty()) return draw_release_orientations(test, prior, options.replays, options.seed, stream);
+  const std::size_t n = recorded.size();
+  const int each = static_cast<int>((static_cast<std::size_t>(options.replays) + n - 1) / n);
+  std::vector<std::vector<Eigen::Quaterniond>> draws;
+  for (std::size_t j = 0; j < n; ++j) {
+    prior.recorded = recorded[j];
+    draws.push_back(draw_release_orientations(test, prior, each, options.seed, 1000 * stream + j));
+  }
+  std::vector<Eigen::Quaterniond> out;
+  for (std::size_t k = 0; static_cast<int>(out.size()) < options.replays; ++k) out.push_back(draws[k % n][k / n]);
+  return out;
+}
 
 Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& baseline,
                                          const std::vector<TrialScore>& scores,

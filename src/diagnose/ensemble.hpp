@@ -63,6 +63,13 @@ struct EnsembleOptions {
   std::uint64_t seed = 1;
 };
 
+/// The release orientations of a recording's replays: from the uniform prior when `recorded`
+/// is empty, else mirroring the recorded sample, in turn from a ball of the prior's spread
+/// about each trial's recorded orientation (never exact), as many from each. Reproducible from
+/// (options.seed, stream).
+std::vector<Eigen::Quaterniond> ensemble_orientations(LabTest test, const std::vector<Eigen::Quaterniond>& recorded,
+                                                      const EnsembleOptions& options, std::uint64_t stream);
+
 /// A candidate effect judged on the outcomes.
 struct EnsembleHypothesis {
   Effect effect = Effect::AirDrag;

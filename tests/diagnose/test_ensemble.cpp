@@ -132,3 +132,32 @@ TEST(ImpactAccuracy, ErrorGrowsAfterASeparationAndFreezesAtTheNextContact) {
   EXPECT_NEAR(w.at(300), landed, 1e-12);  // frozen while it rests
   EXPECT_DOUBLE_EQ(weights_for(replay, 1e-4, 0.0).at(300), 1e-4);
 }
+
+namespace clumpforge {
+// Every trial with its own recorded orientation (a lab that notes each release to +-15 deg):
+// the replays must mirror the recorded sample, as many near each trial's orientation, not all
+// near the first trial's.
+TEST(EnsembleOrientations, MirrorEachTrialsRecordedOrientation) {
+  const std::vector<Eigen::Quaterniond> recorded{
+      Eigen::Quaterniond::Identity(), Eigen::Quaterniond(Eigen::AngleAxisd(2.0, Eigen::Vector3d::UnitX())),
+      Eigen::Quaterniond(Eigen::AngleAxisd(2.0, Eigen::Vector3d::UnitY())),
+      Eigen::Quaterniond(Eigen::AngleAxisd(2.5, Eigen::Vector3d(1, 1, 0).normalized()))};
+  EnsembleOptions options;
+  options.replays = 12;
+  options.orientation_prior_deg = 15.0;
+  const auto drawn = ensemble_orientations(LabTest::Drop, recorded, options, 7);
+  ASSERT_EQ(drawn.size(), 12U);
+  std::vector<int> near(recorded.size(), 0);
+  for (const auto& q : drawn) {
+    for (std::size_t j = 0; j < recorded.size(); ++j) {
+      if (q.angularDistance(recorded[j]) <= 15.0 * std::numbers::pi / 180.0 + 1e-9) ++near[j];
+    }
+  }
+  for (std::size_t j = 0; j < recorded.size(); ++j) EXPECT_EQ(near[j], 3) << "trial " << j;
+  // Nothing recorded: the uniform prior, reproducibly.
+  const auto uniform = ensemble_orientations(LabTest::Drop, {}, options, 7);
+  const auto again = ensemble_orientations(LabTest::Drop, {}, options, 7);
+  ASSERT_EQ(uniform.size(), 12U);
+  for (std::size_t k = 0; k < uniform.size(); ++k) EXPECT_TRUE(uniform[k].isApprox(again[k]));
+}
+}  // namespace clumpforge
