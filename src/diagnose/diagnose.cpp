@@ -1707,6 +1707,18 @@ double largest_z2(const std::vector<OutcomeComparison>& comparisons) {
   return worst;
 }
 
+/// Degrees of freedom of a null with `free` coefficients calibrated on `outcomes` recorded
+/// means (at least one).
+double null_dof(int outcomes, std::size_t free) {
+  return std::max(1.0, outcomes - static_cast<double>(free));
+}
+
+/// Whether such a null, leaving `chi2`, is consistent with the recordings (chi^2 tail >=
+/// kConsistentTail).
+bool null_consistent(double chi2, int outcomes, std::size_t free) {
+  return chi2_upper_tail(chi2, null_dof(outcomes, free)) >= kConsistentTail;
+}
+
 /// The calibrated null leaves the recorded outcomes inconsistent with the replays (chi^2 tail
 /// below kConsistentTail): before the mismatch is blamed on missing physics, each finer clump
 /// left is tried (its null calibrated afresh on the outcomes, from the same orientations); the
@@ -1715,9 +1727,8 @@ double largest_z2(const std::vector<OutcomeComparison>& comparisons) {
 Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
                                            const std::vector<FreeCoefficient>& free, const EnsembleOptions& eo,
                                            int max_evaluations) {
-  const EnsembleReport& e = *result.ensemble;
-  const double dof = std::max(1.0, e.outcomes - static_cast<double>(free.size()));
   if (!result.particle_model || c.finer.empty()) return false;
+  const EnsembleReport& e = *result.ensemble;
   ParticleModelCheck& check = *result.particle_model;
   check.checked = true;
   check.chi2_per_value = e.null_chi2 / e.outcomes;
@@ -1742,7 +1753,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     rung.refitted = true;
     rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
     rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
-    rung.explains = fine->outcomes == e.outcomes && chi2_upper_tail(fine->null_chi2, dof) >= kConsistentTail;
+    rung.explains = fine->outcomes == e.outcomes && null_consistent(fine->null_chi2, e.outcomes, free.size());
     if (rung.explains) {
       check.resolution_needed = rung.spheres;
       say_particle_model(result, check, true);
@@ -1760,8 +1771,8 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
                                   const std::vector<FreeCoefficient>& free, const EnsembleOptions& eo,
                                   int max_evaluations) {
   const EnsembleReport& e = *result.ensemble;
-  const double dof = std::max(1.0, e.outcomes - static_cast<double>(free.size()));
-  if (chi2_upper_tail(e.null_chi2, dof) >= kConsistentTail) return {};
+  if (null_consistent(e.null_chi2, e.outcomes, free.size())) return {};
+  const double dof = null_dof(e.outcomes, free.size());
   auto explained = finer_clump_explains_outcomes(c, result, baseline, free, eo, max_evaluations);
   if (!explained) return std::unexpected(explained.error());
   if (*explained) return {};
@@ -1840,6 +1851,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   report.hypotheses = ens->hypotheses;
   report.detectability = ens->detectability;
   report.trials = ens->trials;
+  result.ensemble = std::move(report);
   const auto library = effect_library();
   // What the outcomes could decide: a candidate whose strong magnitude would have shown is
   // decidable (and, not named below, absent); for the others, the trials per set-up at which
@@ -1879,16 +1891,13 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
     }
   }
   if (!ens->outcomes || ens->hypotheses.empty() || passing.empty()) {
-    result.ensemble = std::move(report);
     if (ens->outcomes > 0 && result.verdict == Verdict::None)
       return outcomes_beyond_null(c, result, baseline, free, eo, options.max_evaluations);
     return {};
   }
   // Before an effect is named beyond the horizon: a null inconsistent with the outcomes may be
   // the particle model's (a coarse clump rolls and bounces otherwise), which a finer clump shows.
-  if (chi2_upper_tail(ens->null_chi2, std::max(1.0, ens->outcomes - static_cast<double>(free.size()))) <
-      kConsistentTail) {
-    result.ensemble = report;
+  if (!null_consistent(ens->null_chi2, ens->outcomes, free.size())) {
     auto explained = finer_clump_explains_outcomes(c, result, baseline, free, eo, options.max_evaluations);
     if (!explained) return std::unexpected(explained.error());
     if (*explained) return {};
@@ -1931,7 +1940,6 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
                            : std::string());
     result.experiment.clear();
   }
-  result.ensemble = std::move(report);
   return {};
 }
 
