@@ -431,7 +431,8 @@ int main(int argc, char** argv) {
     o.seconds = j.value("seconds", NAN);
     if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
       for (const auto& cmp : j["ensemble"]["comparisons"])
-        o.ensemble_z.emplace_back(cmp.value("outcome", "?"), cmp.value("z", NAN));
+        o.ensemble_z.emplace_back(cmp.value("statistic", "mean") + " " + cmp.value("outcome", "?"),
+                                  cmp.value("z", NAN));
     }
     std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id,
                              truth, o.verdict, o.heldout_before, o.heldout_after, o.seconds)

@@ -163,6 +163,9 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
       for (const auto& c : list) {
         out.push_back({{"recording", e.recordings.at(c.recording)},
                        {"outcome", outcome_name(c.outcome)},
+                       {"statistic", statistic_name(c.statistic)},
+                       {"recorded_value", c.recorded_value},
+                       {"replayed_value", c.ensemble_value},
                        {"recorded_mean", c.recorded_mean},
                        {"recorded_sd", c.recorded_sd},
                        {"recorded_n", c.recorded_n},

@@ -310,6 +310,10 @@ struct Context {
   /// Coefficients the fitted windows do not pin (surface, which), and the materials table's
   /// values they keep.
   std::set<std::pair<std::string, Coefficient>> unpinned;
+  /// Coefficients (surface, which) of recordings whose recorded trials part where the replays
+  /// agree (recorded_horizons): the frames before the parting pin them, but whatever parts the
+  /// trials acts there too, so beyond the horizons they are calibrated again with each candidate.
+  std::set<std::pair<std::string, Coefficient>> parted;
   std::vector<SurfaceParameters> table_values;
   std::vector<std::string> names;
   std::vector<double> camera_noise;  ///< per recording [m], from its tracks
@@ -1139,6 +1143,60 @@ Result<void> release_stage(Context& c, DiagnoseResult& result, const Model& base
   return {};
 }
 
+/// The recorded trials' own horizons. A recording whose replays agree for every release
+/// orientation (a sphere) is fitted through its whole tracks, one replay for every trial; if
+/// its recorded trials, put in the replay frame by the baseline's alignments, part from each
+/// other beyond the noise (recorded_horizon: by max(1 mm, 5 camera noise levels) for 20
+/// frames running), the body's path hangs on something unrecorded, and from there on no
+/// single replay can stand for them. Their release horizon becomes that time: they are fitted
+/// up to it, and compared beyond it as a sample (the ensembles), where their test's
+/// coefficient is calibrated again (Context::parted). A tilt's trials part at onsets that
+/// differ. Returns whether any changed, with a note per such recording.
+Result<bool> recorded_horizons(Context& c, DiagnoseResult& result, const Model& baseline) {
+  constexpr int kSustained = 20;
+  const auto& recs = *c.ev.recordings;
+  bool changed = false;
+  for (std::size_t r = 0; r < recs.size(); ++r) {
+    std::vector<std::size_t> which;
+    bool regular = true;
+    for (std::size_t i = 0; i < c.ev.trials.size(); ++i) {
+      if (c.ev.trials[i].recording != r) continue;
+      which.push_back(i);
+      regular = regular && !std::isfinite(c.ev.trials[i].release_horizon);
+    }
+    if (!regular || which.size() < 2) continue;
+    auto scores = score(c, baseline, which, false);
+    if (!scores) return std::unexpected(scores.error());
+    std::vector<Track> tracks;
+    double frame = 0.0;
+    for (std::size_t k = 0; k < which.size(); ++k) {
+      const Track& recorded = *recs[r].trials[c.ev.trials[which[k]].trial].track;
+      const Alignment& a = (*scores)[k].alignment;
+      Track moved;
+      for (std::size_t f = 0; f < recorded.size(); ++f) {
+        if (recorded.t[f] - a.shift < 0.0 || !std::isfinite(recorded.x[f]) || !std::isfinite(recorded.z[f])) continue;
+        moved.t.push_back(recorded.t[f] - a.shift);
+        moved.x.push_back(recorded.x[f] - a.x_offset);
+        moved.z.push_back(recorded.z[f] - a.z_offset);
+      }
+      frame = std::max(frame, frame_interval(recorded));
+      tracks.push_back(std::move(moved));
+    }
+    const double noise = r < c.camera_noise.size() ? c.camera_noise[r] : c.ev.sigma[r];
+    const double parted = recorded_horizon(tracks, frame, std::max(1e-3, 5.0 * noise), kSustained);
+    if (!std::isfinite(parted)) continue;
+    for (std::size_t i : which) c.ev.trials[i].release_horizon = parted;
+    c.parted.insert({recs[r].surface, coefficient_for(recs[r].test)});
+    changed = true;
+    result.notes.push_back(fmt::format(
+        "{}: replays from every release orientation agree, but the recorded trials part from each other {:.3f} s "
+        "after release (by more than {:.2g} mm): the path hangs on something unrecorded; fitted up to there, "
+        "compared beyond it as a sample",
+        c.names[r], parted, 1e3 * std::max(1e-3, 5.0 * noise)));
+  }
+  return changed;
+}
+
 /// Stage 4, baseline: e, mu_s and mu_r per surface on the training trials (each on its own
 /// test over a wide grid, then together), the horizons set again under it; the coefficients
 /// the fitted windows do not pin are said to be uncalibrated.
@@ -1152,7 +1210,16 @@ Result<Model> baseline_stage(Context& c, DiagnoseResult& result, Model baseline,
   baseline = *fitted;
   c.ev.shift.clear();
   if (auto ok = initialise_shifts(c.ev, baseline); !ok) return std::unexpected(ok.error());
+  auto parted = recorded_horizons(c, result, baseline);
+  if (!parted) return std::unexpected(parted.error());
   if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
+  if (*parted) {
+    // The first fit ran through frames no single replay stands for: again, up to the horizons.
+    auto again = fit_baseline(c, baseline, false, c.training);
+    if (!again) return std::unexpected(again.error());
+    baseline = *again;
+    if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
+  }
   // Again: each coefficient now fitted with the others near their values.
   auto polished = fit_coefficients(c, baseline, c.training, options.max_evaluations);
   if (!polished) return std::unexpected(polished.error());
@@ -1782,10 +1849,10 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
     if (std::abs(o.z) < 3.0) continue;
     const bool drop = o.outcome == Outcome::ReboundHeight || o.outcome == Outcome::Drift;
     const double scale = o.outcome == Outcome::RollTime ? 1.0 : 1e3;
-    const std::string where =
-        fmt::format("{} of {} (recorded {:.3g}, replayed {:.3g} {}, z = {:.1f})", outcome_name(o.outcome),
-                    recording_label((*c.ev.recordings)[o.recording], c.names[o.recording]), o.recorded_mean * scale,
-                    o.ensemble_mean * scale, o.outcome == Outcome::RollTime ? "s" : "mm", o.z);
+    const std::string where = fmt::format(
+        "{} {} of {} (recorded {:.3g}, replayed {:.3g} {}, z = {:.1f})", statistic_name(o.statistic),
+        outcome_name(o.outcome), recording_label((*c.ev.recordings)[o.recording], c.names[o.recording]),
+        o.recorded_value * scale, o.ensemble_value * scale, o.outcome == Outcome::RollTime ? "s" : "mm", o.z);
     result.unexplained.push_back({c.names[o.recording], drop ? Phase::Rebound : Phase::Rest, o.z * o.z, where});
     far.push_back(where);
   }
@@ -1794,7 +1861,8 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
   result.basis = Basis::UnexplainedOutcomes;
   result.statement = fmt::format(
       "Mismatch beyond the release horizon not explained by any known effect: the recorded outcomes differ from "
-      "replays over the unknown release orientation (chi^2 {:.1f} over {} recorded means, p = {:.2g}){}; no candidate "
+      "replays over the unknown release orientation (chi^2 {:.1f} over {} recorded means and spreads, p = {:.2g}){}; "
+      "no candidate "
       "effect leaves them consistent{}.",
       e.null_chi2, e.outcomes, chi2_upper_tail(e.null_chi2, dof),
       far.empty() ? std::string() : fmt::format(", most in: {}", fmt::join(far, "; ")),
@@ -1814,7 +1882,9 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
                              const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
                              const DiagnoseOptions& options) {
   std::vector<FreeCoefficient> free;
-  for (const auto& [surface, coefficient] : c.unpinned) {
+  std::set<std::pair<std::string, Coefficient>> calibrate = c.unpinned;
+  calibrate.insert(c.parted.begin(), c.parted.end());
+  for (const auto& [surface, coefficient] : calibrate) {
     if (coefficient == Coefficient::StaticFriction) continue;  // a tilt's, fitted frame by frame
     for (std::size_t b = 0; b < baseline.base.size(); ++b) {
       if (baseline.base[b].surface == surface) free.push_back({b, coefficient});
@@ -1886,7 +1956,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
     if (h.plausible && h.delta_bic >= options.min_delta_bic && !consistent) {
       result.notes.push_back(fmt::format(
           "beyond the release horizon {} improves the outcomes by delta-BIC {:.1f} but leaves chi^2 {:.1f} over {} "
-          "recorded means: not an explanation",
+          "recorded means and spreads: not an explanation",
           effect_name(h.effect), h.delta_bic, h.chi2, ens->outcomes));
     }
   }
@@ -1928,7 +1998,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
     result.statement = fmt::format(
         "Missing physics found beyond the release horizon: {} ({}), {}. Frame by frame the tracks do not decide it; "
         "the recorded outcomes against replays from the unknown release orientation do: chi^2 {:.1f} -> {:.1f} over "
-        "{} recorded means (delta-BIC {:.1f}){}.",
+        "{} recorded means and spreads (delta-BIC {:.1f}){}.",
         spec.name, spec.description,
         fmt::join(result.effect_parameters | std::views::transform([](const ParameterValue& p) {
                     return fmt::format("{} = {:.4g}", p.name, p.value);

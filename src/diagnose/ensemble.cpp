@@ -28,6 +28,10 @@ std::string_view outcome_name(Outcome outcome) {
   return "?";
 }
 
+std::string_view statistic_name(Statistic statistic) {
+  return statistic == Statistic::Mean ? "mean" : "spread";
+}
+
 namespace {
 
 std::vector<Outcome> outcomes_of(LabTest test) {
@@ -102,6 +106,32 @@ OutcomeComparison compare_outcome(const std::vector<double>& recorded, const std
                          ? pooled * (1.0 / c.recorded_n + 1.0 / c.ensemble_n) + floor * floor
                          : floor * floor;
   c.z = se2 > 0.0 ? (c.recorded_mean - c.ensemble_mean) / std::sqrt(se2) : 0.0;
+  c.recorded_value = c.recorded_mean;
+  c.ensemble_value = c.ensemble_mean;
+  return c;
+}
+
+namespace {
+
+std::vector<double> absolute_deviations(const std::vector<double>& sample) {
+  if (sample.empty()) return {};
+  const double centre = quantile(sample, 0.5);  // the middle of an even sample, not one of its two
+  std::vector<double> out;
+  for (double v : sample) out.push_back(std::abs(v - centre));
+  return out;
+}
+
+}  // namespace
+
+OutcomeComparison compare_spread(const std::vector<double>& recorded, const std::vector<double>& ensemble,
+                                 double floor) {
+  OutcomeComparison c = compare_outcome(absolute_deviations(recorded), absolute_deviations(ensemble), floor);
+  c.statistic = Statistic::Spread;
+  const SampleSpread r = sample_spread(recorded), e = sample_spread(ensemble);
+  c.recorded_mean = r.mean;
+  c.recorded_sd = r.sd;
+  c.ensemble_mean = e.mean;
+  c.ensemble_sd = e.sd;
   return c;
 }
 
@@ -224,12 +254,13 @@ std::vector<OutcomeComparison> compare_all(const std::vector<Plan>& plans, const
   for (std::size_t p = 0; p < plans.size(); ++p) {
     for (std::size_t o = 0; o < plans[p].outcomes.size(); ++o) {
       const auto& rec = plans[p].recorded[o];
-      const double mean = sample_spread(rec).mean;
-      OutcomeComparison c =
-          compare_outcome(rec, sample[p][o], floor_for(plans[p], plans[p].outcomes[o], mean, impact_accuracy));
-      c.recording = plans[p].recording;
-      c.outcome = plans[p].outcomes[o];
-      out.push_back(c);
+      const double floor = floor_for(plans[p], plans[p].outcomes[o], sample_spread(rec).mean, impact_accuracy);
+      for (OutcomeComparison c :
+           {compare_outcome(rec, sample[p][o], floor), compare_spread(rec, sample[p][o], floor)}) {
+        c.recording = plans[p].recording;
+        c.outcome = plans[p].outcomes[o];
+        out.push_back(c);
+      }
     }
   }
   return out;
@@ -241,10 +272,10 @@ double chi2_of(const std::vector<OutcomeComparison>& c) {
   return sum;
 }
 
-/// Ensemble means as one vector, in compare_all's order.
+/// The replays' statistics (means and spreads) as one vector, in compare_all's order.
 Eigen::VectorXd means_of(const std::vector<OutcomeComparison>& c) {
   Eigen::VectorXd v(static_cast<Eigen::Index>(c.size()));
-  for (std::size_t j = 0; j < c.size(); ++j) v(static_cast<Eigen::Index>(j)) = c[j].ensemble_mean;
+  for (std::size_t j = 0; j < c.size(); ++j) v(static_cast<Eigen::Index>(j)) = c[j].ensemble_value;
   return v;
 }
 
@@ -423,8 +454,8 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   Eigen::VectorXd recorded(result.outcomes), inverse_se(result.outcomes);
   for (std::size_t j = 0; j < base_cmp.size(); ++j) {
     const auto& c = base_cmp[j];
-    recorded(static_cast<Eigen::Index>(j)) = c.recorded_mean;
-    const double diff = c.recorded_mean - c.ensemble_mean;
+    recorded(static_cast<Eigen::Index>(j)) = c.recorded_value;
+    const double diff = c.recorded_value - c.ensemble_value;
     inverse_se(static_cast<Eigen::Index>(j)) = c.z != 0.0 ? std::abs(c.z / diff) : 1.0 / std::max(c.floor, 1e-12);
   }
   // The free coefficients' responses (one set of replays each, only where they act).

@@ -27,6 +27,13 @@ namespace clumpforge {
 enum class Outcome { ReboundHeight, Drift, RollDistance, RollTime };
 std::string_view outcome_name(Outcome outcome);
 
+/// What of an outcome's sample is compared: its mean, or its spread (the mean absolute
+/// deviation from the sample's median, Brown-Forsythe's robust form of Levene's test). The
+/// spread shows what the means cannot: recorded trials that differ from each other where the
+/// model's replays agree (a sphere whose path hangs on its unrecorded orientation).
+enum class Statistic { Mean, Spread };
+std::string_view statistic_name(Statistic statistic);
+
 /// A path in the replay's frame: time since release [s], x from the release point and the
 /// tracked point's height [m].
 struct PathSample {
@@ -43,6 +50,8 @@ std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const Pat
 struct OutcomeComparison {
   std::size_t recording = 0;
   Outcome outcome = Outcome::ReboundHeight;
+  Statistic statistic = Statistic::Mean;
+  double recorded_value = 0.0, ensemble_value = 0.0;  ///< the statistic compared, of each sample
   double recorded_mean = 0.0, recorded_sd = 0.0;
   double ensemble_mean = 0.0, ensemble_sd = 0.0;
   int recorded_n = 0, ensemble_n = 0;
@@ -54,6 +63,11 @@ struct OutcomeComparison {
 /// se^2 = s_p^2 (1/n + 1/K) + floor^2.
 OutcomeComparison compare_outcome(const std::vector<double>& recorded, const std::vector<double>& ensemble,
                                   double floor);
+
+/// The standardised difference of the spreads: compare_outcome on each sample's absolute
+/// deviations from its own median (Brown-Forsythe), the means and sds of the values kept.
+OutcomeComparison compare_spread(const std::vector<double>& recorded, const std::vector<double>& ensemble,
+                                 double floor);
 
 struct EnsembleOptions {
   int replays = 12;  ///< release orientations per recording, >= 4

@@ -57,4 +57,45 @@ double release_horizon(const std::vector<std::vector<ReplaySample>>& replays, do
   return std::numeric_limits<double>::infinity();
 }
 
+double recorded_horizon(const std::vector<Track>& tracks, double frame, double tolerance, int sustained) {
+  constexpr double kNever = std::numeric_limits<double>::infinity();
+  if (tracks.size() < 2 || !(frame > 0.0) || sustained < 1) return kNever;
+  double end = kNever;
+  for (const auto& track : tracks) {
+    if (track.size() < 2) return kNever;
+    end = std::min(end, track.t.back());
+  }
+  std::vector<std::size_t> at(tracks.size(), 0);  // each track's frame at or before the time
+  int running = 0;
+  double first = kNever;
+  for (long step = 0; step * frame <= end; ++step) {
+    const double t = step * frame;
+    std::vector<Eigen::Vector2d> points;
+    for (std::size_t i = 0; i < tracks.size(); ++i) {
+      const Track& track = tracks[i];
+      if (t < track.t.front()) continue;
+      while (at[i] + 2 < track.size() && track.t[at[i] + 1] <= t) ++at[i];
+      const std::size_t k = at[i];
+      const double span = track.t[k + 1] - track.t[k],
+                   w = span > 0.0 ? std::clamp((t - track.t[k]) / span, 0.0, 1.0) : 0.0;
+      points.emplace_back((1.0 - w) * track.x[k] + w * track.x[k + 1], (1.0 - w) * track.z[k] + w * track.z[k + 1]);
+    }
+    if (points.size() < 2) {
+      running = 0;
+      continue;
+    }
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const auto& p : points) mean += p / static_cast<double>(points.size());
+    double spread = 0.0;
+    for (const auto& p : points) spread += (p - mean).squaredNorm() / static_cast<double>(points.size());
+    if (std::sqrt(spread) > tolerance) {
+      if (running++ == 0) first = t;
+      if (running >= sustained) return first;
+    } else {
+      running = 0;
+    }
+  }
+  return kNever;
+}
+
 }  // namespace clumpforge

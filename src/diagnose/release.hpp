@@ -36,4 +36,14 @@ std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const Or
 /// Infinity when they never do (a sphere; a body whose orientation does not matter).
 double release_horizon(const std::vector<std::vector<ReplaySample>>& replays, double tolerance);
 
+/// The recorded trials' own horizon: the first time from which the trials of one set-up,
+/// each already in the replay frame (t since release, x from the release point, height),
+/// part from each other by more than `tolerance` [m] (RMS about their mean, x and z
+/// together, each track interpolated every `frame` seconds) for `sustained` frames running.
+/// Infinity when they do not part (or fewer than two trials overlap). A body whose replays
+/// agree for every release (a sphere) but whose recorded trials part is not the body the
+/// model says: its path hangs on something unrecorded, and one replay can stand for its
+/// trials only up to there.
+double recorded_horizon(const std::vector<Track>& tracks, double frame, double tolerance, int sustained);
+
 }  // namespace clumpforge

@@ -8,6 +8,7 @@
 
 #include "core/rng.hpp"
 #include "diagnose/ensemble.hpp"
+#include "diagnose/release.hpp"
 #include "diagnose/tracks.hpp"
 
 using namespace clumpforge;
@@ -113,6 +114,71 @@ TEST(EnsembleComparison, FalsePositiveRateOnSamplesOfOneDistribution) {
   const double rate = static_cast<double>(beyond) / kSets;
   EXPECT_NEAR(rate, 0.05, 4.0 * std::sqrt(0.05 * 0.95 / kSets) + 0.01);  // t with 16 dof: 6.5 %
   EXPECT_LE(static_cast<double>(sets_beyond) / kSets, 0.01);
+}
+
+TEST(EnsembleComparison, StandardisedDifferenceOfSpreads) {
+  // Recorded {0, 1, 2, 3}: absolute deviations from the median 1.5 are {1.5, 0.5, 0.5, 1.5},
+  // mean 1, sum of squares about it 1; replays that all agree deviate by 0. Pooled over 6
+  // dof: 1/6; se = sqrt(1/6 (1/4 + 1/4)), z = 1 / se = sqrt(12).
+  const auto c = compare_spread({0.0, 1.0, 2.0, 3.0}, {5.0, 5.0, 5.0, 5.0}, 0.0);
+  EXPECT_EQ(c.statistic, Statistic::Spread);
+  EXPECT_NEAR(c.recorded_value, 1.0, 1e-12);
+  EXPECT_NEAR(c.ensemble_value, 0.0, 1e-12);
+  EXPECT_NEAR(c.z, std::sqrt(12.0), 1e-12);
+  // The values' own means are kept for the report.
+  EXPECT_NEAR(c.recorded_mean, 1.5, 1e-12);
+  EXPECT_NEAR(c.ensemble_mean, 5.0, 1e-12);
+  // Samples that differ only in location have equal spreads.
+  EXPECT_NEAR(compare_spread({0.0, 1.0, 2.0, 3.0}, {10.0, 11.0, 12.0, 13.0}, 0.0).z, 0.0, 1e-12);
+}
+
+TEST(EnsembleComparison, SpreadFalsePositiveRateOnSamplesOfOneDistribution) {
+  // As for the means: six recorded against twelve replays from one skewed distribution; the
+  // absolute deviations from the median keep the rate near 5 % (Brown-Forsythe).
+  Rng rng(29);
+  int beyond = 0;
+  constexpr int kSets = 4000;
+  for (int s = 0; s < kSets; ++s) {
+    std::vector<double> recorded, replays;
+    for (int i = 0; i < 6; ++i) recorded.push_back(std::exp(rng.normal(0.0, 0.6)));
+    for (int i = 0; i < 12; ++i) replays.push_back(std::exp(rng.normal(0.0, 0.6)));
+    beyond += std::abs(compare_spread(recorded, replays, 0.0).z) > 1.96;
+  }
+  const double rate = static_cast<double>(beyond) / kSets;
+  EXPECT_NEAR(rate, 0.05, 4.0 * std::sqrt(0.05 * 0.95 / kSets) + 0.01);  // measured: 5.75 %
+}
+
+TEST(RecordedHorizon, TrialsThatPartBeyondTheNoiseForSustainedFrames) {
+  // Six trials at 1000 fps with 0.1 mm camera noise, offset in time by up to half a frame:
+  // identical paths never part by 1 mm; trials whose x grows apart at 0.05 m/s per trial
+  // index after 0.3 s part by RMS sqrt(35/12) 0.05 (t - 0.3) > 1 mm from t = 0.3117 s.
+  Rng rng(3);
+  std::vector<Track> same, parting;
+  for (int i = 0; i < 6; ++i) {
+    Track a, b;
+    for (int f = 0; f < 800; ++f) {
+      const double t = 1e-3 * f + 0.5e-3 * (i % 2);
+      const double z = 0.5 - 4.905 * std::min(t, 0.3) * std::min(t, 0.3);
+      a.t.push_back(t);
+      a.x.push_back(rng.normal(0.0, 1e-4));
+      a.z.push_back(z + rng.normal(0.0, 1e-4));
+      b.t.push_back(t);
+      b.x.push_back(0.05 * (i - 2.5) * std::max(0.0, t - 0.3) + rng.normal(0.0, 1e-4));
+      b.z.push_back(a.z.back());
+    }
+    same.push_back(a);
+    parting.push_back(b);
+  }
+  EXPECT_TRUE(std::isinf(recorded_horizon(same, 1e-3, 1e-3, 20)));
+  const double parted = 0.3 + 1e-3 / (0.05 * std::sqrt(35.0 / 12.0));
+  EXPECT_NEAR(recorded_horizon(parting, 1e-3, 1e-3, 20), parted, 2e-3);  // the noise moves it a frame or two
+  // A brief parting (an impact's timing, 5 frames) is not sustained.
+  for (std::size_t i = 0; i < same.size(); ++i) {
+    for (int f = 400; f < 405; ++f) same[i].x[f] += 0.01 * static_cast<double>(i);
+  }
+  EXPECT_TRUE(std::isinf(recorded_horizon(same, 1e-3, 1e-3, 20)));
+  // One trial alone has no horizon of its own.
+  EXPECT_TRUE(std::isinf(recorded_horizon({parting.front()}, 1e-3, 1e-3, 20)));
 }
 
 TEST(ImpactAccuracy, ErrorGrowsAfterASeparationAndFreezesAtTheNextContact) {
