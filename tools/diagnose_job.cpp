@@ -264,6 +264,8 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["unexplained"] = phases_of(r.unexplained);
   j["outliers"] = phases_of(r.outliers);
   j["notes"] = r.notes;
+  j["parted"] = nlohmann::json::array();
+  for (const auto& p : r.parted) j["parted"].push_back({{"recording", p.recording}, {"seconds", p.seconds}});
   j["tracked_trials"] = r.tracked_trials;
   j["training_trials"] = r.training_trials;
   j["trial_replays"] = r.evaluations;

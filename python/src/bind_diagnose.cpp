@@ -104,6 +104,10 @@ void bind_parts(py::module_& m) {
 }
 
 void bind_result(py::module_& m) {
+  py::class_<PartedRecording>(m, "PartedRecording",
+                              "A recording whose trials part where the replays agree for every release.")
+      .def_readonly("recording", &PartedRecording::recording)
+      .def_readonly("seconds", &PartedRecording::seconds, "[s] after release: fitted up to here");
   py::class_<DiagnoseResult>(m, "DiagnoseResult", "What a diagnosis concludes, and on what basis.")
       .def_readonly("verdict", &DiagnoseResult::verdict)
       .def_readonly("basis", &DiagnoseResult::basis)
@@ -128,6 +132,7 @@ void bind_result(py::module_& m) {
       .def_readonly("outliers", &DiagnoseResult::outliers)
       .def_readonly("tracks", &DiagnoseResult::tracks)
       .def_readonly("notes", &DiagnoseResult::notes)
+      .def_readonly("parted", &DiagnoseResult::parted)
       .def_readonly("undecidable", &DiagnoseResult::undecidable)
       .def_readonly("particle_model", &DiagnoseResult::particle_model)
       .def_readonly("evaluations", &DiagnoseResult::evaluations)

@@ -1187,6 +1187,7 @@ Result<bool> recorded_horizons(Context& c, DiagnoseResult& result, const Model& 
     if (!std::isfinite(parted)) continue;
     for (std::size_t i : which) c.ev.trials[i].release_horizon = parted;
     c.parted.insert({recs[r].surface, coefficient_for(recs[r].test)});
+    result.parted.push_back({c.names[r], parted});
     changed = true;
     result.notes.push_back(fmt::format(
         "{}: replays from every release orientation agree, but the recorded trials part from each other {:.3f} s "

@@ -193,6 +193,14 @@ enum class Basis {
 };
 std::string_view basis_name(Basis basis);
 
+/// A recording whose recorded trials part from each other where the model's replays agree for
+/// every release (a sphere with something unrecorded about it): fitted up to `seconds` after
+/// release, compared beyond as a sample.
+struct PartedRecording {
+  std::string recording;
+  double seconds = 0.0;
+};
+
 struct DiagnoseResult {
   Verdict verdict = Verdict::None;
   Basis basis = Basis::Consistent;
@@ -213,6 +221,7 @@ struct DiagnoseResult {
   std::vector<PhaseOf> outliers;     ///< phases where one trial alone misfits (not counted as a mismatch)
   std::vector<TrackComparison> tracks;
   std::vector<std::string> notes;
+  std::vector<PartedRecording> parted;  ///< recordings whose trials part where the replays agree
   bool summaries_only = false;  ///< no tracks: what summaries can and cannot decide (in `decidable`, `undecidable`)
   std::vector<std::string> decidable, undecidable;
   std::optional<EnsembleReport> ensemble;
