@@ -1781,14 +1781,25 @@ double null_dof(int outcomes, std::size_t free) {
   return std::max(1.0, outcomes - static_cast<double>(free));
 }
 
-/// Whether such a null, leaving `chi2`, is consistent with the recordings (chi^2 tail >=
-/// kConsistentTail).
-bool null_consistent(double chi2, int outcomes, std::size_t free) {
-  return chi2_upper_tail(chi2, null_dof(outcomes, free)) >= kConsistentTail;
+/// Whether replays of a model with `fitted` parameters calibrated on the outcomes are
+/// consistent with the recordings: the means' chi^2 (over their number less `fitted`, at
+/// least one) and the spreads' (over their number) each have an upper tail of
+/// kConsistentTail / 2 or more. Tested apart, a mean far off is not diluted by spreads that
+/// agree, nor the reverse.
+bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted) {
+  double chi2[2] = {0.0, 0.0};
+  int count[2] = {0, 0};
+  for (const auto& o : comparisons) {
+    const int k = o.statistic == Statistic::Mean ? 0 : 1;
+    chi2[k] += o.z * o.z;
+    ++count[k];
+  }
+  return chi2_upper_tail(chi2[0], null_dof(count[0], fitted)) >= 0.5 * kConsistentTail &&
+         (count[1] == 0 || chi2_upper_tail(chi2[1], count[1]) >= 0.5 * kConsistentTail);
 }
 
-/// The calibrated null leaves the recorded outcomes inconsistent with the replays (chi^2 tail
-/// below kConsistentTail): before the mismatch is blamed on missing physics, each finer clump
+/// The calibrated null leaves the recorded outcomes inconsistent with the replays
+/// (outcomes_consistent): before the mismatch is blamed on missing physics, each finer clump
 /// left is tried (its null calibrated afresh on the outcomes, from the same orientations); the
 /// first that leaves them consistent explains it, and the verdict says so with the resolution
 /// needed. Returns whether one did.
@@ -1821,7 +1832,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     rung.refitted = true;
     rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
     rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
-    rung.explains = fine->outcomes == e.outcomes && null_consistent(fine->null_chi2, e.outcomes, free.size());
+    rung.explains = fine->outcomes == e.outcomes && outcomes_consistent(fine->null_comparisons, free.size());
     if (rung.explains) {
       check.resolution_needed = rung.spheres;
       say_particle_model(result, check, true);
@@ -1839,7 +1850,7 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
                                   const std::vector<FreeCoefficient>& free, const EnsembleOptions& eo,
                                   int max_evaluations) {
   const EnsembleReport& e = *result.ensemble;
-  if (null_consistent(e.null_chi2, e.outcomes, free.size())) return {};
+  if (outcomes_consistent(e.null_comparisons, free.size())) return {};
   const double dof = null_dof(e.outcomes, free.size());
   auto explained = finer_clump_explains_outcomes(c, result, baseline, free, eo, max_evaluations);
   if (!explained) return std::unexpected(explained.error());
@@ -1947,12 +1958,11 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
         fmt::join(more_trials, ", "));
   }
   // A candidate passes when it beats the calibrated null by the margin at a plausible value
-  // and leaves the outcomes consistent with the recordings (chi^2 tail >= 1e-4 over the
-  // outcomes less its parameters): a better fit that still misses by far explains nothing.
+  // and leaves the outcomes consistent with the recordings (outcomes_consistent, its
+  // parameters fitted): a better fit that still misses by far explains nothing.
   std::vector<const EnsembleHypothesis*> passing;
   for (const auto& h : ens->hypotheses) {
-    const double dof = ens->outcomes - static_cast<double>(h.values.size());
-    const bool consistent = chi2_upper_tail(h.chi2, dof) >= kConsistentTail;
+    const bool consistent = outcomes_consistent(h.comparisons, h.values.size());
     if (h.plausible && h.delta_bic >= options.min_delta_bic && consistent) passing.push_back(&h);
     if (h.plausible && h.delta_bic >= options.min_delta_bic && !consistent) {
       result.notes.push_back(fmt::format(
@@ -1968,7 +1978,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   }
   // Before an effect is named beyond the horizon: a null inconsistent with the outcomes may be
   // the particle model's (a coarse clump rolls and bounces otherwise), which a finer clump shows.
-  if (!null_consistent(ens->null_chi2, ens->outcomes, free.size())) {
+  if (!outcomes_consistent(ens->null_comparisons, free.size())) {
     auto explained = finer_clump_explains_outcomes(c, result, baseline, free, eo, options.max_evaluations);
     if (!explained) return std::unexpected(explained.error());
     if (*explained) return {};
