@@ -1155,37 +1155,47 @@ Result<void> release_stage(Context& c, DiagnoseResult& result, const Model& base
 Result<bool> recorded_horizons(Context& c, DiagnoseResult& result, const Model& baseline) {
   constexpr int kSustained = 20;
   const auto& recs = *c.ev.recordings;
+  // The recordings whose replays agree for every release, and their trials.
+  std::vector<std::vector<std::size_t>> members(recs.size());
+  std::vector<bool> regular(recs.size(), true);
+  for (std::size_t i = 0; i < c.ev.trials.size(); ++i) {
+    const TrackedTrial& tt = c.ev.trials[i];
+    members[tt.recording].push_back(i);
+    regular[tt.recording] = regular[tt.recording] && !std::isfinite(tt.release_horizon);
+  }
+  std::vector<std::size_t> which;
+  for (std::size_t r = 0; r < recs.size(); ++r) {
+    if (regular[r] && members[r].size() >= 2) which.insert(which.end(), members[r].begin(), members[r].end());
+  }
+  if (which.empty()) return false;
+  auto scores = score(c, baseline, which, false);  // one evaluation of all of them, for the alignments
+  if (!scores) return std::unexpected(scores.error());
+  std::vector<const Alignment*> alignment(c.ev.trials.size(), nullptr);
+  for (std::size_t k = 0; k < which.size(); ++k) alignment[which[k]] = &(*scores)[k].alignment;
   bool changed = false;
   for (std::size_t r = 0; r < recs.size(); ++r) {
-    std::vector<std::size_t> which;
-    bool regular = true;
-    for (std::size_t i = 0; i < c.ev.trials.size(); ++i) {
-      if (c.ev.trials[i].recording != r) continue;
-      which.push_back(i);
-      regular = regular && !std::isfinite(c.ev.trials[i].release_horizon);
-    }
-    if (!regular || which.size() < 2) continue;
-    auto scores = score(c, baseline, which, false);
-    if (!scores) return std::unexpected(scores.error());
+    if (!regular[r] || members[r].size() < 2) continue;
     std::vector<Track> tracks;
     double frame = 0.0;
-    for (std::size_t k = 0; k < which.size(); ++k) {
-      const Track& recorded = *recs[r].trials[c.ev.trials[which[k]].trial].track;
-      const Alignment& a = (*scores)[k].alignment;
-      Track moved;
-      for (std::size_t f = 0; f < recorded.size(); ++f) {
-        if (recorded.t[f] - a.shift < 0.0 || !std::isfinite(recorded.x[f]) || !std::isfinite(recorded.z[f])) continue;
-        moved.t.push_back(recorded.t[f] - a.shift);
-        moved.x.push_back(recorded.x[f] - a.x_offset);
-        moved.z.push_back(recorded.z[f] - a.z_offset);
-      }
+    for (std::size_t i : members[r]) {
+      const Track& recorded = *recs[r].trials[c.ev.trials[i].trial].track;
       frame = std::max(frame, frame_interval(recorded));
-      tracks.push_back(std::move(moved));
+      // From the release on, lost frames bridged.
+      const Track moved = in_replay_frame(recorded, *alignment[i]);
+      Track kept;
+      for (std::size_t f = 0; f < moved.size(); ++f) {
+        if (moved.t[f] < 0.0 || !std::isfinite(moved.x[f]) || !std::isfinite(moved.z[f])) continue;
+        kept.t.push_back(moved.t[f]);
+        kept.x.push_back(moved.x[f]);
+        kept.z.push_back(moved.z[f]);
+      }
+      tracks.push_back(std::move(kept));
     }
     const double noise = r < c.camera_noise.size() ? c.camera_noise[r] : c.ev.sigma[r];
-    const double parted = recorded_horizon(tracks, frame, std::max(1e-3, 5.0 * noise), kSustained);
+    const double tolerance = std::max(1e-3, 5.0 * noise);
+    const double parted = recorded_horizon(tracks, frame, tolerance, kSustained);
     if (!std::isfinite(parted)) continue;
-    for (std::size_t i : which) c.ev.trials[i].release_horizon = parted;
+    for (std::size_t i : members[r]) c.ev.trials[i].release_horizon = parted;
     c.parted.insert({recs[r].surface, coefficient_for(recs[r].test)});
     result.parted.push_back({c.names[r], parted});
     changed = true;
@@ -1193,7 +1203,7 @@ Result<bool> recorded_horizons(Context& c, DiagnoseResult& result, const Model& 
         "{}: replays from every release orientation agree, but the recorded trials part from each other {:.3f} s "
         "after release (by more than {:.2g} mm): the path hangs on something unrecorded; fitted up to there, "
         "compared beyond it as a sample",
-        c.names[r], parted, 1e3 * std::max(1e-3, 5.0 * noise)));
+        c.names[r], parted, 1e3 * tolerance));
   }
   return changed;
 }
@@ -1738,13 +1748,11 @@ void track_plots(const Context& c, DiagnoseResult& result, const std::vector<Tri
       TrackComparison cmp;
       cmp.recording = names[r];
       cmp.horizon = tt.horizon;
-      const Track& track = *recordings[r].trials[tt.trial].track;
       const Alignment& a = full_base[k].alignment;
-      for (std::size_t f = 0; f < track.size(); ++f) {
-        cmp.t.push_back(track.t[f] - a.shift);
-        cmp.x.push_back(track.x[f] - a.x_offset);
-        cmp.z.push_back(track.z[f] - a.z_offset);
-      }
+      Track moved = in_replay_frame(*recordings[r].trials[tt.trial].track, a);
+      cmp.t = std::move(moved.t);
+      cmp.x = std::move(moved.x);
+      cmp.z = std::move(moved.z);
       // Each model's replay mapped into the frame the recording is drawn in (the baseline's):
       // a model has its own fitted release time and origins, and recorded time t maps to its
       // replay time t - shift.

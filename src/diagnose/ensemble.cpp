@@ -149,14 +149,10 @@ struct Plan {
 using Sample = std::vector<std::vector<std::vector<double>>>;  ///< [plan][outcome][replay]
 
 PathSample recorded_path(const Track& track, const TrialScore& score) {
-  PathSample p;
   const double x0 = score.replay.empty() ? 0.0 : interpolate(score.replay, 0.0).x;
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    p.t.push_back(track.t[i] - score.alignment.shift);
-    p.x.push_back(track.x[i] - score.alignment.x_offset - x0);
-    p.z.push_back(track.z[i] - score.alignment.z_offset);
-  }
-  return p;
+  Track moved = in_replay_frame(track, score.alignment);
+  for (double& x : moved.x) x -= x0;
+  return {std::move(moved.t), std::move(moved.x), std::move(moved.z)};
 }
 
 std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>& scores,

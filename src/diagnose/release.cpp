@@ -78,7 +78,8 @@ double recorded_horizon(const std::vector<Track>& tracks, double frame, double t
       const std::size_t k = at[i];
       const double span = track.t[k + 1] - track.t[k],
                    w = span > 0.0 ? std::clamp((t - track.t[k]) / span, 0.0, 1.0) : 0.0;
-      points.emplace_back((1.0 - w) * track.x[k] + w * track.x[k + 1], (1.0 - w) * track.z[k] + w * track.z[k + 1]);
+      const Eigen::Vector2d p((1.0 - w) * track.x[k] + w * track.x[k + 1], (1.0 - w) * track.z[k] + w * track.z[k + 1]);
+      if (p.allFinite()) points.push_back(p);  // a lost frame leaves the trial out there
     }
     if (points.size() < 2) {
       running = 0;

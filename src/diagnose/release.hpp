@@ -40,6 +40,7 @@ double release_horizon(const std::vector<std::vector<ReplaySample>>& replays, do
 /// each already in the replay frame (t since release, x from the release point, height),
 /// part from each other by more than `tolerance` [m] (RMS about their mean, x and z
 /// together, each track interpolated every `frame` seconds) for `sustained` frames running.
+/// Lost frames (non-finite x or z) leave a trial out where they would be interpolated.
 /// Infinity when they do not part (or fewer than two trials overlap). A body whose replays
 /// agree for every release (a sphere) but whose recorded trials part is not the body the
 /// model says: its path hangs on something unrecorded, and one replay can stand for its

@@ -17,6 +17,16 @@ double frame_interval(const Track& track) {
   return median(std::move(gaps));
 }
 
+Track in_replay_frame(const Track& track, const Alignment& alignment) {
+  Track out;
+  for (std::size_t f = 0; f < track.size(); ++f) {
+    out.t.push_back(track.t[f] - alignment.shift);
+    out.x.push_back(track.x[f] - alignment.x_offset);
+    out.z.push_back(track.z[f] - alignment.z_offset);
+  }
+  return out;
+}
+
 double estimate_noise(const std::vector<const Track*>& tracks) {
   std::vector<double> differences;
   for (const Track* track : tracks) {

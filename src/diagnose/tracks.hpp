@@ -44,6 +44,10 @@ struct Alignment {
   int values = 0;  ///< recorded cells used
 };
 
+/// A recorded track in the frame of the replay it is aligned with: t - shift, x - x_offset,
+/// z - z_offset, every frame kept (lost frames stay non-finite).
+Track in_replay_frame(const Track& track, const Alignment& alignment);
+
 /// How far a recorded frame may lie from a replay, per replay sample: the noise with the
 /// particle model's accuracy (`sigma`), and after each impact a part that grows: no particle
 /// model reproduces the speed a body leaves a contact with to better than about 1 %
