@@ -26,6 +26,7 @@ namespace {
 struct DiagnoseArgs {
   std::vector<std::string> recordings, effects;
   std::string mesh, clump, clump_name, out, materials, units = "mm";
+  std::string roll_release = "on-edge";
   double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3, impact_accuracy_pct = 1.0;
   int ensemble_replays = 12;
   int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
@@ -110,6 +111,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.seed = args.seed;
   options.max_evaluations = args.max_evaluations;
   options.orientation_prior_deg = args.orientation_prior_deg;
+  options.roll_release = parse_roll_posture(args.roll_release).value_or(RollPosture::OnEdge);  // CLI11 checked it
   options.model_accuracy_m = args.model_accuracy_mm * 1e-3;
   options.impact_accuracy = args.impact_accuracy_pct / 100.0;
   options.ensemble_replays = args.ensemble_replays;
@@ -171,6 +173,12 @@ Command add_diagnose_command(CLI::App& app) {
   add_seed_option(*sub, args->seed, "Seed (the release orientations drawn from each prior)");
   sub->add_option("--orientation-prior", args->orientation_prior_deg,
                   "Uncertainty of a recorded release orientation (orientation_wxyz) [deg]; never taken as exact");
+  sub->add_option("--roll-release", args->roll_release,
+                  "How the lab set the particle on a roll's incline when no orientation is recorded: on-edge (a "
+                  "flattened particle stands on its rim and is turned at random about its flat faces' normal; a "
+                  "sphere or equant body anyhow) or any (uniform over all orientations)")
+      ->check(CLI::IsMember({"on-edge", "any"}))
+      ->capture_default_str();
   sub->add_option("--model-accuracy", args->model_accuracy_mm,
                   "How closely the particle model can follow a real particle [mm]; residuals are weighed against it "
                   "and the camera noise together");

@@ -2,6 +2,7 @@
 // proving `clumpforge diagnose` blind. The answer goes to a separate file, for the scorer.
 //   clumpforge-conceal CLUMP.h5 [--clump NAME] --effect air_drag|...|none [--magnitude realistic|strong|V[,V]]
 //                      [--surface Q235] [--trials 8] [--seed 1] [--orientation none|noisy:DEG|exact]
+//                      [--roll-release on-edge|any]
 //                      [--camera silhouette|body-point] [--pixel 0.1]
 //                      [--fps 1000] [--noise 1e-4] [--no-pre-roll] --output DIR [--answer FILE]
 #include "diagnose/conceal.hpp"
@@ -55,7 +56,7 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   double noise = 1e-4, fps = 1000.0;
   int steps_per_contact = generator_lab_options().steps_per_contact;
-  std::string orientation = "none", camera = "silhouette";
+  std::string orientation = "none", camera = "silhouette", roll_release = "on-edge";
   double pixel_mm = 0.1;
   bool no_conceal = false, small = false, no_pre_roll = false;
   std::optional<double> restitution, static_friction, rolling_friction;
@@ -73,6 +74,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-pre-roll", no_pre_roll, "Tracks begin 2-20 ms after the release (default: 5-30 ms before it)");
   app.add_option("--orientation", orientation,
                  "Release orientation written into each trial: none (default, as labs), noisy:DEG, or exact");
+  app.add_option("--roll-release", roll_release,
+                 "How each roll's particle is set on the incline: on-edge (default: a flattened particle on its rim, "
+                 "turned at random; a sphere anyhow) or any")
+      ->check(CLI::IsMember({"on-edge", "any"}));
   app.add_option("--camera", camera,
                  "What the camera tracks: silhouette (its centroid in the side view, default, as tracking software "
                  "does) or body-point (a point fixed in the body)");
@@ -101,6 +106,7 @@ int main(int argc, char** argv) {
   }
   options.lab.steps_per_contact = steps_per_contact;
   if (auto ok = parse_orientation_record(orientation, options); !ok) return cli::report_error(kCommand, ok.error());
+  options.roll_release = parse_roll_posture(roll_release).value_or(RollPosture::OnEdge);  // CLI11 checked it
   if (auto ok = parse_camera(camera, pixel_mm, options); !ok) return cli::report_error(kCommand, ok.error());
   options.conceal = !no_conceal;
   if (small) {

@@ -188,6 +188,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
       tried.push_back({{"name", spec.name},
                        {"values", values},
                        {"chi2", h.chi2},
+                       {"dispersion", h.dispersion},
                        {"delta_bic", h.delta_bic},
                        {"plausible", h.plausible},
                        {"comparisons", comparisons_json(h.comparisons)}});

@@ -1,4 +1,6 @@
 /// The diagnosis: which physics the model leaves out, from recorded tracks.
+#include <fmt/format.h>
+
 #include "common.hpp"
 #include "diagnose/diagnose.hpp"
 
@@ -142,7 +144,8 @@ void bind_result(py::module_& m) {
 DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, const std::vector<std::string>& effects,
                              std::optional<MaterialTable> materials, double orientation_prior_deg,
                              double model_accuracy, int ensemble_replays, int max_evaluations, std::uint64_t seed,
-                             const std::vector<Clump>& finer_clumps, const py::object& progress) {
+                             const std::vector<Clump>& finer_clumps, const std::string& roll_release,
+                             const py::object& progress) {
   std::vector<Recording> list;
   std::vector<std::string> names;
   for (const auto& [name, recording] : recordings) {
@@ -157,6 +160,10 @@ DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, con
   DiagnoseOptions options;
   for (const auto& e : effects) options.effects.push_back(unwrap(parse_effect(e)));
   options.orientation_prior_deg = orientation_prior_deg;
+  const auto posture = parse_roll_posture(roll_release);
+  if (!posture)
+    raise({ErrorCode::InvalidArgument, fmt::format("roll_release '{}' is not on-edge or any", roll_release)});
+  options.roll_release = *posture;
   options.model_accuracy_m = model_accuracy;
   options.ensemble_replays = ensemble_replays;
   options.max_evaluations = max_evaluations;
@@ -175,11 +182,13 @@ void bind_diagnose(py::module_& m) {
         py::arg("effects") = std::vector<std::string>{}, py::arg("materials") = py::none(),
         py::arg("orientation_prior_deg") = 15.0, py::arg("model_accuracy") = 3e-4, py::arg("ensemble_replays") = 12,
         py::arg("max_evaluations") = 45, py::arg("seed") = 1, py::arg("finer_clumps") = std::vector<Clump>{},
-        py::arg("progress") = py::none(),
+        py::arg("roll_release") = "on-edge", py::arg("progress") = py::none(),
         "Finds which physics the model leaves out (`clumpforge diagnose`): recordings is {name: Recording} (as "
         "read_recordings returns), effects the candidates (default: every effect of the library), model_accuracy [m] "
         "how closely any clump follows the real particle, finer_clumps finer clumps of the same body (the "
-        "resolution raised while replayed tracks change; refitted before a mismatch is blamed on missing physics).");
+        "resolution raised while replayed tracks change; refitted before a mismatch is blamed on missing physics), "
+        "roll_release how the lab set the particle on a roll's incline (on-edge: a flattened particle on its rim; "
+        "any).");
 }
 
 }  // namespace clumpforge::python

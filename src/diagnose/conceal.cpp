@@ -49,9 +49,15 @@ std::vector<Setup> setups(const ConcealOptions& o) {
   return out;
 }
 
-Eigen::Quaterniond trial_orientation(LabTest test, Rng& rng) {
+// How the lab sets the particle down: any way for a drop, on its rim for a roll when asked
+// and the body has one, lying as it rests (a random heading) for a tilt.
+Eigen::Quaterniond trial_orientation(LabTest test, bool on_edge, Rng& rng) {
   if (test == LabTest::Tilt)
     return Eigen::Quaterniond(Eigen::AngleAxisd(rng.uniform(0.0, 2.0 * std::numbers::pi), Eigen::Vector3d::UnitZ()));
+  if (test == LabTest::Roll && on_edge) {
+    const double angle = rng.uniform(0.0, 2.0 * std::numbers::pi);
+    return on_edge_orientation(angle, rng.uniform() < 0.5);
+  }
   Eigen::Quaterniond q(rng.normal(), rng.normal(), rng.normal(), rng.normal());
   return q.normalized();
 }
@@ -383,7 +389,9 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
   std::vector<std::vector<Eigen::Quaterniond>> orientations(all.size());
   for (std::size_t r = 0; r < all.size(); ++r) {
     Rng rng(options.seed, 1000 + r);
-    for (int i = 0; i < options.trials; ++i) orientations[r].push_back(trial_orientation(all[r].recording.test, rng));
+    const bool on_edge = options.roll_release == RollPosture::OnEdge && has_edge(clump.principal_moments);
+    for (int i = 0; i < options.trials; ++i)
+      orientations[r].push_back(trial_orientation(all[r].recording.test, on_edge, rng));
   }
   auto with = [&](const Interaction& interaction, bool effect) {
     LabOptions lab = options.lab;

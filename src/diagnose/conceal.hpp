@@ -14,6 +14,7 @@
 #include "core/run_context.hpp"
 #include "dem/lab.hpp"
 #include "diagnose/effects.hpp"
+#include "diagnose/release.hpp"
 
 namespace clumpforge {
 
@@ -54,7 +55,8 @@ struct ConcealOptions {
   double noise_m = 1e-4;          ///< camera noise, per coordinate
   double frame_rate_hz = 1000.0;  ///< (0, 1e5]; labs use 240 to 5000
   OrientationRecord orientation = OrientationRecord::None;
-  double orientation_noise_deg = 15.0;    ///< Noisy: the recorded orientation's error (rms angle)
+  RollPosture roll_release = RollPosture::OnEdge;  ///< how each roll's particle is set on the incline
+  double orientation_noise_deg = 15.0;             ///< Noisy: the recorded orientation's error (rms angle)
   bool pre_roll = true;                   ///< the camera starts 5-30 ms before the release (false: 2-20 ms after it)
   double drop_frame_probability = 0.01;   ///< single frames lost
   double gap_probability = 0.3;           ///< a run of 3-15 lost frames, per track

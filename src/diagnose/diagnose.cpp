@@ -733,6 +733,11 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
 /// orientation the prior allows still agree to half the noise level (their tracked points'
 /// displacements; the origins are fitted). Beyond it no single replay can stand for the
 /// trial. Returns a note per recording.
+// Whether rolls without a recorded orientation are replayed from the rim (see RollPosture).
+bool on_edge_rolls(const Clump& clump, const DiagnoseOptions& options) {
+  return options.roll_release == RollPosture::OnEdge && has_edge(clump.principal_moments);
+}
+
 Result<std::vector<std::string>> settle_release_state(Context& c, const Model& model, const DiagnoseOptions& options) {
   const auto& recs = *c.ev.recordings;
   std::vector<std::string> notes;
@@ -747,6 +752,7 @@ Result<std::vector<std::string>> settle_release_state(Context& c, const Model& m
       OrientationPrior prior;
       prior.spread = options.orientation_prior_deg * std::numbers::pi / 180.0;
       prior.recorded = rec.trials[tt.trial].release_orientation;
+      prior.on_edge = on_edge_rolls(*c.ev.clump, options);
       if (!prior.recorded && !groups.empty() && !groups.front().first.recorded) {
         groups.front().second.push_back(i);
       } else if (!prior.recorded) {
@@ -784,7 +790,9 @@ Result<std::vector<std::string>> settle_release_state(Context& c, const Model& m
     notes.push_back(fmt::format(
         "{}: release orientation {}; replays from {} orientations it allows agree until {} after release", c.names[r],
         recorded ? fmt::format("recorded (a prior of +-{:g} deg)", options.orientation_prior_deg)
-                 : std::string("unknown (uniform prior)"),
+        : rec.test == LabTest::Roll && on_edge_rolls(*c.ev.clump, options)
+            ? std::string("unknown (on its rim at a uniform turn)")
+            : std::string("unknown (uniform prior)"),
         options.release_orientations,
         fmt::join(horizons | std::views::transform([](double h) {
                     return std::isfinite(h) ? fmt::format("{:.3f} s", h) : std::string("the end");
@@ -1917,6 +1925,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   EnsembleOptions eo;
   eo.replays = options.ensemble_replays;
   eo.orientation_prior_deg = options.orientation_prior_deg;
+  eo.roll_on_edge = on_edge_rolls(*c.ev.clump, options);
   eo.impact_accuracy = options.impact_accuracy;
   eo.min_delta_bic = options.min_delta_bic;
   eo.seed = options.seed;

@@ -400,7 +400,13 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
     best.values = m.values;
     best.base = m.base;
     best.chi2 = chi2_of(cmp);
-    best.delta_bic = result.null_chi2 - best.chi2 - penalty;
+    // The margin is judged in units of the candidate's own misfit per degree of freedom when
+    // that exceeds 1 (over-dispersion: no clump replays a real particle's outcomes exactly, and
+    // a candidate must not be named for absorbing the particle model's share of the misfit).
+    const double dof = static_cast<double>(
+        std::max<std::size_t>(1, static_cast<std::size_t>(result.outcomes) - free.size() - spec.parameters.size()));
+    best.dispersion = std::max(1.0, best.chi2 / dof);
+    best.delta_bic = (result.null_chi2 - best.chi2) / best.dispersion - penalty;
     best.comparisons = std::move(cmp);
     best.plausible = true;
     for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
@@ -417,6 +423,7 @@ std::vector<Eigen::Quaterniond> ensemble_orientations(LabTest test, const std::v
                                                       const EnsembleOptions& options, std::uint64_t stream) {
   OrientationPrior prior;
   prior.spread = options.orientation_prior_deg * std::numbers::pi / 180.0;
+  prior.on_edge = options.roll_on_edge;
   if (recorded.empty()) return draw_release_orientations(test, prior, options.replays, options.seed, stream);
   const std::size_t n = recorded.size();
   const int each = static_cast<int>((static_cast<std::size_t>(options.replays) + n - 1) / n);

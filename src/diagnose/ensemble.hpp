@@ -72,6 +72,7 @@ OutcomeComparison compare_spread(const std::vector<double>& recorded, const std:
 struct EnsembleOptions {
   int replays = 12;  ///< release orientations per recording, >= 4
   double orientation_prior_deg = 15.0;
+  bool roll_on_edge = false;  ///< rolls without a recorded orientation start on the rim (OrientationPrior::on_edge)
   double impact_accuracy = 0.01;
   double min_delta_bic = 10.0;
   std::uint64_t seed = 1;
@@ -90,7 +91,8 @@ struct EnsembleHypothesis {
   std::vector<double> values;           ///< its parameters at the fitted magnitude
   std::vector<SurfaceParameters> base;  ///< with the free coefficients refitted
   double chi2 = 0.0;                    ///< from replays at that point
-  double delta_bic = 0.0;               ///< against the calibrated null
+  double dispersion = 1.0;  ///< its chi^2 per degree of freedom when above 1: the margin is judged in these units
+  double delta_bic = 0.0;   ///< against the calibrated null: delta-chi^2 / dispersion - k ln n
   bool plausible = false;
   std::vector<OutcomeComparison> comparisons;  ///< its replays against the recordings
 };

@@ -8,6 +8,27 @@
 
 namespace clumpforge {
 
+std::string_view roll_posture_name(RollPosture posture) {
+  return posture == RollPosture::Any ? "any" : "on-edge";
+}
+
+std::optional<RollPosture> parse_roll_posture(std::string_view text) {
+  if (text == "any") return RollPosture::Any;
+  if (text == "on-edge") return RollPosture::OnEdge;
+  return std::nullopt;
+}
+
+bool has_edge(const Eigen::Vector3d& moments) {
+  return moments.z() >= 1.05 * moments.y() && moments.y() > 0.0;
+}
+
+Eigen::Quaterniond on_edge_orientation(double angle, bool flip) {
+  // z -> -y by a quarter turn about x (+y by the opposite one), then the turn about y.
+  const double quarter = (flip ? -0.5 : 0.5) * std::numbers::pi;
+  return (Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(quarter, Eigen::Vector3d::UnitX()))
+      .normalized();
+}
+
 std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count,
                                                           std::uint64_t seed, std::uint64_t stream) {
   Rng rng(seed, stream);
@@ -25,6 +46,9 @@ std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const Or
       if (axis.norm() < 1e-12) axis = Eigen::Vector3d::UnitX();
       const double angle = prior.spread * std::cbrt(rng.uniform());
       out.push_back((Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())) * *prior.recorded).normalized());
+    } else if (test == LabTest::Roll && prior.on_edge) {
+      const double angle = rng.uniform(0.0, 2.0 * std::numbers::pi);
+      out.push_back(on_edge_orientation(angle, rng.uniform() < 0.5));
     } else if (test == LabTest::Tilt) {
       out.emplace_back(Eigen::AngleAxisd(rng.uniform(0.0, 2.0 * std::numbers::pi), Eigen::Vector3d::UnitZ()));
     } else {

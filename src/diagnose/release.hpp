@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <numbers>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "core/recording.hpp"
@@ -17,16 +18,38 @@
 
 namespace clumpforge {
 
+/// How a lab sets a particle on a roll's incline. Nobody lays a flattened particle flat on a
+/// slope to see it roll: it is stood on its rim, its flat faces across the slope, and turned
+/// at random about that axis. A sphere or an equant body has no rim and is set down anyhow.
+enum class RollPosture {
+  Any,     ///< any orientation (uniform over all rotations)
+  OnEdge,  ///< a flattened body on its rim (see has_edge); any other as Any
+};
+std::string_view roll_posture_name(RollPosture posture);
+std::optional<RollPosture> parse_roll_posture(std::string_view text);  ///< "any", "on-edge"
+
+/// Whether a body with principal moments `moments` (ascending, as in a body's principal
+/// frame) is flattened enough to stand on its rim: its largest moment at least 5 % above the
+/// middle one (the Corydalis tuber's is 27 % above; a sphere's equal).
+bool has_edge(const Eigen::Vector3d& moments);
+
+/// A rim-standing release on a roll's incline: the body's axis of largest moment (z of its
+/// principal frame, the flat faces' normal) across the slope (world +y, or -y when `flip`),
+/// turned by `angle` [rad] about it.
+Eigen::Quaterniond on_edge_orientation(double angle, bool flip);
+
 /// What is known of one trial's release orientation.
 struct OrientationPrior {
   std::optional<Eigen::Quaterniond> recorded;       ///< the lab's, when written down (a prior centre)
   double spread = 15.0 * std::numbers::pi / 180.0;  ///< [rad] how far from `recorded` the release may be, (0, pi]
+  bool on_edge = false;  ///< a roll with nothing recorded: stood on its rim (RollPosture::OnEdge and has_edge)
 };
 
 /// `count` release orientations the prior allows, reproducibly from (`seed`, `stream`):
-/// uniform over all rotations (drop, roll) or over headings about the vertical (tilt: the
-/// particle lies as the test places it) when nothing was recorded; uniform within a ball of
-/// rotation angle `spread` about the recorded one otherwise, the recorded one first.
+/// uniform over all rotations (drop, roll), on the rim at a uniform turn (a roll with
+/// `on_edge`) or over headings about the vertical (tilt: the particle lies as the test places
+/// it) when nothing was recorded; uniform within a ball of rotation angle `spread` about the
+/// recorded one otherwise, the recorded one first.
 std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count,
                                                           std::uint64_t seed, std::uint64_t stream);
 

@@ -382,7 +382,9 @@ TEST(DiagnoseParticleModel, BeyondTheHorizonACoarseClumpIsCheckedBeforeAnEffectI
   // spreads beside them no candidate reaches the margin, and the means alone stay
   // inconsistent: `unexplained`). Given the finer fills of the same scan
   // (tuber-default-ladder.h5: 64 and 128 spheres, not the generator's 340) the mismatch must be
-  // found to be the particle model's: `none`, 64 spheres needed.
+  // found to be the particle model's: `none`, 64 spheres needed. The control's rolls were
+  // made, and are replayed, from any orientation (`--roll-release any`): stood on its rim the
+  // coarse clump rolls like the finer body and nothing misfits (`none`, consistent).
   auto generators = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
   auto ladder = read_clump_library(test::source_dir() / "clumps" / "tuber-default-ladder.h5");
   ASSERT_TRUE(generators && ladder);
@@ -396,6 +398,7 @@ TEST(DiagnoseParticleModel, BeyondTheHorizonACoarseClumpIsCheckedBeforeAnEffectI
   conceal.drop_heights = {0.2, 1.0};
   conceal.roll_starts = {0.10};
   conceal.seed = 1508;
+  conceal.roll_release = RollPosture::Any;
   Interaction base = *table.interaction("tuber", "Q235");
   base.restitution = 0.686568574;
   base.static_friction = 0.349312327;
@@ -403,11 +406,12 @@ TEST(DiagnoseParticleModel, BeyondTheHorizonACoarseClumpIsCheckedBeforeAnEffectI
   conceal.base = base;
   auto made = make_concealed_recordings(*generator, table, conceal);
   ASSERT_TRUE(made) << made.error().message;
-  auto alone = diagnose(*coarse, table, made->recordings, made->names, {});
+  DiagnoseOptions options;
+  options.roll_release = RollPosture::Any;
+  auto alone = diagnose(*coarse, table, made->recordings, made->names, options);
   ASSERT_TRUE(alone) << alone.error().message;
   EXPECT_EQ(alone->verdict, Verdict::Unexplained) << alone->statement;
   EXPECT_EQ(alone->basis, Basis::UnexplainedOutcomes) << alone->statement;
-  DiagnoseOptions options;
   options.finer_clumps = {*finer};
   auto checked = diagnose(*coarse, table, made->recordings, made->names, options);
   ASSERT_TRUE(checked) << checked.error().message;

@@ -229,3 +229,40 @@ TEST(EnsembleOrientations, MirrorEachTrialsRecordedOrientation) {
   for (std::size_t k = 0; k < uniform.size(); ++k) EXPECT_TRUE(uniform[k].isApprox(again[k]));
 }
 }  // namespace clumpforge
+
+// A roll with nothing recorded, from a lab that stands a flattened particle on its rim: every
+// replay's flat faces' normal (body z, the largest moment's axis) lies across the slope (world
+// +-y) and the turn about it is uniform; drops stay uniform over all rotations; a sphere, which
+// has no rim, rolls from any orientation.
+TEST(EnsembleOrientations, RollsStandAFlattenedParticleOnItsRim) {
+  EXPECT_TRUE(has_edge({8.40e-8, 1.178e-7, 1.494e-7}));  // the Corydalis tuber's moments
+  EXPECT_FALSE(has_edge({1.0, 1.0, 1.0}));               // a sphere
+  EXPECT_FALSE(has_edge({1.0, 1.0, 1.04}));              // an equant body
+  for (bool flip : {false, true}) {
+    const Eigen::Vector3d normal = on_edge_orientation(0.7, flip) * Eigen::Vector3d::UnitZ();
+    EXPECT_NEAR(normal.y(), flip ? 1.0 : -1.0, 1e-12);
+  }
+  EnsembleOptions options;
+  options.replays = 400;
+  options.roll_on_edge = true;
+  const auto rolls = ensemble_orientations(LabTest::Roll, {}, options, 3);
+  ASSERT_EQ(rolls.size(), 400U);
+  int plus_y = 0;
+  double mean_cos = 0.0, mean_sin = 0.0;  // of the turn about y: the body x axis in the x-z plane
+  for (const auto& q : rolls) {
+    const Eigen::Vector3d normal = q * Eigen::Vector3d::UnitZ(), x = q * Eigen::Vector3d::UnitX();
+    EXPECT_NEAR(std::abs(normal.y()), 1.0, 1e-12);
+    EXPECT_NEAR(x.y(), 0.0, 1e-12);
+    plus_y += normal.y() > 0.0 ? 1 : 0;
+    mean_cos += x.x() / 400.0;
+    mean_sin += x.z() / 400.0;
+  }
+  // Binomial(400, 1/2) sd 10; a uniform turn's mean cosine and sine have sd 1/sqrt(800) = 0.035.
+  EXPECT_NEAR(plus_y, 200, 40);
+  EXPECT_LT(std::hypot(mean_cos, mean_sin), 0.15);
+  // Drops are not stood on edge: their z axes fill the sphere (|y| mean 1/2 for uniform).
+  const auto drops = ensemble_orientations(LabTest::Drop, {}, options, 3);
+  double mean_abs_y = 0.0;
+  for (const auto& q : drops) mean_abs_y += std::abs((q * Eigen::Vector3d::UnitZ()).y()) / 400.0;
+  EXPECT_NEAR(mean_abs_y, 0.5, 0.05);  // sd of the mean 0.29/20 = 0.014
+}

@@ -166,6 +166,8 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
     big = cf.fill(box(0.02, 0.02, 0.02), method="lattice", diameter=0.002, density=1085.0)
     with pytest.raises(cf.InvalidArgumentError, match="not a model of the body"):
         cf.diagnose(small, recordings, finer_clumps=[big])
+    with pytest.raises(cf.InvalidArgumentError, match="roll_release 'flat'"):
+        cf.diagnose(small, recordings, roll_release="flat")
     assert "particle_model" in dir(cf.DiagnoseResult)
     assert cf.Basis.particle_model != cf.Basis.unexplained_outcomes
 
