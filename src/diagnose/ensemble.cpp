@@ -403,8 +403,8 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
     // The margin is judged in units of the candidate's own misfit per degree of freedom when
     // that exceeds 1 (over-dispersion: no clump replays a real particle's outcomes exactly, and
     // a candidate must not be named for absorbing the particle model's share of the misfit).
-    const double dof = static_cast<double>(
-        std::max<std::size_t>(1, static_cast<std::size_t>(result.outcomes) - free.size() - spec.parameters.size()));
+    const double dof = std::max(1.0, static_cast<double>(result.outcomes) - static_cast<double>(free.size()) -
+                                         static_cast<double>(spec.parameters.size()));
     best.dispersion = std::max(1.0, best.chi2 / dof);
     best.delta_bic = (result.null_chi2 - best.chi2) / best.dispersion - penalty;
     best.comparisons = std::move(cmp);
