@@ -54,10 +54,7 @@ std::vector<Setup> setups(const ConcealOptions& o) {
 Eigen::Quaterniond trial_orientation(LabTest test, bool on_edge, Rng& rng) {
   if (test == LabTest::Tilt)
     return Eigen::Quaterniond(Eigen::AngleAxisd(rng.uniform(0.0, 2.0 * std::numbers::pi), Eigen::Vector3d::UnitZ()));
-  if (test == LabTest::Roll && on_edge) {
-    const double angle = rng.uniform(0.0, 2.0 * std::numbers::pi);
-    return on_edge_orientation(angle, rng.uniform() < 0.5);
-  }
+  if (test == LabTest::Roll && on_edge) return random_on_edge_orientation(rng);
   Eigen::Quaterniond q(rng.normal(), rng.normal(), rng.normal(), rng.normal());
   return q.normalized();
 }

@@ -727,19 +727,21 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
   return out;
 }
 
-/// The release state, a nuisance: every trial replays an orientation its prior allows (the
-/// recorded one when the lab wrote one down, else a draw from the uniform prior) and is
-/// fitted frame by frame only up to its release horizon, where replays from every
-/// orientation the prior allows still agree to half the noise level (their tracked points'
-/// displacements; the origins are fitted). Beyond it no single replay can stand for the
-/// trial. Returns a note per recording.
 // Whether rolls without a recorded orientation are replayed from the rim (see RollPosture).
 bool on_edge_rolls(const Clump& clump, const DiagnoseOptions& options) {
   return options.roll_release == RollPosture::OnEdge && has_edge(clump.principal_moments);
 }
 
+/// The release state, a nuisance: every trial replays an orientation its prior allows (the
+/// recorded one when the lab wrote one down, else a draw from the prior: uniform, or a roll
+/// on its rim) and is
+/// fitted frame by frame only up to its release horizon, where replays from every
+/// orientation the prior allows still agree to half the noise level (their tracked points'
+/// displacements; the origins are fitted). Beyond it no single replay can stand for the
+/// trial. Returns a note per recording.
 Result<std::vector<std::string>> settle_release_state(Context& c, const Model& model, const DiagnoseOptions& options) {
   const auto& recs = *c.ev.recordings;
+  const bool on_edge = on_edge_rolls(*c.ev.clump, options);
   std::vector<std::string> notes;
   for (std::size_t r = 0; r < recs.size(); ++r) {
     const Recording& rec = recs[r];
@@ -752,7 +754,7 @@ Result<std::vector<std::string>> settle_release_state(Context& c, const Model& m
       OrientationPrior prior;
       prior.spread = options.orientation_prior_deg * std::numbers::pi / 180.0;
       prior.recorded = rec.trials[tt.trial].release_orientation;
-      prior.on_edge = on_edge_rolls(*c.ev.clump, options);
+      prior.on_edge = on_edge;
       if (!prior.recorded && !groups.empty() && !groups.front().first.recorded) {
         groups.front().second.push_back(i);
       } else if (!prior.recorded) {
@@ -790,9 +792,8 @@ Result<std::vector<std::string>> settle_release_state(Context& c, const Model& m
     notes.push_back(fmt::format(
         "{}: release orientation {}; replays from {} orientations it allows agree until {} after release", c.names[r],
         recorded ? fmt::format("recorded (a prior of +-{:g} deg)", options.orientation_prior_deg)
-        : rec.test == LabTest::Roll && on_edge_rolls(*c.ev.clump, options)
-            ? std::string("unknown (on its rim at a uniform turn)")
-            : std::string("unknown (uniform prior)"),
+        : rec.test == LabTest::Roll && on_edge ? std::string("unknown (on its rim at a uniform turn)")
+                                               : std::string("unknown (uniform prior)"),
         options.release_orientations,
         fmt::join(horizons | std::views::transform([](double h) {
                     return std::isfinite(h) ? fmt::format("{:.3f} s", h) : std::string("the end");
@@ -1188,7 +1189,7 @@ Result<bool> recorded_horizons(Context& c, DiagnoseResult& result, const Model& 
     for (std::size_t i : members[r]) {
       const Track& recorded = *recs[r].trials[c.ev.trials[i].trial].track;
       frame = std::max(frame, frame_interval(recorded));
-      // From the release on, lost frames bridged.
+      // From the release on; lost frames left out (the horizon interpolates across them).
       const Track moved = in_replay_frame(recorded, *alignment[i]);
       Track kept;
       for (std::size_t f = 0; f < moved.size(); ++f) {

@@ -8,10 +8,6 @@
 
 namespace clumpforge {
 
-std::string_view roll_posture_name(RollPosture posture) {
-  return posture == RollPosture::Any ? "any" : "on-edge";
-}
-
 std::optional<RollPosture> parse_roll_posture(std::string_view text) {
   if (text == "any") return RollPosture::Any;
   if (text == "on-edge") return RollPosture::OnEdge;
@@ -27,6 +23,11 @@ Eigen::Quaterniond on_edge_orientation(double angle, bool flip) {
   const double quarter = (flip ? -0.5 : 0.5) * std::numbers::pi;
   return (Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(quarter, Eigen::Vector3d::UnitX()))
       .normalized();
+}
+
+Eigen::Quaterniond random_on_edge_orientation(Rng& rng) {
+  const double angle = rng.uniform(0.0, 2.0 * std::numbers::pi);
+  return on_edge_orientation(angle, rng.uniform() < 0.5);
 }
 
 std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count,
@@ -47,8 +48,7 @@ std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const Or
       const double angle = prior.spread * std::cbrt(rng.uniform());
       out.push_back((Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())) * *prior.recorded).normalized());
     } else if (test == LabTest::Roll && prior.on_edge) {
-      const double angle = rng.uniform(0.0, 2.0 * std::numbers::pi);
-      out.push_back(on_edge_orientation(angle, rng.uniform() < 0.5));
+      out.push_back(random_on_edge_orientation(rng));
     } else if (test == LabTest::Tilt) {
       out.emplace_back(Eigen::AngleAxisd(rng.uniform(0.0, 2.0 * std::numbers::pi), Eigen::Vector3d::UnitZ()));
     } else {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/recording.hpp"
+#include "core/rng.hpp"
 #include "dem/lab.hpp"
 
 namespace clumpforge {
@@ -25,7 +26,6 @@ enum class RollPosture {
   Any,     ///< any orientation (uniform over all rotations)
   OnEdge,  ///< a flattened body on its rim (see has_edge); any other as Any
 };
-std::string_view roll_posture_name(RollPosture posture);
 std::optional<RollPosture> parse_roll_posture(std::string_view text);  ///< "any", "on-edge"
 
 /// Whether a body with principal moments `moments` (ascending, as in a body's principal
@@ -37,6 +37,9 @@ bool has_edge(const Eigen::Vector3d& moments);
 /// principal frame, the flat faces' normal) across the slope (world +y, or -y when `flip`),
 /// turned by `angle` [rad] about it.
 Eigen::Quaterniond on_edge_orientation(double angle, bool flip);
+/// A rim-standing release at a uniform turn, either way round, drawn from `rng` (the turn
+/// first, then the side): how the diagnoser's prior and the generator's lab set a roll down.
+Eigen::Quaterniond random_on_edge_orientation(Rng& rng);
 
 /// What is known of one trial's release orientation.
 struct OrientationPrior {

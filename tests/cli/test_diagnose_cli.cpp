@@ -66,6 +66,13 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   EXPECT_NE(run.exit_code, 0);
   EXPECT_NE(run.err.find("--finer-clumps must be between 0 and 4"), std::string::npos) << run.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "finer"));
+  // A release posture the tool does not know: refused by name, nothing written.
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --roll-release flat --output '{}'",
+                                         (dir / "rec").string(), clump(), (dir / "posture").string()));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("--roll-release"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("flat"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "posture"));
   // A track too short to decide anything: that verdict, not a guess.
   run = test::run_clumpforge(
       fmt::format("diagnose --recordings '{}' --library '{}' --json", (dir / "rec").string(), clump()));
