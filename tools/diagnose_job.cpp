@@ -156,6 +156,19 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
         {"resolution_needed_spheres", m.resolution_needed ? nlohmann::json(*m.resolution_needed) : nlohmann::json()},
         {"rungs", rungs}};
   }
+  j["flights"] = nlohmann::json();
+  if (r.flights) {
+    const auto& f = *r.flights;
+    j["flights"] = {{"flights", f.flights.size()},
+                    {"wobble_mm", f.wobble_m * 1e3},
+                    {"noise_mm", f.noise_m * 1e3},
+                    {"allowance_mm", f.allowance_m * 1e3},
+                    {"detected", f.detected},
+                    {"offset_mm", f.offset_m * 1e3},
+                    {"offset_low_mm", f.offset_low_m * 1e3},
+                    {"offset_high_mm", f.offset_high_m * 1e3},
+                    {"smallest_offset_mm", finite_or_null(f.smallest_offset_m * 1e3)}};
+  }
   if (r.ensemble) {
     const auto& e = *r.ensemble;
     auto comparisons_json = [&](const std::vector<OutcomeComparison>& list) {

@@ -15,9 +15,9 @@ void bind_enums(py::module_& m) {
       .value("unexplained", Verdict::Unexplained)
       .value("undecidable", Verdict::Undecidable);
   py::enum_<Basis> basis(m, "Basis");
-  for (Basis b :
-       {Basis::Consistent, Basis::SlightMisfit, Basis::FrameByFrame, Basis::Ensemble, Basis::UnexplainedPhases,
-        Basis::TooFewTrials, Basis::TooNoisy, Basis::SummariesOnly, Basis::ParticleModel, Basis::UnexplainedOutcomes})
+  for (Basis b : {Basis::Consistent, Basis::SlightMisfit, Basis::FrameByFrame, Basis::Ensemble,
+                  Basis::UnexplainedPhases, Basis::TooFewTrials, Basis::TooNoisy, Basis::SummariesOnly,
+                  Basis::ParticleModel, Basis::UnexplainedOutcomes, Basis::FreeFlights})
     basis.value(std::string(basis_name(b)).c_str(), b);
   py::enum_<Phase> phase(m, "Phase");
   for (Phase p : {Phase::Hold, Phase::Flight, Phase::Impact, Phase::Rebound, Phase::SecondFlight, Phase::LaterBounces,
@@ -106,6 +106,20 @@ void bind_parts(py::module_& m) {
 }
 
 void bind_result(py::module_& m) {
+  py::class_<FlightWobble>(m, "FlightWobble",
+                           "What the drops' free flights after the first contact say about the tracked point.")
+      .def_property_readonly("flights", [](const FlightWobble& f) { return f.flights.size(); })
+      .def_readonly("wobble_m", &FlightWobble::wobble_m,
+                    "[m] RMS per coordinate about the flights' parabolas beyond the noise (median flight)")
+      .def_readonly("noise_m", &FlightWobble::noise_m)
+      .def_readonly("allowance_m", &FlightWobble::allowance_m, "[m] the silhouette centroid's wander for this body")
+      .def_readonly("detected", &FlightWobble::detected)
+      .def_readonly("offset_m", &FlightWobble::offset_m,
+                    "[m] the centre of mass's distance from the tracked point (low estimate)")
+      .def_readonly("offset_low_m", &FlightWobble::offset_low_m)
+      .def_readonly("offset_high_m", &FlightWobble::offset_high_m)
+      .def_readonly("smallest_offset_m", &FlightWobble::smallest_offset_m,
+                    "[m] the smallest offset these flights would have shown");
   py::class_<PartedRecording>(m, "PartedRecording",
                               "A recording whose trials part where the replays agree for every release.")
       .def_readonly("recording", &PartedRecording::recording)
@@ -137,6 +151,7 @@ void bind_result(py::module_& m) {
       .def_readonly("parted", &DiagnoseResult::parted)
       .def_readonly("undecidable", &DiagnoseResult::undecidable)
       .def_readonly("particle_model", &DiagnoseResult::particle_model)
+      .def_readonly("flights", &DiagnoseResult::flights)
       .def_readonly("evaluations", &DiagnoseResult::evaluations)
       .def_readonly("seconds", &DiagnoseResult::seconds);
 }

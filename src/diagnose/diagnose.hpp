@@ -26,6 +26,7 @@
 #include "dem/lab.hpp"
 #include "diagnose/effects.hpp"
 #include "diagnose/ensemble.hpp"
+#include "diagnose/flights.hpp"
 #include "diagnose/phases.hpp"
 #include "diagnose/release.hpp"
 
@@ -194,6 +195,7 @@ enum class Basis {
   TooNoisy,             ///< undecidable: the tracks' noise hides what the effects would do
   SummariesOnly,        ///< no tracks: what the summaries decide
   ParticleModel,        ///< none: the mismatch goes with a finer clump of the same body (see ParticleModelCheck)
+  FreeFlights,          ///< named from the drops' free flights after the first contact (see diagnose/flights.hpp)
 };
 std::string_view basis_name(Basis basis);
 
@@ -230,6 +232,7 @@ struct DiagnoseResult {
   std::vector<std::string> decidable, undecidable;
   std::optional<EnsembleReport> ensemble;
   std::optional<ParticleModelCheck> particle_model;  ///< when finer clumps were given
+  std::optional<FlightWobble> flights;               ///< when drops were tracked
   int tracked_trials = 0, training_trials = 0, evaluations = 0;
   double seconds = 0.0;
 };

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace clumpforge {
 
@@ -118,6 +119,21 @@ SampleSpread sample_spread(const std::vector<double>& values) {
 double standard_error(const std::vector<double>& values) {
   if (values.size() < 2) return 0.0;
   return sample_spread(values).sd / std::sqrt(static_cast<double>(values.size()));
+}
+
+double weighted_median(const std::vector<double>& values, const std::vector<double>& weights) {
+  std::vector<std::size_t> order(std::min(values.size(), weights.size()));
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return values[a] < values[b]; });
+  double total = 0.0;
+  for (std::size_t k : order) total += std::max(0.0, weights[k]);
+  if (!(total > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  double reached = 0.0;
+  for (std::size_t k : order) {
+    reached += std::max(0.0, weights[k]);
+    if (reached >= 0.5 * total) return values[k];
+  }
+  return values[order.back()];
 }
 
 double median(std::vector<double> values) {

@@ -30,6 +30,9 @@ SampleSpread sample_spread(const std::vector<double>& values);
 double standard_error(const std::vector<double>& values);
 /// The median (the upper of the two middle values for an even count); NaN when empty.
 double median(std::vector<double> values);
+/// The weighted median: the smallest value whose weight and the smaller values' reach half the
+/// total weight (weights >= 0; NaN for an empty sample or no weight).
+double weighted_median(const std::vector<double>& values, const std::vector<double>& weights);
 /// The q-quantile (0 <= q <= 1) by linear interpolation between order statistics (Hyndman &
 /// Fan type 7, as R's and numpy's default); NaN when empty.
 double quantile(std::vector<double> values, double q);
