@@ -71,6 +71,15 @@ Track tumbling_drop(const Eigen::Vector3d& offset, std::uint64_t seed) {
   return track;
 }
 
+// The bundled tuber's finest clump, the generator's.
+Clump tuber_340() {
+  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
+  EXPECT_TRUE(library) << library.error().message;
+  auto clump = select_clump(std::move(*library), "adaptive-340", "tuber-default.h5");
+  EXPECT_TRUE(clump) << clump.error().message;
+  return *clump;
+}
+
 Recording drops_of(const Eigen::Vector3d& offset, int trials, std::uint64_t seed) {
   Recording r;
   r.test = LabTest::Drop;
@@ -134,22 +143,15 @@ TEST(FreeFlights, FlightsStartAfterTheFirstPossibleContactAndSplitAtDips) {
 
 TEST(FreeFlights, SilhouetteWanderOfASphereIsNoneAndOfTheTuberSmall) {
   EXPECT_EQ(silhouette_wander({Sphere{Eigen::Vector3d::Zero(), 0.009}}, 5e-5, 50, 1), 0.0);
-  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
-  ASSERT_TRUE(library);
-  auto clump = select_clump(std::move(*library), "adaptive-340", "tuber-default.h5");
-  ASSERT_TRUE(clump);
-  const double wander = silhouette_wander(clump->spheres, 5e-5, 200, 3);
+  const Clump clump = tuber_340();
+  const double wander = silhouette_wander(clump.spheres, 5e-5, 200, 3);
   RecordProperty("wander_um", static_cast<int>(wander * 1e6));
   // Per coordinate about its mean: below SilhouetteCamera's 0.149 mm RMS distance from the
   // centre of mass (two coordinates, and not about the mean), and not nothing.
   EXPECT_GT(wander, 3e-5);
   EXPECT_LT(wander, 0.149e-3);
-  EXPECT_NEAR(body_reach(clump->spheres), 0.0115, 0.0025);
+  EXPECT_NEAR(body_reach(clump.spheres), 0.0115, 0.0025);
 }
-
-}  // namespace clumpforge
-
-namespace clumpforge {
 
 TEST(FreeFlights, GeneratedTuberDropsSeenBySilhouetteShowARealisticOffsetAndNotAControl) {
   // Drops of the bundled tuber made by the generator from its adaptive-340 clump and filmed by
@@ -157,10 +159,7 @@ TEST(FreeFlights, GeneratedTuberDropsSeenBySilhouetteShowARealisticOffsetAndNotA
   // with no release recorded; judged with the reach and wander of the diagnosis's own
   // adaptive-32 clump, not the generator's. A control: nothing claimed. The realistic offset
   // (1.0 mm along the 1st axis, 0.5 mm along the 3rd: 1.12 mm): claimed, its size a low estimate.
-  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
-  ASSERT_TRUE(library);
-  auto generator = select_clump(std::move(*library), "adaptive-340", "tuber-default.h5");
-  ASSERT_TRUE(generator);
+  const Clump generator = tuber_340();
   auto diagnosis = read_clump_library(test::source_dir() / "clumps" / "tuber-default-diagnosis.h5");
   ASSERT_TRUE(diagnosis);
   const Clump& clump = diagnosis->front();
@@ -176,7 +175,7 @@ TEST(FreeFlights, GeneratedTuberDropsSeenBySilhouetteShowARealisticOffsetAndNotA
   const MaterialTable table = default_material_table();
   auto judged = [&](std::optional<Effect> effect) {
     conceal.effect = effect;
-    auto made = make_concealed_recordings(*generator, table, conceal);
+    auto made = make_concealed_recordings(generator, table, conceal);
     EXPECT_TRUE(made) << made.error().message;
     return flight_wobble(made->recordings, std::vector<double>(made->recordings.size(), conceal.noise_m), options);
   };
