@@ -1,0 +1,389 @@
+/// Beyond the release horizon: the free flights and the outcomes over the unknown release compared
+/// as a sample with replay ensembles (null calibrated, candidates, the finer clumps).
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iterator>
+#include <numbers>
+#include <numeric>
+#include <ranges>
+
+#include "core/rng.hpp"
+#include "diagnose/stages.hpp"
+#include "numerics/least_squares.hpp"
+#include "numerics/statistics.hpp"
+
+namespace clumpforge::diagnosis {
+
+/// The largest z^2 of `comparisons`.
+double largest_z2(const std::vector<OutcomeComparison>& comparisons) {
+  double worst = 0.0;
+  for (const auto& o : comparisons) worst = std::max(worst, o.z * o.z);
+  return worst;
+}
+
+/// Degrees of freedom of a null with `free` coefficients calibrated on `outcomes` recorded
+/// means (at least one).
+double null_dof(int outcomes, std::size_t free) {
+  return std::max(1.0, outcomes - static_cast<double>(free));
+}
+
+/// Whether replays of a model with `fitted` parameters calibrated on the outcomes are
+/// consistent with the recordings: the means' chi^2 (over their number less `fitted`, at
+/// least one) and the spreads' (over their number) each have an upper tail of
+/// kConsistentTail / 2 or more. Tested apart, a mean far off is not diluted by spreads that
+/// agree, nor the reverse.
+bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted) {
+  double chi2[2] = {0.0, 0.0};
+  int count[2] = {0, 0};
+  for (const auto& o : comparisons) {
+    const int k = o.statistic == Statistic::Mean ? 0 : 1;
+    chi2[k] += o.z * o.z;
+    ++count[k];
+  }
+  return chi2_upper_tail(chi2[0], null_dof(count[0], fitted)) >= 0.5 * kConsistentTail &&
+         (count[1] == 0 || chi2_upper_tail(chi2[1], count[1]) >= 0.5 * kConsistentTail);
+}
+
+/// The hypotheses beyond the release horizon that pass, best first: each beats the calibrated
+/// null by the margin at a plausible value and leaves the outcomes consistent with the
+/// recordings (outcomes_consistent, its parameters fitted): a better fit that still misses by
+/// far explains nothing (a note says so).
+std::vector<const EnsembleHypothesis*> passing_hypotheses(const EnsembleResult& ens, double min_delta_bic,
+                                                          std::vector<std::string>& notes) {
+  std::vector<const EnsembleHypothesis*> passing;
+  for (const auto& h : ens.hypotheses) {
+    if (!h.plausible || h.delta_bic < min_delta_bic) continue;
+    if (outcomes_consistent(h.comparisons, h.values.size())) {
+      passing.push_back(&h);
+    } else {
+      notes.push_back(fmt::format(
+          "beyond the release horizon {} improves the outcomes by delta-BIC {:.1f} but leaves chi^2 {:.1f} over {} "
+          "recorded means and spreads: not an explanation",
+          effect_name(h.effect), h.delta_bic, h.chi2, ens.outcomes));
+    }
+  }
+  return passing;
+}
+
+/// The verdict from the passing hypotheses beyond the horizon (not empty): the best named, or
+/// ambiguous when the next comes within the margin.
+void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
+                         const std::vector<const EnsembleHypothesis*>& passing, double min_delta_bic) {
+  const auto library = effect_library();
+  const EnsembleHypothesis& best = *passing.front();
+  const EffectSpec& spec = effect_spec(library, best.effect);
+  const bool close = passing.size() > 1 && best.delta_bic - passing[1]->delta_bic < min_delta_bic;
+  result.basis = Basis::Ensemble;
+  if (close) {
+    result.verdict = Verdict::Ambiguous;
+    result.effect.reset();
+    result.candidates = {spec.name, effect_spec(library, passing[1]->effect).name};
+    result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
+    result.statement = fmt::format(
+        "Frame by frame nothing is named, but the recorded outcomes (rebound heights, drifts, roll distances, times "
+        "to rest) differ from replays over the unknown release orientation, and {} and {} explain that about equally "
+        "well (delta-BIC {:.1f} vs {:.1f}). To separate them: {}.",
+        result.candidates[0], result.candidates[1], best.delta_bic, passing[1]->delta_bic, result.experiment);
+  } else {
+    result.verdict = Verdict::Named;
+    result.effect = best.effect;
+    result.effect_parameters.clear();
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k)
+      result.effect_parameters.push_back({spec.parameters[k].name, best.values[k], NAN, NAN});
+    result.improved = best.base;
+    result.unexplained.clear();
+    std::erase(result.undecidable, spec.name);
+    result.statement = fmt::format(
+        "Missing physics found beyond the release horizon: {} ({}), {}. Frame by frame the tracks do not decide it; "
+        "the recorded outcomes against replays from the unknown release orientation do: chi^2 {:.1f} -> {:.1f} over "
+        "{} recorded means and spreads (delta-BIC {:.1f}){}.",
+        spec.name, spec.description,
+        fmt::join(result.effect_parameters | std::views::transform([](const ParameterValue& p) {
+                    return fmt::format("{} = {:.4g}", p.name, p.value);
+                  }),
+                  ", "),
+        ens.null_chi2, best.chi2, ens.outcomes, best.delta_bic,
+        passing.size() > 1 ? fmt::format("; next: {} at delta-BIC {:.1f}",
+                                         effect_spec(library, passing[1]->effect).name, passing[1]->delta_bic)
+                           : std::string());
+    result.experiment.clear();
+  }
+}
+
+/// The calibrated null leaves the recorded outcomes inconsistent with the replays
+/// (outcomes_consistent): before the mismatch is blamed on missing physics, each finer clump
+/// left is tried (its null calibrated afresh on the outcomes, from the same orientations); the
+/// first that leaves them consistent explains it, and the verdict says so with the resolution
+/// needed. The candidates are tried with that clump too: one that passes there (beats its
+/// consistent null by the margin, see passing_hypotheses) is named, on the finer clump's
+/// outcomes. Returns whether a finer clump explained the mismatch.
+Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
+                                           const std::vector<FreeCoefficient>& free,
+                                           const std::vector<Effect>& candidates, const EnsembleOptions& eo,
+                                           int max_evaluations) {
+  if (!result.particle_model || c.finer.empty()) return false;
+  const EnsembleReport& e = *result.ensemble;
+  ParticleModelCheck& check = *result.particle_model;
+  check.checked = true;
+  check.chi2_per_value = e.null_chi2 / e.outcomes;
+  const double coarse_chi2 = e.null_chi2;  // e is the report, replaced below when a candidate passes
+  const int outcomes = e.outcomes;
+  check.worst_phase_chi2_per_value = largest_z2(e.null_comparisons);
+  for (std::size_t k = 0; k < c.finer.size(); ++k) {
+    // The baseline refitted the baseline's way with the finer clump (the coefficients the
+    // frames pin change with the clump: a coarse clump rolls otherwise), its whole tracks
+    // replayed to put the recordings in its frame, and its null calibrated on the outcomes.
+    const ClumpSwap swap(c, c.finer[k]);
+    const auto unpinned = c.unpinned;
+    auto fitted = fit_coefficients(c, baseline, c.training, max_evaluations);
+    c.unpinned = unpinned;
+    if (!fitted) return std::unexpected(fitted.error());
+    c.ev.full_duration = true;
+    auto scores = score(c, fitted->model, c.all, true);
+    c.ev.full_duration = false;
+    if (!scores) return std::unexpected(scores.error());
+    auto fine = compare_ensembles(c.ev, fitted->model, *scores, free, candidates, eo);
+    if (!fine) return std::unexpected(fine.error());
+    c.evaluations += fine->replays;
+    ParticleModelRung& rung = check.rungs.at(k + 1);
+    rung.refitted = true;
+    rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
+    rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
+    rung.explains = fine->outcomes == outcomes && outcomes_consistent(fine->null_comparisons, free.size());
+    if (!rung.explains) continue;
+    check.resolution_needed = rung.spheres;
+    const auto passing = passing_hypotheses(*fine, eo.min_delta_bic, result.notes);
+    if (passing.empty()) {
+      if (!fine->hypotheses.empty())
+        result.notes.push_back(fmt::format(
+            "with {} the candidates tried beyond the release horizon: {} (none passes; the margin is {:.0f})",
+            rung.name,
+            fmt::join(fine->hypotheses | std::views::transform([](const EnsembleHypothesis& h) {
+                        return fmt::format("{} delta-BIC {:.1f}{}", effect_name(h.effect), h.delta_bic,
+                                           h.plausible ? "" : " (implausible value)");
+                      }),
+                      ", "),
+            eo.min_delta_bic));
+      say_particle_model(result, check, true);
+      result.improved = fine->calibrated;  // the finer clump's coefficients, calibrated on the outcomes
+      return true;
+    }
+    // Named on the clump the body needs: the report's ensemble is that clump's.
+    EnsembleReport& report = *result.ensemble;
+    report.null_chi2 = fine->null_chi2;
+    report.null_comparisons = fine->null_comparisons;
+    report.calibrated = fine->calibrated;
+    report.hypotheses = fine->hypotheses;
+    report.detectability = fine->detectability;
+    report.replays += fine->replays;
+    name_beyond_horizon(result, *fine, passing, eo.min_delta_bic);
+    result.statement += fmt::format(
+        " Replayed with {} ({} spheres): with the diagnosed clump the recorded outcomes differ from the replays "
+        "beyond the noise (chi^2 {:.1f} over {}), with this one they do not (chi^2 {:.1f}) until the effect is "
+        "tried.",
+        rung.name, rung.spheres, coarse_chi2, outcomes, fine->null_chi2);
+    return true;
+  }
+  return false;
+}
+
+/// Nothing named, yet the calibrated null leaves the recorded outcomes inconsistent with the
+/// replays: a mismatch beyond the release horizon. Unless a finer clump explains it
+/// (finer_clump_explains_outcomes), the verdict is unexplained.
+Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Model& baseline,
+                                  const std::vector<FreeCoefficient>& free, const std::vector<Effect>& candidates,
+                                  const EnsembleOptions& eo, int max_evaluations) {
+  const EnsembleReport& e = *result.ensemble;
+  if (outcomes_consistent(e.null_comparisons, free.size())) return {};
+  const double dof = null_dof(e.outcomes, free.size());
+  auto explained = finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, max_evaluations);
+  if (!explained) return std::unexpected(explained.error());
+  if (*explained) return {};
+  // Unexplained: the outcomes beyond the noise, three standard errors or more.
+  std::vector<std::string> far;
+  for (const auto& o : e.null_comparisons) {
+    if (std::abs(o.z) < 3.0) continue;
+    const bool drop = o.outcome == Outcome::ReboundHeight || o.outcome == Outcome::Drift;
+    const double scale = o.outcome == Outcome::RollTime ? 1.0 : 1e3;
+    const std::string where = fmt::format(
+        "{} {} of {} (recorded {:.3g}, replayed {:.3g} {}, z = {:.1f})", statistic_name(o.statistic),
+        outcome_name(o.outcome), recording_label((*c.ev.recordings)[o.recording], c.names[o.recording]),
+        o.recorded_value * scale, o.ensemble_value * scale, o.outcome == Outcome::RollTime ? "s" : "mm", o.z);
+    result.unexplained.push_back({c.names[o.recording], drop ? Phase::Rebound : Phase::Rest, o.z * o.z, where});
+    far.push_back(where);
+  }
+  if (!result.statement.empty()) result.notes.push_back(fmt::format("frame by frame: {}", result.statement));
+  result.verdict = Verdict::Unexplained;
+  result.basis = Basis::UnexplainedOutcomes;
+  result.statement = fmt::format(
+      "Mismatch beyond the release horizon not explained by any known effect: the recorded outcomes differ from "
+      "replays over the unknown release orientation (chi^2 {:.1f} over {} recorded means and spreads, p = {:.2g}){}; "
+      "no candidate "
+      "effect leaves them consistent{}.",
+      e.null_chi2, e.outcomes, chi2_upper_tail(e.null_chi2, dof),
+      far.empty() ? std::string() : fmt::format(", most in: {}", fmt::join(far, "; ")),
+      c.finer.empty() ? std::string() : ", nor does a finer clump of the same body");
+  result.experiment =
+      "compare the recorded and replayed outcomes in the report's ensemble section; more trials per set-up, or "
+      "recorded release orientations, would narrow the cause";
+  return {};
+}
+
+/// Whether the free flights rule out a centre-of-mass offset of the library's realistic
+/// magnitude: enough flights, no wobble, a body whose silhouette is not a disc (it tumbles
+/// after an off-centre impact: a sphere dropped straight may not turn at all), and the
+/// smallest offset they would have shown at most the realistic one. Notes it when they do.
+bool flights_rule_out_offset(DiagnoseResult& result) {
+  if (!result.flights || result.flights->detected || !(result.flights->allowance_m > 0.0)) return false;
+  const auto library = effect_library();
+  const auto& p = effect_spec(library, Effect::ComOffset).parameters;
+  const double realistic = std::hypot(p[0].realistic, p[1].realistic);
+  if (!(result.flights->smallest_offset_m <= realistic)) return false;
+  result.notes.push_back(fmt::format(
+      "com_offset not tried beyond the release horizon: the free flights show no wobble ({:.3f} mm, {} flights) and "
+      "would have shown an offset of {:.2f} mm or more (the library's realistic one is {:.2f} mm)",
+      result.flights->wobble_m * 1e3, result.flights->flights.size(), result.flights->smallest_offset_m * 1e3,
+      realistic * 1e3));
+  return true;
+}
+
+/// Beyond the release horizons: the recorded trials against replays from the release prior
+/// (diagnose/ensemble.hpp). The coefficients the frame fits left unpinned are calibrated on
+/// the outcomes; a candidate is named when its replays beat that null by the delta-BIC
+/// margin, at a plausible magnitude, and no other comes within the margin (else ambiguous).
+/// Runs when the frame-by-frame stages named nothing.
+Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& baseline,
+                             const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
+                             const DiagnoseOptions& options) {
+  std::vector<FreeCoefficient> free;
+  std::set<std::pair<std::string, Coefficient>> calibrate = c.unpinned;
+  calibrate.insert(c.parted.begin(), c.parted.end());
+  for (const auto& [surface, coefficient] : calibrate) {
+    if (coefficient == Coefficient::StaticFriction) continue;  // a tilt's, fitted frame by frame
+    for (std::size_t b = 0; b < baseline.base.size(); ++b) {
+      if (baseline.base[b].surface == surface) free.push_back({b, coefficient});
+    }
+  }
+  std::vector<Effect> candidates;
+  for (Effect e : effects) {
+    if (e != Effect::StaticKineticFriction && !(e == Effect::ComOffset && flights_rule_out_offset(result)))
+      candidates.push_back(e);
+  }
+  EnsembleOptions eo;
+  eo.replays = options.ensemble_replays;
+  eo.orientation_prior_deg = options.orientation_prior_deg;
+  eo.roll_on_edge = on_edge_rolls(*c.ev.clump, options);
+  eo.impact_accuracy = options.impact_accuracy;
+  eo.min_delta_bic = options.min_delta_bic;
+  eo.seed = options.seed;
+  auto ens = compare_ensembles(c.ev, baseline, full_scores, free, candidates, eo);
+  if (!ens) return std::unexpected(ens.error());
+  c.evaluations += ens->replays;
+  EnsembleReport report;
+  report.replays = ens->replays;
+  report.outcomes = ens->outcomes;
+  report.null_chi2 = ens->null_chi2;
+  report.recordings = c.names;
+  report.null_comparisons = ens->null_comparisons;
+  report.calibrated = ens->calibrated;
+  for (const auto& f : free) {
+    const auto& surface = baseline.base[f.surface].surface;
+    report.calibrated_here.push_back(fmt::format("{}:{}", surface, coefficient_name(f.coefficient)));
+    result.notes.push_back(
+        fmt::format("{} on {} calibrated on the recorded outcomes against replays from the release prior: {:.4g}",
+                    coefficient_name(f.coefficient), surface,
+                    coefficient_of(ens->calibrated[f.surface].interaction, f.coefficient)));
+  }
+  report.hypotheses = ens->hypotheses;
+  report.detectability = ens->detectability;
+  report.trials = ens->trials;
+  result.ensemble = std::move(report);
+  const auto library = effect_library();
+  // What the outcomes could decide: a candidate whose strong magnitude would have shown is
+  // decidable (and, not named below, absent); for the others, the trials per set-up at which
+  // it would show.
+  std::vector<std::string> more_trials;
+  for (const auto& d : ens->detectability) {
+    const std::string& name = effect_spec(library, d.effect).name;
+    if (d.strong_signal >= d.needed) {
+      std::erase(result.undecidable, name);
+    } else if (std::find(result.undecidable.begin(), result.undecidable.end(), name) != result.undecidable.end()) {
+      more_trials.push_back(std::isfinite(d.trials_needed) && d.trials_needed <= 1000
+                                ? fmt::format("{} about {:.0f}", name, d.trials_needed)
+                                : fmt::format("{} (the outcomes do not respond to it)", name));
+    }
+  }
+  if (result.verdict == Verdict::None && !more_trials.empty()) {
+    result.experiment = fmt::format(
+        "{}; or repeat each set-up more often: compared as a sample with replays over the unknown release, the "
+        "recorded outcomes would show each at its strong magnitude with these trials per set-up: {}",
+        result.experiment.empty() ? std::string("record each trial's release orientation to a few degrees")
+                                  : result.experiment,
+        fmt::join(more_trials, ", "));
+  }
+  std::vector<const EnsembleHypothesis*> passing = passing_hypotheses(*ens, options.min_delta_bic, result.notes);
+  if (!ens->outcomes || ens->hypotheses.empty() || passing.empty()) {
+    if (ens->outcomes > 0 && result.verdict == Verdict::None)
+      return outcomes_beyond_null(c, result, baseline, free, candidates, eo, options.max_evaluations);
+    return {};
+  }
+  // Before an effect is named beyond the horizon: a null inconsistent with the outcomes may be
+  // the particle model's (a coarse clump rolls and bounces otherwise), which a finer clump shows.
+  if (!outcomes_consistent(ens->null_comparisons, free.size())) {
+    auto explained = finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, options.max_evaluations);
+    if (!explained) return std::unexpected(explained.error());
+    if (*explained) return {};
+  }
+  name_beyond_horizon(result, *ens, passing, options.min_delta_bic);
+  return {};
+}
+
+/// The drops' free flights after the first contact (diagnose/flights.hpp), when there are drops: the body's reach
+/// and its silhouette's wander come from the finest particle model at hand (the nearest to the
+/// body itself), the silhouette sampled at 0.05 mm.
+std::optional<FlightWobble> flights_of(const Context& c, const std::vector<Recording>& recordings,
+                                       const DiagnoseOptions& options) {
+  if (std::none_of(recordings.begin(), recordings.end(), [](const Recording& r) { return r.test == LabTest::Drop; }))
+    return std::nullopt;
+  const Clump& body = c.finer.empty() ? *c.ev.clump : *c.finer.back();
+  FlightWobbleOptions fo;
+  fo.reach_m = body_reach(body.spheres);
+  fo.allowance_m = silhouette_wander(body.spheres, 5e-5, 400, options.seed);
+  fo.seed = options.seed;
+  return flight_wobble(recordings, c.camera_noise, fo);
+}
+
+/// Named from the free flights: the tracked point circles something as the body tumbles
+/// between bounces, so it is not the centre of mass. Needs no replay and no release state.
+void say_flights(DiagnoseResult& result, const FlightWobble& f) {
+  const auto library = effect_library();
+  const EffectSpec& spec = effect_spec(library, Effect::ComOffset);
+  if (!result.statement.empty()) result.notes.push_back(fmt::format("frame by frame: {}", result.statement));
+  result.verdict = Verdict::Named;
+  result.basis = Basis::FreeFlights;
+  result.effect = Effect::ComOffset;
+  result.candidates.clear();
+  result.unexplained.clear();
+  std::erase(result.undecidable, spec.name);
+  result.effect_parameters = {{"offset_m", f.offset_m, f.offset_low_m, f.offset_high_m}};
+  result.statement = fmt::format(
+      "Missing physics found in the free flights: {} ({}), at least about {:.2f} mm from the tracked point (95 % "
+      "interval {:.2f} to {:.2f} mm). Between bounces nothing touches the body and its centre of mass flies on a "
+      "parabola whatever the release; the tracked point leaves its own best parabola by {:.3f} mm RMS per "
+      "coordinate (the median of {} flights after the first contact), beyond the camera noise ({:.3f} mm) and "
+      "what this body's silhouette centroid wanders as it turns ({:.3f} mm). The direction of the offset in the "
+      "body is not seen without the particle's angle; a tracker that follows a surface feature instead of the "
+      "centroid would show the same.",
+      spec.name, spec.description, f.offset_m * 1e3, f.offset_low_m * 1e3, f.offset_high_m * 1e3, f.wobble_m * 1e3,
+      f.flights.size(), f.noise_m * 1e3, f.allowance_m * 1e3);
+  result.experiment =
+      "balance the particle on a knife edge along two axes to find its centre of mass, and check that the tracker "
+      "follows the silhouette's centroid";
+}
+
+}  // namespace clumpforge::diagnosis

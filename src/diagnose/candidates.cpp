@@ -1,0 +1,422 @@
+/// The candidates frame by frame: each effect fitted on the training trials, then on every trial
+/// against the second null; the detection limits; the particle-model check; the plotted tracks.
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iterator>
+#include <numbers>
+#include <numeric>
+#include <ranges>
+
+#include "core/rng.hpp"
+#include "diagnose/stages.hpp"
+#include "numerics/least_squares.hpp"
+#include "numerics/statistics.hpp"
+
+namespace clumpforge::diagnosis {
+
+/// Before a mismatch is blamed on missing physics: the coefficients refitted on every trial
+/// with each finer clump left (coarsest first, from `null`, the diagnosed clump's own refitted
+/// null); the first that leaves no large misfit explains the mismatch (its index in c.finer
+/// and its fit). The diagnosed clump stays c.ev.clump.
+Result<std::optional<std::pair<std::size_t, Fitted>>> particle_model_check(Context& c, ParticleModelCheck& check,
+                                                                           const Model& null,
+                                                                           const DiagnoseOptions& options) {
+  check.checked = true;
+  auto scored = score(c, null, c.all, true);
+  if (!scored) return std::unexpected(scored.error());
+  const Groups null_groups = phase_groups(c, c.all, *scored);
+  check.worst_phase_chi2_per_value = largest_misfit(c, null_groups).first;
+  check.chi2_per_value = total_chi_squared(*scored) / std::max(1, total_values(*scored));
+  Model from = null;
+  std::optional<std::pair<std::size_t, Fitted>> explained;
+  for (std::size_t k = 0; k < c.finer.size() && !explained; ++k) {
+    const ClumpSwap swap(c, c.finer[k]);
+    auto fitted = refit(c, from, nullptr, c.all, options.max_evaluations);
+    if (!fitted) return std::unexpected(fitted.error());
+    auto fine = score(c, fitted->model, c.all, true);
+    if (!fine) return std::unexpected(fine.error());
+    const auto [worst, large] = largest_misfit(c, phase_groups(c, c.all, *fine));
+    ParticleModelRung& rung = check.rungs.at(k + 1);
+    rung.refitted = true;
+    rung.chi2_per_value = fitted->chi2 / std::max(1, fitted->values);
+    rung.worst_phase_chi2_per_value = worst;
+    rung.explains = !large;
+    if (rung.explains) {
+      check.resolution_needed = rung.spheres;
+      explained = std::pair{k, std::move(*fitted)};
+    } else {
+      from = fitted->model;
+    }
+  }
+  return explained;
+}
+
+/// The verdict when a finer clump explains the mismatch: none, on the particle model's basis,
+/// with what was about to be blamed on missing physics and the resolution needed.
+void say_particle_model(DiagnoseResult& result, const ParticleModelCheck& check, bool outcomes) {
+  std::string blamed;
+  if (outcomes) {
+    blamed = "the recorded outcomes differ from replays over the unknown release orientation beyond the noise";
+  } else if (result.verdict == Verdict::Named && result.effect) {
+    blamed = fmt::format("the misfit {} absorbed is three times the noise or more", effect_name(*result.effect));
+  } else if (result.verdict == Verdict::Ambiguous) {
+    blamed = fmt::format("the misfit {} absorbed about equally is three times the noise or more",
+                         fmt::join(result.candidates, " and "));
+  } else {
+    blamed = fmt::format(
+        "the misfit in {} is three times the noise or more",
+        fmt::join(result.unexplained | std::views::transform([](const PhaseOf& u) { return u.where; }), "; "));
+  }
+  const auto it = std::find_if(check.rungs.begin(), check.rungs.end(), [](const auto& r) { return r.explains; });
+  if (!result.statement.empty())
+    result.notes.push_back(fmt::format("before the particle model was checked: {}", result.statement));
+  result.verdict = Verdict::None;
+  result.basis = Basis::ParticleModel;
+  result.effect.reset();
+  result.effect_parameters.clear();
+  result.candidates.clear();
+  result.unexplained.clear();
+  const std::string measure = outcomes ? "the largest z^2 of a recorded mean" : "chi^2 per value of the worst phase";
+  result.statement = fmt::format(
+      "No missing physics found: the mismatch is the particle model's. With {} ({} spheres) {} ({} {:.1f}); with {} "
+      "({} spheres) and its coefficients refitted, {} ({:.1f}){}. This body needs a clump of {} spheres or more; "
+      "diagnose again with it to look for physics beyond the particle model{}.",
+      check.diagnosed, check.spheres, blamed, measure, check.worst_phase_chi2_per_value, it->name, it->spheres,
+      outcomes ? "they are consistent with the recordings" : "no phase is", it->worst_phase_chi2_per_value,
+      outcomes ? ", and no candidate effect beats that by the margin" : "", it->spheres,
+      outcomes ? " frame by frame" : "");
+  result.experiment =
+      fmt::format("diagnose again with a clump of {} spheres or more (--spheres {})", it->spheres, it->spheres);
+}
+
+/// When no finer clump explains the mismatch, a note saying so (the verdict stands).
+void say_not_particle_model(DiagnoseResult& result, const ParticleModelCheck& check) {
+  std::vector<std::string> tried;
+  for (const auto& r : check.rungs) {
+    if (r.refitted)
+      tried.push_back(fmt::format("{} ({} spheres) leaves chi^2 per value {:.2f}, its worst phase {:.1f}", r.name,
+                                  r.spheres, r.chi2_per_value, r.worst_phase_chi2_per_value));
+  }
+  result.notes.push_back(fmt::format(
+      "not the particle model: with {} ({} spheres) every trial is at chi^2 per value {:.2f}, its worst phase {:.1f}; "
+      "refitted with finer clumps of the same body, {}",
+      check.diagnosed, check.spheres, check.chi2_per_value, check.worst_phase_chi2_per_value, fmt::join(tried, "; ")));
+}
+
+/// Stage 6, candidates: every effect fitted with all base coefficients free on the training
+/// trials, and judged (delta-BIC, held-out trials, plausibility, signature, large misfit);
+/// one report per effect in result.hypotheses, its fit returned in the same order.
+Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result, const Model& baseline,
+                                             const Located& located, const std::vector<Effect>& effects,
+                                             const DiagnoseOptions& options) {
+  const RunContext& run = *c.run;
+  const auto& recordings = *c.ev.recordings;
+  const auto library = effect_library();
+  std::vector<Fitted> fits;
+  // A candidate passes only when it clears a large misfit among the flagged phases
+  // (clears_large_misfit). With none, no candidate can pass, and their fits would only cost
+  // time (nine fits are most of a diagnosis); each is listed unfitted, and its detection
+  // limit is still probed (detection_limits).
+  bool any_large = false;
+  for (const auto& key : located.flagged) {
+    const auto b = located.base_train_groups.find(key);
+    any_large = any_large || (b != located.base_train_groups.end() && large_misfit(c, key, b->second));
+  }
+  if (!any_large) {
+    int values = 0;
+    for (std::size_t k = 0; k < c.all.size(); ++k) {
+      if (c.ev.trials[c.all[k]].training) values += located.base_scores[k].alignment.values;
+    }
+    for (Effect effect : effects) {
+      const EffectSpec& spec = effect_spec(library, effect);
+      HypothesisReport report;
+      report.name = spec.name;
+      report.fitted = false;
+      report.base = baseline.base;
+      report.values_used = values;
+      result.hypotheses.push_back(std::move(report));
+      Fitted unfitted{.model = baseline, .chi2 = located.sum(c.training), .evaluations = 0, .values = values};
+      unfitted.model.effect = effect;
+      unfitted.model.values = effect_off(spec);  // the baseline itself
+      fits.push_back(std::move(unfitted));
+    }
+    result.notes.push_back(
+        "candidate effects not fitted: no flagged phase misfits by three times hypot(noise, model accuracy) or more, "
+        "and an effect is named only when it clears such a misfit");
+    return fits;
+  }
+  for (std::size_t h = 0; h < effects.size(); ++h) {
+    const EffectSpec& spec = effect_spec(library, effects[h]);
+    run.report("fitting effects", 0.2 + 0.65 * static_cast<double>(h) / static_cast<double>(effects.size()));
+    if (run.should_stop()) return fail(ErrorCode::Cancelled, "cancelled");
+    // Judged on every test: an effect acts wherever the particle moves (drag on a roll,
+    // kinetic friction at an impact), and its fit must not spoil the other tests.
+    const auto& train = c.training;
+    const auto& held = c.heldout;
+    if (train.empty()) {
+      result.notes.push_back(fmt::format("{} not tested: no recordings of the tests it shows in", spec.name));
+      continue;
+    }
+    // Every coefficient stays free: the fair null is the baseline itself, polished the same way.
+    auto fit = fit_hypothesis(c, baseline, spec, train, options.max_evaluations);
+    if (!fit) return std::unexpected(fit.error());
+    HypothesisReport report;
+    report.name = spec.name;
+    report.evaluations = fit->evaluations;
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k)
+      report.values.push_back({spec.parameters[k].name, fit->model.values[k], NAN, NAN});
+    report.base = fit->model.base;
+    const double chi2_0 = located.sum(train);
+    report.delta_chi2 = chi2_0 - fit->chi2;
+    auto train_scores_k = score(c, fit->model, train, true);
+    if (!train_scores_k) return std::unexpected(train_scores_k.error());
+    report.values_used = total_values(*train_scores_k);
+    report.delta_bic =
+        report.delta_chi2 - static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
+    if (!held.empty()) {
+      auto held_scores = score(c, fit->model, held, false);
+      if (!held_scores) return std::unexpected(held_scores.error());
+      report.heldout_delta_chi2 = located.sum(held) - total_chi_squared(*held_scores);
+    }
+    report.improves_heldout = !held.empty() && report.heldout_delta_chi2 > 0.0;
+    report.plausible = true;
+    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
+      const double v = fit->model.values[k];
+      const auto& p = spec.parameters[k];
+      report.plausible = report.plausible && v >= p.plausible_low && v <= p.plausible_high;
+    }
+    if (spec.effect == Effect::ComOffset) {
+      const double offset = std::hypot(fit->model.values[0], fit->model.values[1]);
+      report.plausible = offset >= 2e-4 && offset <= 3e-3;
+    }
+    // Signature: the flagged phases of its tests, on the training trials.
+    std::vector<GroupKey> own;
+    for (const auto& key : located.flagged) {
+      if (std::find(spec.tests.begin(), spec.tests.end(), recordings[key.recording].test) != spec.tests.end())
+        own.push_back(key);
+    }
+    const Groups after = phase_groups(c, train, *train_scores_k);
+    report.flagged_excess_before = flagged_excess(located.base_train_groups, own);
+    report.flagged_excess_after = flagged_excess(after, own);
+    // It removes its signature: the flagged phases' excess falls by half or more, and none of
+    // them gets worse (beyond the chi^2 per value's own scatter).
+    bool none_worse = true;
+    for (const auto& key : own) {
+      const auto b = located.base_train_groups.find(key), a = after.find(key);
+      if (b == located.base_train_groups.end() || a == after.end() || b->second.values == 0 || a->second.values == 0)
+        continue;
+      const double before_per_value = b->second.chi2 / b->second.values,
+                   after_per_value = a->second.chi2 / a->second.values;
+      if (after_per_value > before_per_value + 3.0 * std::sqrt(2.0 / b->second.values)) {
+        none_worse = false;
+        report.worsened_phases.push_back(fmt::format("{} phases of {}: chi^2/value {:.2f} -> {:.2f}",
+                                                     phase_name(key.phase), c.names[key.recording], before_per_value,
+                                                     after_per_value));
+      }
+    }
+    report.clears_signature = none_worse && (report.flagged_excess_before <= 0.0 ||
+                                             report.flagged_excess_after <= 0.5 * report.flagged_excess_before);
+    // It explains a misfit no particle model's inaccuracy could: a flagged phase three times
+    // hypot(noise, model accuracy) or more (RMS) whose chi^2 it at least halves.
+    for (const auto& key : own) {
+      const auto b = located.base_train_groups.find(key), a = after.find(key);
+      if (b == located.base_train_groups.end() || a == after.end() || b->second.values == 0) continue;
+      report.clears_large_misfit =
+          report.clears_large_misfit || (large_misfit(c, key, b->second) && a->second.chi2 <= 0.5 * b->second.chi2);
+    }
+    report.passes = report.delta_bic >= options.min_delta_bic && report.improves_heldout && report.plausible &&
+                    report.clears_signature && report.clears_large_misfit;
+    result.hypotheses.push_back(std::move(report));
+    fits.push_back(std::move(*fit));
+  }
+  return fits;
+}
+
+/// For a `none`: the smallest effect of each candidate the data could have shown (its
+/// signal at a fifth of its realistic magnitude, the part the coefficients could absorb
+/// projected out, scaled quadratically to the delta-BIC margin; a lower bound), in each
+/// hypothesis report; returns the statements and the candidates not testable even at
+/// their strong magnitude.
+Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_limits(Context& c,
+                                                                                       DiagnoseResult& result,
+                                                                                       const Model& baseline,
+                                                                                       const std::vector<Fitted>& fits,
+                                                                                       const DiagnoseOptions& options) {
+  const auto library = effect_library();
+  // The smallest effect the data could have shown: an effect's signal (its replays minus
+  // the baseline's at a fifth of its realistic magnitude) with the part the coefficients
+  // could absorb projected out (their own finite-difference directions), scaled
+  // quadratically to the delta-BIC margin.
+  auto cells = [&](const Model& m) -> Result<Eigen::VectorXd> {
+    auto scores = evaluate(c.ev, m, c.training, false, true);
+    c.evaluations += static_cast<int>(c.training.size());
+    if (!scores) return std::unexpected(scores.error());
+    std::vector<double> all_cells;
+    for (const auto& sc : *scores) all_cells.insert(all_cells.end(), sc.residuals.begin(), sc.residuals.end());
+    return Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));
+  };
+  auto base_cells = cells(baseline);
+  if (!base_cells) return std::unexpected(base_cells.error());
+  std::vector<Eigen::VectorXd> directions;
+  for (std::size_t b = 0; b < baseline.base.size(); ++b) {
+    for (Coefficient k : {Coefficient::Restitution, Coefficient::StaticFriction, Coefficient::RollingFriction}) {
+      Model moved = baseline;
+      double& v = coefficient_of(moved.base[b].interaction, k);
+      v = k == Coefficient::RollingFriction && v < 1e-3 ? v + 1e-5 : v * 1.002;
+      auto moved_cells = cells(moved);
+      if (!moved_cells) return std::unexpected(moved_cells.error());
+      if (moved_cells->size() == base_cells->size()) directions.push_back(*moved_cells - *base_cells);
+    }
+  }
+  Eigen::MatrixXd absorb(base_cells->size(), static_cast<Eigen::Index>(directions.size()));
+  for (std::size_t k = 0; k < directions.size(); ++k) absorb.col(static_cast<Eigen::Index>(k)) = directions[k];
+  std::vector<std::string> limits, untestable;
+  for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
+    auto& report = result.hypotheses[h];
+    const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
+    Model probe = baseline;
+    probe.effect = spec.effect;
+    for (const auto& p : spec.parameters) probe.values.push_back(p.log_scale ? p.realistic : 0.2 * p.realistic);
+    auto probe_cells = cells(probe);
+    if (!probe_cells) return std::unexpected(probe_cells.error());
+    double signal = 0.0;
+    if (probe_cells->size() == base_cells->size()) {
+      const Eigen::VectorXd d = *base_cells - *probe_cells;
+      const Eigen::VectorXd kept =
+          absorb.cols() > 0 ? Eigen::VectorXd(d - absorb * absorb.colPivHouseholderQr().solve(d)) : d;
+      signal = kept.squaredNorm();
+    }
+    const double needed =
+        options.min_delta_bic + static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
+    const auto& first = spec.parameters[0];
+    if (first.log_scale) {
+      report.smallest_detectable = signal >= needed ? first.realistic : NAN;
+      limits.push_back(signal >= needed
+                           ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.realistic)
+                           : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.realistic));
+    } else {
+      const double null_value = effect_off(spec)[0];
+      const double probed = 0.2 * first.realistic;
+      report.smallest_detectable =
+          signal > 0.0 ? null_value + (probed - null_value) * std::sqrt(needed / signal) : kNever;
+      limits.push_back(fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable));
+    }
+    // Beyond its strong magnitude (or never): the predictable parts of these tracks cannot
+    // decide it; said, not counted as absent.
+    const bool testable = first.log_scale
+                              ? std::isfinite(report.smallest_detectable)
+                              : std::isfinite(report.smallest_detectable) && report.smallest_detectable <= first.strong;
+    if (!testable) untestable.push_back(spec.name);
+  }
+  return std::pair{std::move(limits), std::move(untestable)};
+}
+
+/// Stage 8, show: each recording's first tracked trial against the baseline and the improved
+/// model, whole tracks, in the recording's frame.
+void track_plots(const Context& c, DiagnoseResult& result, const std::vector<TrialScore>& full_base,
+                 const std::vector<TrialScore>& full_improved) {
+  const auto& recordings = *c.ev.recordings;
+  const auto& names = c.names;
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    for (std::size_t k = 0; k < c.all.size(); ++k) {
+      const TrackedTrial& tt = c.ev.trials[c.all[k]];
+      if (tt.recording != r) continue;
+      TrackComparison cmp;
+      cmp.recording = names[r];
+      cmp.horizon = tt.horizon;
+      const Alignment& a = full_base[k].alignment;
+      Track moved = in_replay_frame(*recordings[r].trials[tt.trial].track, a);
+      cmp.t = std::move(moved.t);
+      cmp.x = std::move(moved.x);
+      cmp.z = std::move(moved.z);
+      // Each model's replay mapped into the frame the recording is drawn in (the baseline's):
+      // a model has its own fitted release time and origins, and recorded time t maps to its
+      // replay time t - shift.
+      auto sampled = [&](const TrialScore& score, std::vector<double>& t, std::vector<double>& x,
+                         std::vector<double>& z) {
+        const Alignment& own = score.alignment;
+        const double dt = own.shift - a.shift, dx = own.x_offset - a.x_offset, dz = own.z_offset - a.z_offset;
+        for (std::size_t s = 0; s < score.replay.size(); s += 10) {
+          const ReplaySample& sample = score.replay[s];
+          if (sample.t + dt < cmp.t.front() || sample.t + dt > cmp.t.back()) continue;
+          t.push_back(sample.t + dt);
+          x.push_back(sample.x + dx);
+          z.push_back(sample.z + dz);
+        }
+      };
+      sampled(full_base[k], cmp.baseline_t, cmp.baseline_x, cmp.baseline_z);
+      sampled(full_improved[k], cmp.improved_t, cmp.improved_x, cmp.improved_z);
+      result.tracks.push_back(std::move(cmp));
+      break;
+    }
+  }
+}
+
+/// Stage 7a, every trial: each candidate that passed on the training trials refitted on every
+/// trial, from its training fit and from the second null's coefficients with the effect's
+/// training values (an effect and a coefficient trade off along a valley, so the training fit
+/// alone can be stuck on the wrong side); it passes when it beats the second null by the
+/// margin. The candidate contains the null (its parameter at the null value), so it does no
+/// worse than the null.
+Result<void> every_trial_stage(Context& c, DiagnoseResult& result, const std::vector<Fitted>& fits, SecondNull& second,
+                               const DiagnoseOptions& options) {
+  const auto library = effect_library();
+  for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
+    HypothesisReport& report = result.hypotheses[h];
+    if (!report.passes) continue;
+    auto null_all = second.get(c);
+    if (!null_all) return std::unexpected(null_all.error());
+    const Fitted& null = **null_all;
+    const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
+    Model from_null = null.model;
+    from_null.effect = fits[h].model.effect;
+    from_null.values = fits[h].model.values;
+    double chi2_all = null.chi2;
+    for (const Model* start : {&fits[h].model, static_cast<const Model*>(&from_null)}) {
+      auto on_all = refit(c, *start, &spec, c.all, options.max_evaluations);
+      if (!on_all) return std::unexpected(on_all.error());
+      report.evaluations += on_all->evaluations;
+      chi2_all = std::min(chi2_all, on_all->chi2);
+    }
+    report.all_trials_delta_bic =
+        null.chi2 - chi2_all - static_cast<double>(spec.parameters.size()) * std::log(std::max(1, null.values));
+    report.beats_refitted_null = report.all_trials_delta_bic >= options.min_delta_bic;
+    report.passes = report.beats_refitted_null;
+  }
+  return {};
+}
+
+/// Stage 7b, is it the particle model? When the verdict so far blames missing physics and finer
+/// clumps are left (see particle_model_check): the first that explains the mismatch becomes the
+/// improvement and the verdict none; else a note says it is not the particle model.
+Result<bool> particle_model_stage(Context& c, DiagnoseResult& result, SecondNull& second, Improvement& improvement,
+                                  const DiagnoseOptions& options) {
+  const bool blamed =
+      result.verdict == Verdict::Named || result.verdict == Verdict::Ambiguous || !result.unexplained.empty();
+  if (!blamed || c.finer.empty()) return false;
+  auto null_all = second.get(c);
+  if (!null_all) return std::unexpected(null_all.error());
+  c.run->report("particle model", 0.85);
+  auto explained = particle_model_check(c, *result.particle_model, (*null_all)->model, options);
+  if (!explained) return std::unexpected(explained.error());
+  if (!*explained) {
+    say_not_particle_model(result, *result.particle_model);
+    return false;
+  }
+  improvement.clump = c.finer[(*explained)->first];
+  improvement.model = (*explained)->second.model;
+  const ClumpSwap swap(c, improvement.clump);
+  auto s = score(c, improvement.model, c.all, true);
+  if (!s) return std::unexpected(s.error());
+  improvement.scores = std::move(*s);
+  improvement.changed = true;
+  say_particle_model(result, *result.particle_model, false);
+  return true;
+}
+
+}  // namespace clumpforge::diagnosis

@@ -1,0 +1,335 @@
+#pragma once
+/// The diagnosis's stages and what they share: private to the diagnose module (not installed).
+/// diagnose() (diagnose.cpp) runs the stages in order; the other files of the folder hold them:
+/// - early_stages.cpp: inputs checked, tracks loaded, the release state, the clump's
+///   resolution, the baseline fit, the phases located;
+/// - fitting.cpp: the replays scored against the tracks, the predictability horizons, the
+///   baseline fit, Levenberg-Marquardt over a model's parameters, a hypothesis's fit;
+/// - residuals.cpp: the residuals per recording and phase and their statistics, the phases
+///   beyond the noise, the fit's quality;
+/// - candidates.cpp: each candidate effect fitted frame by frame (training trials, then every
+///   trial against the second null), the detection limits, the particle-model check;
+/// - beyond_horizon.cpp: the free flights, and the outcomes over the unknown release compared
+///   with replay ensembles;
+/// - verdict.cpp: the decision between the hypotheses and what the result says.
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "diagnose/diagnose.hpp"
+#include "diagnose/ensemble.hpp"
+#include "diagnose/flights.hpp"
+#include "diagnose/model.hpp"
+#include "diagnose/phases.hpp"
+#include "diagnose/release.hpp"
+#include "numerics/minimize.hpp"
+
+namespace clumpforge::diagnosis {
+
+constexpr double kNever = std::numeric_limits<double>::infinity();
+
+/// A phase is a mismatch only when its residual also exceeds the noise in size: chi^2 per
+/// value above 1.5 (an RMS misfit above 0.7 sigma). Replays of irregular bodies near their
+/// predictability horizon never match to a small fraction of the noise, and a statistically
+/// significant 0.02 mm is not a physics question.
+constexpr double kPracticalExcess = 1.5;
+
+/// A phase's residual beyond the noise: significant after a Bonferroni correction over the
+/// `groups` phases, and large (kPracticalExcess).
+/// chi^2 per value of a misfit three times the noise (RMS): a mismatch whatever its shape.
+constexpr double kLargeMisfit = 10.0;
+
+/// A coefficient whose chi^2 moves by less than this across its whole range is not pinned by
+/// the fitted windows (the delta-BIC margin: no evidence either way).
+constexpr double kUnpinned = 10.0;
+
+/// Recorded outcomes are consistent with replays while their chi^2 tail is at least this (the
+/// margin a candidate must leave them within, see judge_ensembles).
+constexpr double kConsistentTail = 1e-4;
+
+struct FitParameter {
+  bool effect = false;
+  std::size_t index = 0;  ///< effect parameter index, or surface index
+  Coefficient coefficient = Coefficient::Restitution;
+  double lower = 0.0, upper = 1.0;
+  bool log_scale = false;
+  double to_unit(double v) const {
+    if (log_scale) return (std::log10(v) - std::log10(lower)) / (std::log10(upper) - std::log10(lower));
+    return (v - lower) / (upper - lower);
+  }
+  double from_unit(double u) const {
+    u = std::clamp(u, 0.0, 1.0);
+    if (log_scale) return std::pow(10.0, std::log10(lower) + u * (std::log10(upper) - std::log10(lower)));
+    return lower + u * (upper - lower);
+  }
+};
+
+/// Grid points of the first (wide) search: the chi^2 of an irregular body has several dips,
+/// a roll's in mu_r most of all, so the grid is fine enough to land in the right one.
+inline int wide_grid(Coefficient c) {
+  return c == Coefficient::RollingFriction ? 25 : c == Coefficient::Restitution ? 18 : 14;
+}
+
+struct GroupKey {
+  std::size_t recording = 0;
+  Phase phase = Phase::Hold;
+  auto operator<=>(const GroupKey&) const = default;
+};
+
+struct Segment {
+  std::vector<double> tau, rx, rz;  ///< time since the trial entered the phase, residuals (sigma units)
+  bool training = true;             ///< from a training trial (else held out)
+  std::size_t trial = 0;            ///< which tracked trial
+};
+
+struct Group {
+  double chi2 = 0.0;
+  int values = 0;
+  double sum_x = 0.0, sum_z = 0.0;
+  int count_x = 0, count_z = 0;
+  double sq_x = 0.0, sq_z = 0.0;
+  std::vector<Segment> segments;
+};
+
+using Groups = std::map<GroupKey, Group>;
+
+/// Least-squares r = a tau^k for k = 1..4 over the group's frames (one axis); the best k,
+/// its amplitude at tau_end and the share of the sum of squares it explains.
+struct Growth {
+  int power = 0;
+  double at_end = 0.0;
+  double explained = 0.0;
+};
+
+/// What a smooth discrepancy explains in a group: one cubic in the time since the phase
+/// began, per axis, shared by every trial's segment (8 parameters). A missing effect bends
+/// every trial the same way in a phase; the leftovers of a release state the model cannot
+/// know differ from trial to trial and are not fitted by a shared shape.
+struct SmoothDiscrepancy {
+  double gain = 0.0;          ///< chi^2 the cubic fitted to every segment removes
+  double heldout_gain = 0.0;  ///< chi^2 the cubic fitted to the training segments removes from the held-out ones
+  int parameters = 0;
+};
+
+/// The group's chi^2 per value without its worst trial, and that trial's own: a misfit that
+/// one trial carries (a tumble the fitted coefficients do not reproduce) is an outlier, not
+/// a mismatch the trials share.
+struct TrialSpread {
+  double worst = 0.0, rest = 0.0;  ///< chi^2 per value of the worst trial, of the others
+  int trials = 0;
+};
+
+struct Context {
+  Evaluator ev;
+  /// Coefficients the fitted windows do not pin (surface, which), and the materials table's
+  /// values they keep.
+  std::set<std::pair<std::string, Coefficient>> unpinned;
+  /// Coefficients (surface, which) of recordings whose recorded trials part where the replays
+  /// agree (recorded_horizons): the frames before the parting pin them, but whatever parts the
+  /// trials acts there too, so beyond the horizons they are calibrated again with each candidate.
+  std::set<std::pair<std::string, Coefficient>> parted;
+  std::vector<SurfaceParameters> table_values;
+  std::vector<std::string> names;
+  std::vector<double> camera_noise;  ///< per recording [m], from its tracks
+  std::vector<std::size_t> training, heldout, all;
+  int evaluations = 0;
+  const RunContext* run = nullptr;
+  /// Finer clumps of the same body than the one diagnosed (c.ev.clump), coarsest first: what the
+  /// particle-model check refits with before a mismatch is blamed on missing physics.
+  std::vector<const Clump*> finer;
+};
+
+/// Replays run with `clump` while it lives; the clump before it is restored after.
+class ClumpSwap {
+ public:
+  ClumpSwap(Context& c, const Clump* clump) : c_(c), kept_(c.ev.clump) { c.ev.clump = clump; }
+  ~ClumpSwap() { c_.ev.clump = kept_; }
+  ClumpSwap(const ClumpSwap&) = delete;
+  ClumpSwap& operator=(const ClumpSwap&) = delete;
+
+ private:
+  Context& c_;
+  const Clump* kept_;
+};
+
+struct Fitted {
+  Model model;
+  double chi2 = 0.0;
+  int evaluations = 0;
+  int values = 0;  ///< residual values behind chi2 (set by refit)
+};
+
+/// What the baseline leaves, per trial and phase.
+struct Located {
+  std::vector<TrialScore> base_scores;  ///< every trial (c.all), replays kept
+  std::vector<double> base_chi2;        ///< per trial
+  Groups base_train_groups;             ///< the training trials' phases
+  std::vector<GroupKey> flagged;        ///< phases beyond the noise (every trial)
+  double sum(const std::vector<std::size_t>& which) const {
+    double total = 0.0;
+    for (std::size_t i : which) total += base_chi2[i];
+    return total;
+  }
+};
+
+/// What the diagnosis shows as the improvement: the model, the clump it replays with, and its
+/// scores on every trial within the horizons.
+struct Improvement {
+  Model model;
+  const Clump* clump = nullptr;
+  std::vector<TrialScore> scores;
+  bool changed = false;  ///< not the baseline: an effect, recalibrated coefficients or a finer clump
+};
+
+class SecondNull;  // below: the coefficients refitted on every trial, once
+
+// ---- residuals.cpp ---------------------------------------------------------------------------
+
+bool beyond_noise(double chi2, int values, std::size_t groups);
+Model apply_parameters(const Model& start, const std::vector<FitParameter>& parameters,
+                       const std::vector<double>& unit);
+void accumulate(Groups& groups, std::size_t recording, LabTest test, const Track& track,
+                const std::vector<ReplaySample>& replay, const Weights& sigma, const Alignment& alignment,
+                double cutoff, bool training, std::size_t trial);
+Growth growth_law(const Group& g, bool z_axis);
+SmoothDiscrepancy smooth_discrepancy(const Group& g);
+TrialSpread trial_spread(const Group& g);
+bool outlier_trial(const Group& g, const TrialSpread& spread);
+double rms_mm(const Context& c, const std::vector<std::size_t>& which, const std::vector<TrialScore>& scores);
+double summary_scale(LabTest test);
+FitQuality quality(const Context& c, const std::vector<TrialScore>& scores);
+Groups phase_groups(const Context& c, const std::vector<std::size_t>& which, const std::vector<TrialScore>& scores);
+std::string recording_label(const Recording& r, const std::string& name);
+std::vector<PhaseReport> locate(const Context& c, const Groups& groups);
+double flagged_excess(const Groups& groups, const std::vector<GroupKey>& flagged);
+std::string experiment_for(const std::string& a, const std::string& b);
+bool large_misfit(const Context& c, const GroupKey& key, const Group& g);
+std::vector<PhaseOf> smooth_misfits(const Context& c, const Groups& groups, const DiagnoseOptions& options);
+std::pair<double, bool> largest_misfit(const Context& c, const Groups& groups);
+double replay_difference(const TrackedTrial& tt, const std::vector<ReplaySample>& a,
+                         const std::vector<ReplaySample>& b);
+
+// ---- fitting.cpp -----------------------------------------------------------------------------
+
+Result<std::vector<TrialScore>> score(Context& c, const Model& m, const std::vector<std::size_t>& which, bool keep);
+Result<void> set_horizons(Context& c, const Model& model, double perturbation);
+Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vector<std::size_t>& trials);
+Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::vector<FitParameter>& parameters,
+                                    const std::vector<std::size_t>& which, std::vector<double> unit, int iterations);
+std::pair<Model, std::vector<FitParameter>> fit_parameters(const Context& c, const Model& model, const EffectSpec* spec,
+                                                           const std::vector<std::size_t>& which, bool fresh);
+std::vector<double> unit_point(const Model& start, const std::vector<FitParameter>& parameters);
+Result<Fitted> refit(Context& c, const Model& model, const EffectSpec* spec, const std::vector<std::size_t>& which,
+                     int max_evaluations);
+Result<Fitted> fit_coefficients(Context& c, const Model& start, const std::vector<std::size_t>& trials,
+                                int max_evaluations);
+Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpec& spec,
+                              const std::vector<std::size_t>& which, int max_evaluations);
+
+// ---- early_stages.cpp ------------------------------------------------------------------------
+
+Result<void> check_options(const DiagnoseOptions& options);
+std::vector<double> load_tracks(Context& c, DiagnoseResult& result, const std::vector<Recording>& recordings,
+                                const std::vector<std::string>& names, const DiagnoseOptions& options);
+Result<Model> starting_model(Context& c, const MaterialTable& table, const std::vector<Recording>& recordings,
+                             const DiagnoseOptions& options);
+bool on_edge_rolls(const Clump& clump, const DiagnoseOptions& options);
+Result<std::vector<std::string>> settle_release_state(Context& c, const Model& model, const DiagnoseOptions& options);
+Result<void> release_stage(Context& c, DiagnoseResult& result, const Model& baseline, const DiagnoseOptions& options);
+Result<bool> recorded_horizons(Context& c, DiagnoseResult& result, const Model& baseline);
+Result<Model> baseline_stage(Context& c, DiagnoseResult& result, Model baseline, const DiagnoseOptions& options);
+Result<Located> locate_stage(Context& c, DiagnoseResult& result, const Model& baseline);
+Result<void> resolution_stage(Context& c, DiagnoseResult& result, const Model& start, const DiagnoseOptions& options);
+Result<void> check_inputs(const Clump& clump, const std::vector<Recording>& recordings,
+                          const std::vector<std::string>& names, const DiagnoseOptions& options);
+std::optional<std::pair<Basis, std::string>> undecidable_tracks(const Context& c,
+                                                                const std::vector<double>& camera_noise);
+
+// ---- candidates.cpp --------------------------------------------------------------------------
+
+Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result, const Model& baseline,
+                                             const Located& located, const std::vector<Effect>& effects,
+                                             const DiagnoseOptions& options);
+Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_limits(Context& c,
+                                                                                       DiagnoseResult& result,
+                                                                                       const Model& baseline,
+                                                                                       const std::vector<Fitted>& fits,
+                                                                                       const DiagnoseOptions& options);
+Result<void> every_trial_stage(Context& c, DiagnoseResult& result, const std::vector<Fitted>& fits, SecondNull& second,
+                               const DiagnoseOptions& options);
+Result<std::optional<std::pair<std::size_t, Fitted>>> particle_model_check(Context& c, ParticleModelCheck& check,
+                                                                           const Model& null,
+                                                                           const DiagnoseOptions& options);
+void say_particle_model(DiagnoseResult& result, const ParticleModelCheck& check, bool outcomes);
+void say_not_particle_model(DiagnoseResult& result, const ParticleModelCheck& check);
+Result<bool> particle_model_stage(Context& c, DiagnoseResult& result, SecondNull& second, Improvement& improvement,
+                                  const DiagnoseOptions& options);
+void track_plots(const Context& c, DiagnoseResult& result, const std::vector<TrialScore>& full_base,
+                 const std::vector<TrialScore>& full_improved);
+
+// ---- beyond_horizon.cpp ----------------------------------------------------------------------
+
+double largest_z2(const std::vector<OutcomeComparison>& comparisons);
+double null_dof(int outcomes, std::size_t free);
+bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted);
+std::vector<const EnsembleHypothesis*> passing_hypotheses(const EnsembleResult& ens, double min_delta_bic,
+                                                          std::vector<std::string>& notes);
+void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
+                         const std::vector<const EnsembleHypothesis*>& passing, double min_delta_bic);
+Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
+                                           const std::vector<FreeCoefficient>& free,
+                                           const std::vector<Effect>& candidates, const EnsembleOptions& eo,
+                                           int max_evaluations);
+Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Model& baseline,
+                                  const std::vector<FreeCoefficient>& free, const std::vector<Effect>& candidates,
+                                  const EnsembleOptions& eo, int max_evaluations);
+bool flights_rule_out_offset(DiagnoseResult& result);
+Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& baseline,
+                             const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
+                             const DiagnoseOptions& options);
+std::optional<FlightWobble> flights_of(const Context& c, const std::vector<Recording>& recordings,
+                                       const DiagnoseOptions& options);
+void say_flights(DiagnoseResult& result, const FlightWobble& f);
+
+// ---- verdict.cpp -----------------------------------------------------------------------------
+
+void say_ambiguous(DiagnoseResult& result, const Decision& decision);
+Result<void> say_named(Context& c, DiagnoseResult& result, const Fitted& fit, const Decision& decision);
+void say_unexplained_phases(DiagnoseResult& result, const DiagnoseOptions& options);
+Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline, const std::vector<Fitted>& fits,
+                      const Groups& final_groups, const DiagnoseOptions& options);
+
+/// The second null: the coefficients refitted on every trial, the held-out ones included,
+/// computed once, when first needed. When the training trials pin a coefficient poorly (a
+/// roll fitted only up to its short horizon), the held-out trials show a miscalibration, which
+/// an effect with a free parameter can absorb; it must beat the coefficients doing the same
+/// before it is named.
+class SecondNull {
+ public:
+  SecondNull(const Model& baseline, int max_evaluations) : baseline_(baseline), max_evaluations_(max_evaluations) {}
+  Result<const Fitted*> get(Context& c) {
+    if (!fit_) {
+      // The baseline's own procedure on every trial (grids, so a coefficient stuck in the
+      // wrong dip of an irregular body's chi^2 can leave it), and a local polish from the
+      // baseline; the better is the null.
+      auto global = fit_coefficients(c, baseline_, c.all, max_evaluations_);
+      if (!global) return std::unexpected(global.error());
+      auto local = refit(c, baseline_, nullptr, c.all, max_evaluations_);
+      if (!local) return std::unexpected(local.error());
+      fit_ = global->chi2 <= local->chi2 ? std::move(*global) : std::move(*local);
+    }
+    return &*fit_;
+  }
+  const std::optional<Fitted>& fit() const { return fit_; }
+
+ private:
+  const Model& baseline_;
+  int max_evaluations_;
+  std::optional<Fitted> fit_;
+};
+
+}  // namespace clumpforge::diagnosis

@@ -1,0 +1,243 @@
+/// The verdict: the decision between the hypotheses and what the result says for each verdict.
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iterator>
+#include <numbers>
+#include <numeric>
+#include <ranges>
+
+#include "core/rng.hpp"
+#include "diagnose/stages.hpp"
+#include "numerics/least_squares.hpp"
+#include "numerics/statistics.hpp"
+
+namespace clumpforge::diagnosis {
+
+/// Ambiguous frame by frame: the candidates within the margin, and the experiment that would
+/// separate them.
+void say_ambiguous(DiagnoseResult& result, const Decision& decision) {
+  const auto& best = result.hypotheses[*decision.best];
+  const auto& other = result.hypotheses[decision.close.front()];
+  result.verdict = Verdict::Ambiguous;
+  result.basis = Basis::FrameByFrame;
+  result.candidates.push_back(best.name);
+  for (std::size_t k : decision.close) result.candidates.push_back(result.hypotheses[k].name);
+  result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
+  result.statement = fmt::format(
+      "The recordings disagree with the baseline, and {} explain it about equally well ({}); "
+      "no single effect can be named. To separate them: {}.",
+      fmt::join(result.candidates, " and "),
+      other.passes ? fmt::format("delta-BIC refitted on every trial {:.1f} vs {:.1f}", best.all_trials_delta_bic,
+                                 other.all_trials_delta_bic)
+                   : fmt::format("training delta-BIC {:.1f} vs {:.1f}", best.delta_bic, other.delta_bic),
+      result.experiment);
+}
+
+/// Named frame by frame: the effect's parameters with 95 % intervals from the chi^2 curvature
+/// (others held, scaled by the fit's reduced chi^2 when it is above 1), and the statement with
+/// the runner-up (the next candidate on every trial when another passed, else the next by
+/// training delta-BIC).
+Result<void> say_named(Context& c, DiagnoseResult& result, const Fitted& fit, const Decision& decision) {
+  HypothesisReport& report = result.hypotheses[*decision.best];
+  const Model& improved = fit.model;
+  result.verdict = Verdict::Named;
+  result.basis = Basis::FrameByFrame;
+  result.effect = *improved.effect;
+  const auto library = effect_library();
+  const EffectSpec& spec = effect_spec(library, *improved.effect);
+  for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
+    const auto& p = spec.parameters[k];
+    const double v = improved.values[k];
+    const double step = p.log_scale ? v * 0.1 : std::max(0.05 * std::abs(v), 0.01 * (p.upper - p.lower));
+    auto chi2_at = [&](double value) -> Result<double> {
+      Model m = improved;
+      m.values[k] = value;
+      auto s = score(c, m, c.training, false);
+      if (!s) return std::unexpected(s.error());
+      return total_chi_squared(*s);
+    };
+    auto lo = chi2_at(v - step), hi = chi2_at(v + step);
+    if (!lo || !hi) return std::unexpected(!lo ? lo.error() : hi.error());
+    const double curvature = (*lo + *hi - 2.0 * fit.chi2) / (step * step);
+    const double inflation = std::sqrt(std::max(1.0, fit.chi2 / std::max(1, report.values_used)));
+    const double se = curvature > 0.0 ? inflation * std::sqrt(2.0 / curvature) : kNever;
+    report.values[k].low = std::max(p.lower, v - 1.96 * se);
+    report.values[k].high = std::min(p.upper, v + 1.96 * se);
+  }
+  result.effect_parameters = report.values;
+  std::string next = "none";
+  if (decision.runner_up) {
+    const auto& r = result.hypotheses[*decision.runner_up];
+    next = fmt::format("{}, {:.1f} behind when both are refitted on every trial (training delta-BIC {:.1f})", r.name,
+                       report.all_trials_delta_bic - r.all_trials_delta_bic, r.delta_bic);
+  } else if (decision.training_next) {
+    next = fmt::format("{} at training delta-BIC {:.1f}", result.hypotheses[*decision.training_next].name,
+                       result.hypotheses[*decision.training_next].delta_bic);
+  }
+  result.statement = fmt::format(
+      "Missing physics found: {} ({}), {}; it improves the training fit by delta-chi^2 {:.0f} (delta-BIC {:.1f}) "
+      "and the held-out trials by delta-chi^2 {:.0f}; next best: {}.",
+      report.name, spec.description,
+      fmt::join(report.values | std::views::transform([](const ParameterValue& p) {
+                  return fmt::format("{} = {:.4g} [{:.4g}, {:.4g}]", p.name, p.value, p.low, p.high);
+                }),
+                ", "),
+      report.delta_chi2, report.delta_bic, report.heldout_delta_chi2, next);
+  return {};
+}
+
+/// Unexplained frame by frame: the phases no candidate explains.
+void say_unexplained_phases(DiagnoseResult& result, const DiagnoseOptions& options) {
+  result.verdict = Verdict::Unexplained;
+  result.basis = Basis::UnexplainedPhases;
+  result.statement = fmt::format(
+      "Mismatch not explained by any known effect in: {}. Each is beyond the noise after the coefficients are "
+      "refitted on every trial: a smooth per-phase shape shared by the trials removes it (delta-BIC >= {:g}, "
+      "cross-validated), or it is three times the noise or more; none of the {} candidate effects passes every "
+      "check.",
+      fmt::join(result.unexplained | std::views::transform([](const PhaseOf& u) { return u.where; }), "; "),
+      options.min_delta_bic, result.hypotheses.size());
+  result.experiment = "look at the residual plots of these phases; add set-ups that isolate them";
+}
+
+/// None frame by frame: what is left (phases slightly beyond the noise with no shape the trials
+/// share, outlier trials: said, not hidden), the smallest effects the recordings would have
+/// shown, and the candidates their predictable parts cannot decide.
+Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline, const std::vector<Fitted>& fits,
+                      const Groups& final_groups, const DiagnoseOptions& options) {
+  result.verdict = Verdict::None;
+  auto detection = detection_limits(c, result, baseline, fits, options);
+  if (!detection) return std::unexpected(detection.error());
+  const auto& [limits, untestable] = *detection;
+  std::vector<std::string> slight, outliers;
+  for (const auto& [key, g] : final_groups) {
+    if (key.phase == Phase::Hold || g.values < 20 || !beyond_noise(g.chi2, g.values, final_groups.size())) continue;
+    if (const TrialSpread spread = trial_spread(g); outlier_trial(g, spread)) {
+      outliers.push_back(fmt::format("{} phases of {} (one trial at chi^2/value {:.0f}, the other {} at {:.2f})",
+                                     phase_name(key.phase), c.names[key.recording], spread.worst, spread.trials - 1,
+                                     spread.rest));
+      result.outliers.push_back({c.names[key.recording], key.phase, spread.worst, outliers.back()});
+    } else {
+      slight.push_back(fmt::format("{} phases of {} (chi^2/value {:.2f})", phase_name(key.phase),
+                                   c.names[key.recording], g.chi2 / g.values));
+    }
+  }
+  std::string residual_state =
+      slight.empty()
+          ? std::string("the residuals are consistent with the estimated noise level once the coefficients are fitted")
+          : fmt::format(
+                "the residuals are at the noise level except for a small misfit, below three times the noise and "
+                "with no shape the trials share, in {}",
+                fmt::join(slight, ", "));
+  if (!outliers.empty()) {
+    residual_state += fmt::format(
+        "; one trial alone misfits in {}: an outlier (a tumble the fitted coefficients do not reproduce), not a "
+        "mismatch the trials share",
+        fmt::join(outliers, ", "));
+    result.notes.push_back(fmt::format("outlier trials, not counted as a mismatch: {}", fmt::join(outliers, ", ")));
+  }
+  result.basis = slight.empty() ? Basis::Consistent : Basis::SlightMisfit;
+  result.statement = fmt::format(
+      "No missing physics found: no candidate passes every check and {}. Smallest effects these recordings would "
+      "have revealed (at delta-BIC {:g}, after the coefficients absorb what they can, to first order): {}.",
+      residual_state, options.min_delta_bic, fmt::join(limits, "; "));
+  if (!untestable.empty()) {
+    // What the frame-by-frame fit cannot reach: the effects that act after the release
+    // horizon of an irregular body (its contacts) need more than these tracks.
+    result.undecidable = untestable;
+    result.statement += fmt::format(
+        " Not decidable from the predictable parts of these tracks (even at their strong magnitude): {}; they act "
+        "where the unknown release orientation decides the path.",
+        fmt::join(untestable, ", "));
+    result.experiment =
+        "record each trial's release orientation to a few degrees (a marked particle, a release jig), or repeat the "
+        "tests with a sphere of the same material, whose path does not depend on it";
+  }
+  return {};
+}
+
+}  // namespace clumpforge::diagnosis
+
+namespace clumpforge {
+
+std::string_view basis_name(Basis basis) {
+  switch (basis) {
+    case Basis::Consistent:
+      return "consistent";
+    case Basis::SlightMisfit:
+      return "slight_misfit";
+    case Basis::FrameByFrame:
+      return "frame_by_frame";
+    case Basis::Ensemble:
+      return "ensemble";
+    case Basis::UnexplainedPhases:
+      return "unexplained_phases";
+    case Basis::TooFewTrials:
+      return "too_few_trials";
+    case Basis::TooNoisy:
+      return "too_noisy";
+    case Basis::SummariesOnly:
+      return "summaries_only";
+    case Basis::ParticleModel:
+      return "particle_model";
+    case Basis::UnexplainedOutcomes:
+      return "unexplained_outcomes";
+    case Basis::FreeFlights:
+      return "free_flights";
+  }
+  return "?";
+}
+
+std::string verdict_name(const DiagnoseResult& result) {
+  switch (result.verdict) {
+    case Verdict::None:
+      return "none";
+    case Verdict::Named:
+      return result.effect ? effect_name(*result.effect) : "none";
+    case Verdict::Ambiguous:
+      return "ambiguous";
+    case Verdict::Unexplained:
+      return "unexplained";
+    case Verdict::Undecidable:
+      return "undecidable";
+  }
+  return "none";
+}
+
+Decision decide(const std::vector<HypothesisReport>& hypotheses, double min_delta_bic) {
+  Decision decision;
+  std::vector<std::size_t> order(hypotheses.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return hypotheses[a].delta_bic > hypotheses[b].delta_bic; });
+  // The data favour a rejected explanation: nothing is named.
+  if (order.empty() || !hypotheses[order[0]].passes) return decision;
+  // The passing candidates compete on every trial, each refitted there against the same
+  // second null: a training fit can stop in a local minimum.
+  std::vector<std::size_t> passing;
+  std::copy_if(order.begin(), order.end(), std::back_inserter(passing),
+               [&](std::size_t k) { return hypotheses[k].passes; });
+  std::stable_sort(passing.begin(), passing.end(), [&](std::size_t a, std::size_t b) {
+    return hypotheses[a].all_trials_delta_bic > hypotheses[b].all_trials_delta_bic;
+  });
+  decision.best = passing[0];
+  if (passing.size() > 1) decision.runner_up = passing[1];
+  const HypothesisReport& best = hypotheses[passing[0]];
+  for (std::size_t k : order) {
+    if (k == passing[0]) continue;
+    if (!decision.training_next) decision.training_next = k;
+    const HypothesisReport& other = hypotheses[k];
+    const bool near = other.passes ? best.all_trials_delta_bic - other.all_trials_delta_bic < min_delta_bic
+                                   : other.delta_bic >= min_delta_bic &&
+                                         hypotheses[order[0]].delta_bic - other.delta_bic < min_delta_bic;
+    if (near) decision.close.push_back(k);
+  }
+  return decision;
+}
+
+}  // namespace clumpforge
