@@ -159,14 +159,17 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["flights"] = nlohmann::json();
   if (r.flights) {
     const auto& f = *r.flights;
+    // Too few flights to judge: only their number and the allowance; the measures are null.
+    const auto measured = [&f](double metres) { return f.judged ? nlohmann::json(metres * 1e3) : nlohmann::json(); };
     j["flights"] = {{"flights", f.flights.size()},
-                    {"wobble_mm", f.wobble_m * 1e3},
-                    {"noise_mm", f.noise_m * 1e3},
+                    {"judged", f.judged},
+                    {"wobble_mm", measured(f.wobble_m)},
+                    {"noise_mm", measured(f.noise_m)},
                     {"allowance_mm", f.allowance_m * 1e3},
                     {"detected", f.detected},
-                    {"offset_mm", f.offset_m * 1e3},
-                    {"offset_low_mm", f.offset_low_m * 1e3},
-                    {"offset_high_mm", f.offset_high_m * 1e3},
+                    {"offset_mm", measured(f.offset_m)},
+                    {"offset_low_mm", measured(f.offset_low_m)},
+                    {"offset_high_mm", measured(f.offset_high_m)},
                     {"smallest_offset_mm", finite_or_null(f.smallest_offset_m * 1e3)}};
   }
   if (r.ensemble) {

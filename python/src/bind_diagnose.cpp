@@ -113,6 +113,8 @@ void bind_result(py::module_& m) {
                     "[m] RMS per coordinate about the flights' parabolas beyond the noise (median flight)")
       .def_readonly("noise_m", &FlightWobble::noise_m)
       .def_readonly("allowance_m", &FlightWobble::allowance_m, "[m] the silhouette centroid's wander for this body")
+      .def_readonly("judged", &FlightWobble::judged,
+                    "enough flights to judge; when False nothing else but flights is measured")
       .def_readonly("detected", &FlightWobble::detected)
       .def_readonly("offset_m", &FlightWobble::offset_m,
                     "[m] the centre of mass's distance from the tracked point (low estimate)")

@@ -239,7 +239,8 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
 /// after an off-centre impact: a sphere dropped straight may not turn at all), and the
 /// smallest offset they would have shown at most the realistic one. Notes it when they do.
 bool flights_rule_out_offset(DiagnoseResult& result) {
-  if (!result.flights || result.flights->detected || !(result.flights->allowance_m > 0.0)) return false;
+  if (!result.flights || !result.flights->judged || result.flights->detected || !(result.flights->allowance_m > 0.0))
+    return false;
   const auto library = effect_library();
   const auto& p = effect_spec(library, Effect::ComOffset).parameters;
   const double realistic = std::hypot(p[0].realistic, p[1].realistic);

@@ -128,6 +128,7 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
   }
   const std::size_t n = result.flights.size();
   if (drop_noise.empty() || n < static_cast<std::size_t>(std::max(1, options.min_flights))) return result;
+  result.judged = true;
   result.noise_m = median(drop_noise);
   std::vector<std::size_t> every(n);
   for (std::size_t k = 0; k < n; ++k) every[k] = k;

@@ -60,6 +60,9 @@ struct FlightWobbleOptions {
 /// What the free flights say about the tracked point.
 struct FlightWobble {
   std::vector<FreeFlight> flights;
+  /// Enough flights (FlightWobbleOptions::min_flights) to judge: when false nothing below is
+  /// measured (a 240 fps camera on a few low bounces can leave too few).
+  bool judged = false;
   /// [m] per coordinate, the median flight's RMS about its parabola beyond the camera noise,
   /// flights weighed by their frames (0 when the median is within the noise).
   double wobble_m = 0.0;

@@ -102,6 +102,7 @@ TEST(FreeFlights, ATrackedPointOffTheCentreOfMassLeavesItsParabolas) {
   // At the centre of mass: every flight a parabola within the noise.
   const auto centred = flight_wobble({drops_of(Eigen::Vector3d::Zero(), 6, 100)}, {kNoise}, options);
   ASSERT_GE(centred.flights.size(), 8u);
+  EXPECT_TRUE(centred.judged);
   EXPECT_FALSE(centred.detected);
   EXPECT_LT(centred.wobble_m, 0.3 * kNoise);
   EXPECT_LT(centred.offset_m, 0.3e-3);
@@ -117,6 +118,14 @@ TEST(FreeFlights, ATrackedPointOffTheCentreOfMassLeavesItsParabolas) {
   // A silhouette camera's wander as large as the wobble: nothing claimed.
   options.allowance_m = off.wobble_m;
   EXPECT_FALSE(flight_wobble({drops_of(Eigen::Vector3d(0.0008, 0.0, 0.0006), 6, 100)}, {kNoise}, options).detected);
+  // Fewer flights than it takes to judge: nothing measured, nothing claimed, nothing ruled out.
+  options.allowance_m = 0.0;
+  options.min_flights = static_cast<int>(off.flights.size()) + 1;
+  const auto few = flight_wobble({drops_of(Eigen::Vector3d(0.0008, 0.0, 0.0006), 6, 100)}, {kNoise}, options);
+  EXPECT_EQ(few.flights.size(), off.flights.size());
+  EXPECT_FALSE(few.judged);
+  EXPECT_FALSE(few.detected);
+  EXPECT_FALSE(std::isfinite(few.smallest_offset_m));
 }
 
 TEST(FreeFlights, FlightsStartAfterTheFirstPossibleContactAndSplitAtDips) {

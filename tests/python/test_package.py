@@ -172,7 +172,7 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
     assert cf.Basis.particle_model != cf.Basis.unexplained_outcomes
     # The drops' free flights: what they say about the tracked point, and the basis they name on.
     assert "flights" in dir(cf.DiagnoseResult)
-    assert {"wobble_m", "allowance_m", "detected", "offset_m", "smallest_offset_m"} <= set(dir(cf.FlightWobble))
+    assert {"judged", "wobble_m", "allowance_m", "detected", "offset_m", "smallest_offset_m"} <= set(dir(cf.FlightWobble))
     assert cf.Basis.free_flights != cf.Basis.ensemble
 
 
