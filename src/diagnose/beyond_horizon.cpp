@@ -115,17 +115,30 @@ void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
   }
 }
 
+/// The report's view of an ensemble comparison: the calibrated null and the candidates tried
+/// (replays are added, since a finer clump's comparison comes on top of the diagnosed one's).
+void report_ensemble(EnsembleReport& report, const EnsembleResult& ens) {
+  report.replays += ens.replays;
+  report.outcomes = ens.outcomes;
+  report.null_chi2 = ens.null_chi2;
+  report.null_comparisons = ens.null_comparisons;
+  report.calibrated = ens.calibrated;
+  report.hypotheses = ens.hypotheses;
+  report.detectability = ens.detectability;
+  report.trials = ens.trials;
+}
+
 /// The calibrated null leaves the recorded outcomes inconsistent with the replays
-/// (outcomes_consistent): before the mismatch is blamed on missing physics, each finer clump
-/// left is tried (its null calibrated afresh on the outcomes, from the same orientations); the
-/// first that leaves them consistent explains it, and the verdict says so with the resolution
+/// (outcomes_consistent), or a candidate (`let_through`) beat a consistent one: before the mismatch is blamed on
+/// missing physics, each finer clump left is tried (its null calibrated afresh on the outcomes, from the same
+/// orientations); the first that leaves them consistent explains it, and the verdict says so with the resolution
 /// needed. The candidates are tried with that clump too: one that passes there (beats its
 /// consistent null by the margin, see passing_hypotheses) is named, on the finer clump's
 /// outcomes. Returns whether a finer clump explained the mismatch.
 Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
                                            const std::vector<FreeCoefficient>& free,
                                            const std::vector<Effect>& candidates, const EnsembleOptions& eo,
-                                           int max_evaluations) {
+                                           int max_evaluations, std::optional<LetThrough> let_through) {
   if (!result.particle_model || c.finer.empty()) return false;
   const EnsembleReport& e = *result.ensemble;
   ParticleModelCheck& check = *result.particle_model;
@@ -136,8 +149,6 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
   // A consistent coarse null is checked too when a candidate beat it (judge_ensembles): then the
   // question is whether that candidate only absorbed the coarse clump's share.
   const bool coarse_consistent = outcomes_consistent(e.null_comparisons, free.size());
-  const std::optional<EnsembleHypothesis> coarse_best =
-      e.hypotheses.empty() ? std::nullopt : std::optional<EnsembleHypothesis>(e.hypotheses.front());
   check.worst_phase_chi2_per_value = largest_z2(e.null_comparisons);
   for (std::size_t k = 0; k < c.finer.size(); ++k) {
     // The baseline refitted the baseline's way with the finer clump (the coefficients the
@@ -175,26 +186,20 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
                       ", "),
             eo.min_delta_bic));
       say_particle_model(result, check, true);
-      if (coarse_consistent && coarse_best) {
+      if (coarse_consistent && let_through) {
         result.statement = fmt::format(
             "No missing physics found: the mismatch is the particle model's. With {} ({} spheres) {} beat the null "
             "calibrated on the recorded outcomes over the unknown release orientation (delta-BIC {:.1f}); with {} ({} "
             "spheres) and its coefficients refitted, no candidate effect beats that clump's null by the margin: what "
             "{} absorbed was the coarse clump's share. This body needs a clump of {} spheres or more.",
-            check.diagnosed, check.spheres, effect_name(coarse_best->effect), coarse_best->delta_bic, rung.name,
-            rung.spheres, effect_name(coarse_best->effect), rung.spheres);
+            check.diagnosed, check.spheres, effect_name(let_through->effect), let_through->delta_bic, rung.name,
+            rung.spheres, effect_name(let_through->effect), rung.spheres);
       }
       result.improved = fine->calibrated;  // the finer clump's coefficients, calibrated on the outcomes
       return true;
     }
     // Named on the clump the body needs: the report's ensemble is that clump's.
-    EnsembleReport& report = *result.ensemble;
-    report.null_chi2 = fine->null_chi2;
-    report.null_comparisons = fine->null_comparisons;
-    report.calibrated = fine->calibrated;
-    report.hypotheses = fine->hypotheses;
-    report.detectability = fine->detectability;
-    report.replays += fine->replays;
+    report_ensemble(*result.ensemble, *fine);
     name_beyond_horizon(result, *fine, passing, eo.min_delta_bic);
     result.statement +=
         coarse_consistent
@@ -221,7 +226,8 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
   const EnsembleReport& e = *result.ensemble;
   if (outcomes_consistent(e.null_comparisons, free.size())) return {};
   const double dof = null_dof(e.outcomes, free.size());
-  auto explained = finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, max_evaluations);
+  auto explained =
+      finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, max_evaluations, std::nullopt);
   if (!explained) return std::unexpected(explained.error());
   if (*explained) return {};
   // Unexplained: the outcomes beyond the noise, three standard errors or more.
@@ -306,12 +312,8 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   if (!ens) return std::unexpected(ens.error());
   c.evaluations += ens->replays;
   EnsembleReport report;
-  report.replays = ens->replays;
-  report.outcomes = ens->outcomes;
-  report.null_chi2 = ens->null_chi2;
+  report_ensemble(report, *ens);
   report.recordings = c.names;
-  report.null_comparisons = ens->null_comparisons;
-  report.calibrated = ens->calibrated;
   for (const auto& f : free) {
     const auto& surface = baseline.base[f.surface].surface;
     report.calibrated_here.push_back(fmt::format("{}:{}", surface, coefficient_name(f.coefficient)));
@@ -320,9 +322,6 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
                     coefficient_name(f.coefficient), surface,
                     coefficient_of(ens->calibrated[f.surface].interaction, f.coefficient)));
   }
-  report.hypotheses = ens->hypotheses;
-  report.detectability = ens->detectability;
-  report.trials = ens->trials;
   result.ensemble = std::move(report);
   const auto library = effect_library();
   // What the outcomes could decide: a candidate whose strong magnitude would have shown is
@@ -358,7 +357,9 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   // whether or not the coarse null is consistent: a candidate that beats a consistent null by
   // the margin may still only absorb the coarse clump's bias (generated control-05 at 240 fps
   // was named viscous_rolling so).
-  auto explained = finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, options.max_evaluations);
+  const LetThrough best{passing.front()->effect, passing.front()->delta_bic};
+  auto explained =
+      finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, options.max_evaluations, best);
   if (!explained) return std::unexpected(explained.error());
   if (*explained) return {};
   name_beyond_horizon(result, *ens, passing, options.min_delta_bic);

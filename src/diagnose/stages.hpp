@@ -280,10 +280,17 @@ std::vector<const EnsembleHypothesis*> passing_hypotheses(const EnsembleResult& 
                                                           std::vector<std::string>& notes);
 void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
                          const std::vector<const EnsembleHypothesis*>& passing, double min_delta_bic);
+/// The best candidate that passed against the diagnosed clump's null (judge_ensembles), which
+/// the particle-model check beyond the horizon must confirm on a finer clump.
+struct LetThrough {
+  Effect effect = Effect::AirDrag;
+  double delta_bic = 0.0;
+};
+void report_ensemble(EnsembleReport& report, const EnsembleResult& ens);
 Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
                                            const std::vector<FreeCoefficient>& free,
                                            const std::vector<Effect>& candidates, const EnsembleOptions& eo,
-                                           int max_evaluations);
+                                           int max_evaluations, std::optional<LetThrough> let_through);
 Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Model& baseline,
                                   const std::vector<FreeCoefficient>& free, const std::vector<Effect>& candidates,
                                   const EnsembleOptions& eo, int max_evaluations);
