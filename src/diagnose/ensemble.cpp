@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #include "diagnose/release.hpp"
 #include "diagnose/tracks.hpp"
@@ -155,8 +156,9 @@ PathSample recorded_path(const Track& track, const TrialScore& score) {
   return {std::move(moved.t), std::move(moved.x), std::move(moved.z)};
 }
 
-std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>& scores,
-                             const EnsembleOptions& options) {
+/// The plans of every recording compared, their replays' orientations drawn from `stream` on.
+std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>& scores, const EnsembleOptions& options,
+                             std::uint64_t stream) {
   const auto& recs = *ev.recordings;
   std::vector<Plan> plans;
   for (std::size_t r = 0; r < recs.size(); ++r) {
@@ -184,7 +186,7 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
     }
     if (plan.recorded.front().size() < 2) continue;
     plan.orientations = ensemble_orientations(
-        rec.test, every_recorded ? recorded_orientations : std::vector<Eigen::Quaterniond>{}, options, 90000 + r);
+        rec.test, every_recorded ? recorded_orientations : std::vector<Eigen::Quaterniond>{}, options, stream + r);
     plans.push_back(std::move(plan));
   }
   return plans;
@@ -290,14 +292,20 @@ std::vector<double> effect_values(const EffectSpec& spec, double u) {
   return values;
 }
 
+/// The first step of each free coefficient: large enough that the replays' response stands
+/// above their chaotic scatter (a step of 0.05 in a tuber's restitution moves its mean rebound
+/// by about the scatter of 12 replays), toward the middle of the range.
 double coefficient_step(Coefficient c, double value) {
-  return c == Coefficient::Restitution       ? (value > 0.5 ? -0.05 : 0.05)
-         : c == Coefficient::RollingFriction ? 0.005
-                                             : 0.05;
+  return c == Coefficient::Restitution ? (value > 0.5 ? -0.12 : 0.12) : c == Coefficient::RollingFriction ? 0.01 : 0.05;
 }
 
-/// The surrogate's best coefficient changes for ensemble means `target_shift` away:
-/// weighted least squares of (recorded - mean - J dc) / se, within the coefficients' ranges.
+/// The largest first move of a free coefficient in one calibration step.
+double step_radius(Coefficient c) {
+  return c == Coefficient::Restitution ? 0.15 : c == Coefficient::RollingFriction ? 0.015 : 0.1;
+}
+
+/// Weighted least squares: the x minimising sum_i (w_i (r_i - (J x)_i))^2 (the surrogate's best
+/// coefficient changes for a residual of the means, with w the inverse standard errors).
 Eigen::VectorXd solve_coefficients(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residual,
                                    const Eigen::VectorXd& inverse_se) {
   if (jacobian.cols() == 0) return Eigen::VectorXd();
@@ -314,6 +322,11 @@ Model with_coefficients(const Model& start, const std::vector<FreeCoefficient>& 
     v = std::clamp(v + delta(static_cast<Eigen::Index>(k)), low, high);
   }
   return m;
+}
+
+/// A candidate's degrees of freedom: the outcomes less the free coefficients and its parameters (at least one).
+double hypothesis_dof(int outcomes, std::size_t free, std::size_t parameters) {
+  return std::max(1.0, static_cast<double>(outcomes) - static_cast<double>(free) - static_cast<double>(parameters));
 }
 
 struct Proposal {
@@ -403,9 +416,7 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
     // The margin is judged in units of the candidate's own misfit per degree of freedom when
     // that exceeds 1 (over-dispersion: no clump replays a real particle's outcomes exactly, and
     // a candidate must not be named for absorbing the particle model's share of the misfit).
-    const double dof = std::max(1.0, static_cast<double>(result.outcomes) - static_cast<double>(free.size()) -
-                                         static_cast<double>(spec.parameters.size()));
-    best.dispersion = std::max(1.0, best.chi2 / dof);
+    best.dispersion = std::max(1.0, best.chi2 / hypothesis_dof(result.outcomes, free.size(), spec.parameters.size()));
     best.delta_bic = (result.null_chi2 - best.chi2) / best.dispersion - penalty;
     best.comparisons = std::move(cmp);
     best.plausible = true;
@@ -415,6 +426,181 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
     }
   }
   return best;
+}
+
+/// A model's free coefficients as a vector.
+Eigen::VectorXd coefficients_of(const Model& m, const std::vector<FreeCoefficient>& free) {
+  Eigen::VectorXd c(static_cast<Eigen::Index>(free.size()));
+  for (std::size_t k = 0; k < free.size(); ++k)
+    c(static_cast<Eigen::Index>(k)) = coefficient_of(m.base[free[k].surface].interaction, free[k].coefficient);
+  return c;
+}
+
+/// One point of the calibration: the free coefficients and each compared statistic's
+/// log(value + floor) under them (a rebound height grows about as a power of the restitution:
+/// linear in the logarithm, not in the value).
+struct SurrogatePoint {
+  Eigen::VectorXd c, y;
+};
+
+Eigen::VectorXd log_values(const std::vector<OutcomeComparison>& cmp) {
+  Eigen::VectorXd y(static_cast<Eigen::Index>(cmp.size()));
+  for (std::size_t j = 0; j < cmp.size(); ++j)
+    y(static_cast<Eigen::Index>(j)) = std::log(std::max(cmp[j].ensemble_value, 0.0) + std::max(cmp[j].floor, 1e-12));
+  return y;
+}
+
+/// The surrogate about `centre`: each statistic's log value regressed on the coefficients of its
+/// own recording's surface (`acts`) over every point replayed so far, the nearer points weighing
+/// more (Gaussian in steps of 2 `scale`). Regression, not interpolation: one draw of chaotic replays
+/// moves a statistic by its scatter, and a fit over every point tried averages that out.
+/// Returns the fitted values at `centre` (first column) and the slopes (the others).
+Eigen::MatrixXd fit_surrogate(const std::vector<SurrogatePoint>& points, const Eigen::VectorXd& centre,
+                              const Eigen::VectorXd& scale, const Eigen::MatrixXi& acts) {
+  const Eigen::Index rows = acts.rows(), k = acts.cols(), n = static_cast<Eigen::Index>(points.size());
+  Eigen::VectorXd weight(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::VectorXd d = (points[static_cast<std::size_t>(i)].c - centre).cwiseQuotient(2.0 * scale);
+    weight(i) = std::sqrt(std::exp(-0.5 * d.squaredNorm()));
+  }
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(rows, k + 1);
+  for (Eigen::Index j = 0; j < rows; ++j) {
+    std::vector<Eigen::Index> active;
+    for (Eigen::Index q = 0; q < k; ++q)
+      if (acts(j, q) != 0) active.push_back(q);
+    Eigen::MatrixXd a(n, static_cast<Eigen::Index>(active.size()) + 1);
+    Eigen::VectorXd b(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const SurrogatePoint& p = points[static_cast<std::size_t>(i)];
+      a(i, 0) = 1.0;
+      for (std::size_t q = 0; q < active.size(); ++q)
+        a(i, static_cast<Eigen::Index>(q) + 1) = p.c(active[q]) - centre(active[q]);
+      b(i) = p.y(j);
+    }
+    const Eigen::VectorXd x = solve_coefficients(a, b, weight);
+    out(j, 0) = x(0);
+    for (std::size_t q = 0; q < active.size(); ++q) out(j, active[q] + 1) = x(static_cast<Eigen::Index>(q) + 1);
+  }
+  return out;
+}
+
+struct CalibratedNull {
+  Model model;
+  Sample sample;
+  Eigen::MatrixXd jacobian;  ///< d(statistic)/d(coefficient) at the null, from the surrogate
+};
+
+/// The null calibrated on the outcomes: steps of Gauss-Newton on the regression surrogate
+/// (fit_surrogate), each within a trust region and judged by new replays; a step that does not
+/// lower chi^2 halves the region and is kept as a point of the surrogate, one that does widens
+/// it. Each free coefficient is first moved alone (coefficient_step), replaying only the
+/// recordings of its surface.
+Result<CalibratedNull> calibrate_null(const Evaluator& ev, const std::vector<Plan>& plans, const Model& baseline,
+                                      const std::vector<FreeCoefficient>& free, const Sample& base,
+                                      const std::vector<OutcomeComparison>& base_cmp, const Eigen::VectorXd& recorded,
+                                      const Eigen::VectorXd& inverse_se, const EnsembleOptions& options,
+                                      EnsembleResult& result) {
+  const auto& recs = *ev.recordings;
+  const auto k = static_cast<Eigen::Index>(free.size());
+  const auto rows = static_cast<Eigen::Index>(base_cmp.size());
+  CalibratedNull null{baseline, base, Eigen::MatrixXd::Zero(rows, k)};
+  if (free.empty()) return null;
+  Eigen::MatrixXi acts(rows, k);
+  Eigen::VectorXd scale(k), radius(k);
+  for (Eigen::Index q = 0; q < k; ++q) {
+    const FreeCoefficient& f = free[static_cast<std::size_t>(q)];
+    for (Eigen::Index j = 0; j < rows; ++j)
+      acts(j, q) = recs[base_cmp[static_cast<std::size_t>(j)].recording].surface == baseline.base[f.surface].surface;
+    scale(q) = std::abs(coefficient_step(f.coefficient, 0.0));
+    radius(q) = step_radius(f.coefficient);
+  }
+  std::vector<SurrogatePoint> points{{coefficients_of(baseline, free), log_values(base_cmp)}};
+  for (Eigen::Index q = 0; q < k; ++q) {
+    const FreeCoefficient& f = free[static_cast<std::size_t>(q)];
+    Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
+    delta(q) = coefficient_step(f.coefficient, points.front().c(q));
+    const Model moved = with_coefficients(baseline, free, delta);
+    std::vector<bool> run(plans.size());
+    for (std::size_t p = 0; p < plans.size(); ++p)
+      run[p] = recs[plans[p].recording].surface == baseline.base[f.surface].surface;
+    auto out = replay_outcomes(ev, moved, plans, run, &base, result.replays);
+    if (!out) return std::unexpected(out.error());
+    points.push_back({coefficients_of(moved, free), log_values(compare_all(plans, *out, options.impact_accuracy))});
+  }
+  Eigen::VectorXd target(rows);
+  for (Eigen::Index j = 0; j < rows; ++j)
+    target(j) = std::log(std::max(recorded(j), 0.0) + std::max(base_cmp[static_cast<std::size_t>(j)].floor, 1e-12));
+  double chi2 = chi2_of(base_cmp);
+  for (int iteration = 0; iteration < 4; ++iteration) {
+    const Eigen::VectorXd centre = coefficients_of(null.model, free);
+    const Eigen::MatrixXd s = fit_surrogate(points, centre, scale, acts);
+    // Weighted so that each residual is the statistic's z at the centre: the values' logarithmic
+    // mean times the inverse standard error.
+    Eigen::VectorXd w(rows), r(rows);
+    for (Eigen::Index j = 0; j < rows; ++j) {
+      const double a = std::exp(target(j)), b = std::exp(s(j, 0));
+      const double log_mean = std::abs(target(j) - s(j, 0)) > 1e-9 ? (a - b) / (target(j) - s(j, 0)) : a;
+      w(j) = log_mean * inverse_se(j);
+      r(j) = target(j) - s(j, 0);
+    }
+    Eigen::VectorXd step = solve_coefficients(s.rightCols(k), r, w);
+    double shrink = 1.0;
+    for (Eigen::Index q = 0; q < k; ++q)
+      if (std::abs(step(q)) > radius(q)) shrink = std::min(shrink, radius(q) / std::abs(step(q)));
+    const Model trial = with_coefficients(null.model, free, shrink * step);
+    const Eigen::VectorXd taken = coefficients_of(trial, free) - centre;
+    if (taken.cwiseQuotient(scale).norm() < 1e-3) break;
+    auto out = replay_outcomes(ev, trial, plans, std::vector<bool>(plans.size(), true), nullptr, result.replays);
+    if (!out) return std::unexpected(out.error());
+    const auto cmp = compare_all(plans, *out, options.impact_accuracy);
+    points.push_back({coefficients_of(trial, free), log_values(cmp)});
+    if (chi2_of(cmp) < chi2) {
+      chi2 = chi2_of(cmp);
+      null.model = trial;
+      null.sample = std::move(*out);
+      radius *= 1.5;
+    } else {
+      radius *= 0.5;
+    }
+  }
+  // The response at the null, in the statistics' own units, for the candidates' surrogate.
+  const Eigen::MatrixXd s = fit_surrogate(points, coefficients_of(null.model, free), scale, acts);
+  const auto cmp = compare_all(plans, null.sample, options.impact_accuracy);
+  for (Eigen::Index j = 0; j < rows; ++j) {
+    const double value = std::max(cmp[static_cast<std::size_t>(j)].ensemble_value, 0.0) +
+                         std::max(cmp[static_cast<std::size_t>(j)].floor, 1e-12);
+    null.jacobian.row(j) = value * s.row(j).tail(k);
+  }
+  return null;
+}
+
+/// The hypotheses that reach the margin replayed again, with the null, from orientations drawn
+/// afresh (`fresh`): each keeps the lower of its two delta-BICs (EnsembleHypothesis::fresh_delta_bic).
+Result<void> replay_afresh(const Evaluator& ev, const std::vector<Plan>& fresh, const Model& null_model,
+                           std::size_t free, const EnsembleOptions& options, EnsembleResult& result) {
+  const std::vector<bool> every(fresh.size(), true);
+  std::optional<double> null_chi2;
+  const auto library = effect_library();
+  for (EnsembleHypothesis& h : result.hypotheses) {
+    if (!h.plausible || h.delta_bic < options.min_delta_bic) continue;
+    if (!null_chi2) {
+      auto out = replay_outcomes(ev, null_model, fresh, every, nullptr, result.replays);
+      if (!out) return std::unexpected(out.error());
+      null_chi2 = chi2_of(compare_all(fresh, *out, options.impact_accuracy));
+    }
+    Model m = null_model;
+    m.base = h.base;
+    m.effect = h.effect;
+    m.values = h.values;
+    auto out = replay_outcomes(ev, m, fresh, every, nullptr, result.replays);
+    if (!out) return std::unexpected(out.error());
+    const double chi2 = chi2_of(compare_all(fresh, *out, options.impact_accuracy));
+    const double k = static_cast<double>(h.values.size());
+    const double dispersion = std::max(1.0, chi2 / hypothesis_dof(result.outcomes, free, h.values.size()));
+    h.fresh_delta_bic = (*null_chi2 - chi2) / dispersion - k * std::log(std::max(1, result.outcomes));
+    h.delta_bic = std::min(h.delta_bic, h.fresh_delta_bic);
+  }
+  return {};
 }
 
 }  // namespace
@@ -444,9 +630,8 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   if (options.replays < 4) return fail(ErrorCode::InvalidArgument, "an ensemble needs 4 or more replays");
   if (scores.size() != ev.trials.size())
     return fail(ErrorCode::InvalidArgument, "one full-duration score per tracked trial is needed");
-  const auto& recs = *ev.recordings;
   EnsembleResult result;
-  const std::vector<Plan> plans = make_plans(ev, scores, options);
+  const std::vector<Plan> plans = make_plans(ev, scores, options, 90000);
   if (plans.empty()) return result;
   for (const Plan& p : plans) result.trials += static_cast<double>(p.recorded.front().size()) / plans.size();
   const std::vector<bool> every(plans.size(), true);
@@ -461,48 +646,11 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
     const double diff = c.recorded_value - c.ensemble_value;
     inverse_se(static_cast<Eigen::Index>(j)) = c.z != 0.0 ? std::abs(c.z / diff) : 1.0 / std::max(c.floor, 1e-12);
   }
-  // The free coefficients' responses (one set of replays each, only where they act).
-  Eigen::MatrixXd jacobian(result.outcomes, static_cast<Eigen::Index>(free.size()));
-  for (std::size_t k = 0; k < free.size(); ++k) {
-    Model moved = baseline;
-    const std::string& surface = baseline.base[free[k].surface].surface;
-    double& v = coefficient_of(moved.base[free[k].surface].interaction, free[k].coefficient);
-    const double h = coefficient_step(free[k].coefficient, v);
-    v += h;
-    std::vector<bool> run(plans.size());
-    for (std::size_t p = 0; p < plans.size(); ++p) run[p] = recs[plans[p].recording].surface == surface;
-    auto out = replay_outcomes(ev, moved, plans, run, &*base, result.replays);
-    if (!out) return std::unexpected(out.error());
-    jacobian.col(static_cast<Eigen::Index>(k)) =
-        (means_of(compare_all(plans, *out, options.impact_accuracy)) - means_of(base_cmp)) / h;
-  }
-  // The calibrated null: Gauss-Newton steps on the outcomes, each judged by new replays, the
-  // response matrix updated from every step taken (Broyden): a tuber's rebound height is
-  // far from linear in its restitution.
-  Model null_model = baseline;
-  Sample null_sample = *base;
-  Eigen::VectorXd means = means_of(base_cmp);
-  double chi2 = chi2_of(base_cmp);
-  for (int iteration = 0; iteration < 4 && !free.empty(); ++iteration) {
-    const Model trial = with_coefficients(null_model, free, solve_coefficients(jacobian, recorded - means, inverse_se));
-    Eigen::VectorXd taken(static_cast<Eigen::Index>(free.size()));
-    for (std::size_t k = 0; k < free.size(); ++k) {
-      taken(static_cast<Eigen::Index>(k)) =
-          coefficient_of(trial.base[free[k].surface].interaction, free[k].coefficient) -
-          coefficient_of(null_model.base[free[k].surface].interaction, free[k].coefficient);
-    }
-    if (taken.norm() < 1e-4) break;
-    auto out = replay_outcomes(ev, trial, plans, every, nullptr, result.replays);
-    if (!out) return std::unexpected(out.error());
-    const auto cmp = compare_all(plans, *out, options.impact_accuracy);
-    const Eigen::VectorXd moved = means_of(cmp);
-    jacobian += ((moved - means) - jacobian * taken) * taken.transpose() / taken.squaredNorm();
-    if (chi2_of(cmp) >= chi2) break;
-    chi2 = chi2_of(cmp);
-    null_model = trial;
-    null_sample = std::move(*out);
-    means = moved;
-  }
+  auto null = calibrate_null(ev, plans, baseline, free, *base, base_cmp, recorded, inverse_se, options, result);
+  if (!null) return std::unexpected(null.error());
+  const Model& null_model = null->model;
+  const Sample& null_sample = null->sample;
+  const Eigen::MatrixXd& jacobian = null->jacobian;
   result.calibrated = null_model.base;
   result.null_comparisons = compare_all(plans, null_sample, options.impact_accuracy);
   result.null_chi2 = chi2_of(result.null_comparisons);
@@ -523,6 +671,9 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
     if (!h) return std::unexpected(h.error());
     result.hypotheses.push_back(std::move(*h));
   }
+  if (auto ok = replay_afresh(ev, make_plans(ev, scores, options, 190000), null_model, free.size(), options, result);
+      !ok)
+    return std::unexpected(ok.error());
   std::sort(result.hypotheses.begin(), result.hypotheses.end(),
             [](const EnsembleHypothesis& a, const EnsembleHypothesis& b) { return a.delta_bic > b.delta_bic; });
   return result;

@@ -15,6 +15,7 @@
 /// and new replays at that point decide (delta-BIC against the calibrated null, computed from
 /// replays, never from the surrogate).
 #include <cstdint>
+#include <limits>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -92,7 +93,11 @@ struct EnsembleHypothesis {
   std::vector<SurfaceParameters> base;  ///< with the free coefficients refitted
   double chi2 = 0.0;                    ///< from replays at that point
   double dispersion = 1.0;  ///< its chi^2 per degree of freedom when above 1: the margin is judged in these units
-  double delta_bic = 0.0;   ///< against the calibrated null: delta-chi^2 / dispersion - k ln n
+  double delta_bic = 0.0;   ///< against the calibrated null: delta-chi^2 / dispersion - k ln n (the lower draw)
+  /// Its delta-BIC with the null and it replayed from orientations drawn afresh (NaN when not
+  /// replayed: only a candidate that reaches the margin on the first draw is). delta_bic is the
+  /// lower of the two: chaotic replays move chi^2 by tens between draws.
+  double fresh_delta_bic = std::numeric_limits<double>::quiet_NaN();
   bool plausible = false;
   std::vector<OutcomeComparison> comparisons;  ///< its replays against the recordings
 };

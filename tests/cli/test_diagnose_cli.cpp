@@ -174,4 +174,28 @@ TEST(DiagnoseCli, SummariesOnlySayWhatTheyCanDecide) {
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "report.json"));
 }
 
+TEST(DiagnoseCli, AnotherSimulatorsTuberControlIsConsistentWithTheDiagnosedClumpAlone) {
+  // Control case-07 of ../shared/data/lab-like (a simulator that shares no code with this
+  // project, its own fine lattice of the tuber; nine set-ups of six trials, no release
+  // orientations), diagnosed from the mesh with no finer clump to fall back on. The null
+  // calibrated on the outcomes beyond the release horizon must leave them consistent: `none`,
+  // not an effect and not `unexplained`. (The calibration before the regression surrogate,
+  // Gauss-Newton on single-step responses that stopped at the first step not lowering chi^2,
+  // left this case's outcomes inconsistent with the diagnosed clump, and without a finer clump
+  // named `adhesion` here: this test failed on it.)
+  test::ScratchDir dir("diagnose-lab-like-control");
+  const auto set = test::shared_dir() / "data" / "lab-like";
+  const auto run = test::run_clumpforge(
+      fmt::format("diagnose --recordings '{}' --mesh '{}' --finer-clumps 0 --json --output '{}'",
+                  (set / "case-07").string(), (set / "meshes" / "tuber.stl").string(), (dir / "out").string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["verdict"], "none") << j["statement"];
+  EXPECT_EQ(j["basis"], "consistent") << j["statement"];
+  ASSERT_TRUE(j.contains("ensemble") && j["ensemble"].is_object());
+  const std::string calibrated = j["ensemble"]["calibrated_here"].dump();
+  EXPECT_NE(calibrated.find("soil:restitution"), std::string::npos) << calibrated;
+  EXPECT_NE(calibrated.find("Q235:restitution"), std::string::npos) << calibrated;
+}
+
 }  // namespace clumpforge
