@@ -261,22 +261,31 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
 }
 
 /// Whether the free flights rule out a centre-of-mass offset of the library's realistic
-/// magnitude: enough flights, no wobble, a body whose silhouette is not a disc (it tumbles
-/// after an off-centre impact: a sphere dropped straight may not turn at all), and the
-/// smallest offset they would have shown at most the realistic one. Notes it when they do.
+/// magnitude (rules_out_offset: enough flights, no wobble, a body whose silhouette is not a disc
+/// (it tumbles after an off-centre impact: a sphere dropped straight may not turn at all), the
+/// smallest offset they would have shown and their interval's upper end at most the realistic
+/// one). Notes it when they do, and when only the interval keeps the offset in.
 bool flights_rule_out_offset(DiagnoseResult& result) {
-  if (!result.flights || !result.flights->judged || result.flights->detected || !(result.flights->allowance_m > 0.0))
-    return false;
+  if (!result.flights || !result.flights->judged || result.flights->detected) return false;
   const auto library = effect_library();
   const auto& p = effect_spec(library, Effect::ComOffset).parameters;
   const double realistic = std::hypot(p[0].realistic, p[1].realistic);
-  if (!(result.flights->smallest_offset_m <= realistic)) return false;
-  result.notes.push_back(fmt::format(
-      "com_offset not tried beyond the release horizon: the free flights show no wobble ({:.3f} mm, {} flights) and "
-      "would have shown an offset of {:.2f} mm or more (the library's realistic one is {:.2f} mm)",
-      result.flights->wobble_m * 1e3, result.flights->flights.size(), result.flights->smallest_offset_m * 1e3,
-      realistic * 1e3));
-  return true;
+  const FlightWobble& f = *result.flights;
+  const double upper = f.offset_high_m / kOffsetRecovered;
+  if (rules_out_offset(f, realistic)) {
+    result.notes.push_back(fmt::format(
+        "com_offset not tried beyond the release horizon: the free flights show no wobble ({:.3f} mm, {} flights), "
+        "would have shown an offset of {:.2f} mm or more, and allow at most {:.2f} mm (the library's realistic one "
+        "is {:.2f} mm)",
+        f.wobble_m * 1e3, f.flights.size(), f.smallest_offset_m * 1e3, upper * 1e3, realistic * 1e3));
+    return true;
+  }
+  if (f.smallest_offset_m <= realistic && !(upper <= realistic))
+    result.notes.push_back(fmt::format(
+        "com_offset still tried beyond the release horizon: the free flights show no wobble ({:.3f} mm, {} flights), "
+        "but their 95 % interval allows an offset of up to {:.2f} mm (the library's realistic one is {:.2f} mm)",
+        f.wobble_m * 1e3, f.flights.size(), upper * 1e3, realistic * 1e3));
+  return false;
 }
 
 /// Beyond the release horizons: the recorded trials against replays from the release prior

@@ -156,4 +156,9 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
   return result;
 }
 
+bool rules_out_offset(const FlightWobble& wobble, double offset) {
+  return wobble.judged && !wobble.detected && wobble.allowance_m > 0.0 && wobble.smallest_offset_m <= offset &&
+         wobble.offset_high_m / kOffsetRecovered <= offset;
+}
+
 }  // namespace clumpforge
