@@ -266,26 +266,26 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
 /// smallest offset they would have shown and their interval's upper end at most the realistic
 /// one). Notes it when they do, and when only the interval keeps the offset in.
 bool flights_rule_out_offset(DiagnoseResult& result) {
-  if (!result.flights || !result.flights->judged || result.flights->detected) return false;
+  if (!result.flights) return false;
   const auto library = effect_library();
   const auto& p = effect_spec(library, Effect::ComOffset).parameters;
   const double realistic = std::hypot(p[0].realistic, p[1].realistic);
   const FlightWobble& f = *result.flights;
+  // Flights that would have shown the realistic offset: rules_out_offset's other conditions.
+  if (!f.judged || f.detected || !(f.allowance_m > 0.0) || !(f.smallest_offset_m <= realistic)) return false;
   const double upper = f.offset_high_m / kOffsetRecovered;
-  if (rules_out_offset(f, realistic)) {
-    result.notes.push_back(fmt::format(
-        "com_offset not tried beyond the release horizon: the free flights show no wobble ({:.3f} mm, {} flights), "
-        "would have shown an offset of {:.2f} mm or more, and allow at most {:.2f} mm (the library's realistic one "
-        "is {:.2f} mm)",
-        f.wobble_m * 1e3, f.flights.size(), f.smallest_offset_m * 1e3, upper * 1e3, realistic * 1e3));
-    return true;
-  }
-  if (f.smallest_offset_m <= realistic && !(upper <= realistic))
-    result.notes.push_back(fmt::format(
-        "com_offset still tried beyond the release horizon: the free flights show no wobble ({:.3f} mm, {} flights), "
-        "but their 95 % interval allows an offset of up to {:.2f} mm (the library's realistic one is {:.2f} mm)",
-        f.wobble_m * 1e3, f.flights.size(), upper * 1e3, realistic * 1e3));
-  return false;
+  const bool ruled_out = rules_out_offset(f, realistic);  // here: whether upper <= realistic
+  result.notes.push_back(
+      ruled_out
+          ? fmt::format("com_offset not tried beyond the release horizon: the free flights show no wobble ({:.3f} "
+                        "mm, {} flights), would have shown an offset of {:.2f} mm or more, and allow at most "
+                        "{:.2f} mm (the library's realistic one is {:.2f} mm)",
+                        f.wobble_m * 1e3, f.flights.size(), f.smallest_offset_m * 1e3, upper * 1e3, realistic * 1e3)
+          : fmt::format("com_offset still tried beyond the release horizon: the free flights show no wobble "
+                        "({:.3f} mm, {} flights), but their 95 % interval allows an offset of up to {:.2f} mm "
+                        "(the library's realistic one is {:.2f} mm)",
+                        f.wobble_m * 1e3, f.flights.size(), upper * 1e3, realistic * 1e3));
+  return ruled_out;
 }
 
 /// Beyond the release horizons: the recorded trials against replays from the release prior

@@ -324,9 +324,20 @@ Model with_coefficients(const Model& start, const std::vector<FreeCoefficient>& 
   return m;
 }
 
-/// A candidate's degrees of freedom: the outcomes less the free coefficients and its parameters (at least one).
-double hypothesis_dof(int outcomes, std::size_t free, std::size_t parameters) {
-  return std::max(1.0, static_cast<double>(outcomes) - static_cast<double>(free) - static_cast<double>(parameters));
+/// A candidate's margin over the null: its dispersion (chi^2 per degree of freedom, the
+/// outcomes less the free coefficients and its parameters, when above 1) and delta-BIC =
+/// (chi^2_null - chi^2) / dispersion - k ln n. Judged in units of the candidate's own misfit:
+/// no clump replays a real particle's outcomes exactly, and a candidate must not be named for
+/// absorbing the particle model's share of the misfit.
+struct Margin {
+  double dispersion = 1.0, delta_bic = 0.0;
+};
+Margin margin_over_null(double null_chi2, double chi2, int outcomes, std::size_t free, std::size_t parameters) {
+  const double dof =
+      std::max(1.0, static_cast<double>(outcomes) - static_cast<double>(free) - static_cast<double>(parameters));
+  const double dispersion = std::max(1.0, chi2 / dof);
+  return {dispersion,
+          (null_chi2 - chi2) / dispersion - static_cast<double>(parameters) * std::log(std::max(1, outcomes))};
 }
 
 struct Proposal {
@@ -397,7 +408,6 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
                                    const std::vector<FreeCoefficient>& free, const EffectSpec& spec, const Proposal& p,
                                    const EnsembleOptions& options, EnsembleResult& result) {
   const std::vector<bool> every(plans.size(), true);
-  const double penalty = static_cast<double>(spec.parameters.size()) * std::log(std::max(1, result.outcomes));
   EnsembleHypothesis best;
   best.chi2 = std::numeric_limits<double>::infinity();
   for (double factor : {1.0, 0.6, 1.6}) {
@@ -413,11 +423,10 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
     best.values = m.values;
     best.base = m.base;
     best.chi2 = chi2_of(cmp);
-    // The margin is judged in units of the candidate's own misfit per degree of freedom when
-    // that exceeds 1 (over-dispersion: no clump replays a real particle's outcomes exactly, and
-    // a candidate must not be named for absorbing the particle model's share of the misfit).
-    best.dispersion = std::max(1.0, best.chi2 / hypothesis_dof(result.outcomes, free.size(), spec.parameters.size()));
-    best.delta_bic = (result.null_chi2 - best.chi2) / best.dispersion - penalty;
+    const Margin margin =
+        margin_over_null(result.null_chi2, best.chi2, result.outcomes, free.size(), spec.parameters.size());
+    best.dispersion = margin.dispersion;
+    best.delta_bic = margin.delta_bic;
     best.comparisons = std::move(cmp);
     best.plausible = true;
     for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
@@ -443,10 +452,15 @@ struct SurrogatePoint {
   Eigen::VectorXd c, y;
 };
 
+/// A statistic's value lifted by its comparison's floor (positive: its logarithm is defined).
+double above_floor(double value, const OutcomeComparison& c) {
+  return std::max(value, 0.0) + std::max(c.floor, 1e-12);
+}
+
 Eigen::VectorXd log_values(const std::vector<OutcomeComparison>& cmp) {
   Eigen::VectorXd y(static_cast<Eigen::Index>(cmp.size()));
   for (std::size_t j = 0; j < cmp.size(); ++j)
-    y(static_cast<Eigen::Index>(j)) = std::log(std::max(cmp[j].ensemble_value, 0.0) + std::max(cmp[j].floor, 1e-12));
+    y(static_cast<Eigen::Index>(j)) = std::log(above_floor(cmp[j].ensemble_value, cmp[j]));
   return y;
 }
 
@@ -487,7 +501,8 @@ Eigen::MatrixXd fit_surrogate(const std::vector<SurrogatePoint>& points, const E
 struct CalibratedNull {
   Model model;
   Sample sample;
-  Eigen::MatrixXd jacobian;  ///< d(statistic)/d(coefficient) at the null, from the surrogate
+  std::vector<OutcomeComparison> comparisons;  ///< of `sample` against the recordings
+  Eigen::MatrixXd jacobian;                    ///< d(statistic)/d(coefficient) at the null, from the surrogate
 };
 
 /// The null calibrated on the outcomes: steps of Gauss-Newton on the regression surrogate
@@ -503,7 +518,7 @@ Result<CalibratedNull> calibrate_null(const Evaluator& ev, const std::vector<Pla
   const auto& recs = *ev.recordings;
   const auto k = static_cast<Eigen::Index>(free.size());
   const auto rows = static_cast<Eigen::Index>(base_cmp.size());
-  CalibratedNull null{baseline, base, Eigen::MatrixXd::Zero(rows, k)};
+  CalibratedNull null{baseline, base, base_cmp, Eigen::MatrixXd::Zero(rows, k)};
   if (free.empty()) return null;
   Eigen::MatrixXi acts(rows, k);
   Eigen::VectorXd scale(k), radius(k);
@@ -529,8 +544,7 @@ Result<CalibratedNull> calibrate_null(const Evaluator& ev, const std::vector<Pla
   }
   Eigen::VectorXd target(rows);
   for (Eigen::Index j = 0; j < rows; ++j)
-    target(j) = std::log(std::max(recorded(j), 0.0) + std::max(base_cmp[static_cast<std::size_t>(j)].floor, 1e-12));
-  double chi2 = chi2_of(base_cmp);
+    target(j) = std::log(above_floor(recorded(j), base_cmp[static_cast<std::size_t>(j)]));
   for (int iteration = 0; iteration < 4; ++iteration) {
     const Eigen::VectorXd centre = coefficients_of(null.model, free);
     const Eigen::MatrixXd s = fit_surrogate(points, centre, scale, acts);
@@ -554,10 +568,10 @@ Result<CalibratedNull> calibrate_null(const Evaluator& ev, const std::vector<Pla
     if (!out) return std::unexpected(out.error());
     const auto cmp = compare_all(plans, *out, options.impact_accuracy);
     points.push_back({coefficients_of(trial, free), log_values(cmp)});
-    if (chi2_of(cmp) < chi2) {
-      chi2 = chi2_of(cmp);
+    if (chi2_of(cmp) < chi2_of(null.comparisons)) {
       null.model = trial;
       null.sample = std::move(*out);
+      null.comparisons = cmp;
       radius *= 1.5;
     } else {
       radius *= 0.5;
@@ -565,26 +579,26 @@ Result<CalibratedNull> calibrate_null(const Evaluator& ev, const std::vector<Pla
   }
   // The response at the null, in the statistics' own units, for the candidates' surrogate.
   const Eigen::MatrixXd s = fit_surrogate(points, coefficients_of(null.model, free), scale, acts);
-  const auto cmp = compare_all(plans, null.sample, options.impact_accuracy);
   for (Eigen::Index j = 0; j < rows; ++j) {
-    const double value = std::max(cmp[static_cast<std::size_t>(j)].ensemble_value, 0.0) +
-                         std::max(cmp[static_cast<std::size_t>(j)].floor, 1e-12);
-    null.jacobian.row(j) = value * s.row(j).tail(k);
+    const OutcomeComparison& c = null.comparisons[static_cast<std::size_t>(j)];
+    null.jacobian.row(j) = above_floor(c.ensemble_value, c) * s.row(j).tail(k);
   }
   return null;
 }
 
 /// The hypotheses that reach the margin replayed again, with the null, from orientations drawn
-/// afresh (`fresh`): each keeps the lower of its two delta-BICs (EnsembleHypothesis::fresh_delta_bic).
-Result<void> replay_afresh(const Evaluator& ev, const std::vector<Plan>& fresh, const Model& null_model,
-                           std::size_t free, const EnsembleOptions& options, EnsembleResult& result) {
-  const std::vector<bool> every(fresh.size(), true);
+/// afresh (plans from `stream` on, made only when one does): each keeps the lower of its two
+/// delta-BICs (EnsembleHypothesis::fresh_delta_bic).
+Result<void> replay_afresh(const Evaluator& ev, const std::vector<TrialScore>& scores, const Model& null_model,
+                           std::size_t free, const EnsembleOptions& options, std::uint64_t stream,
+                           EnsembleResult& result) {
+  std::vector<Plan> fresh;
   std::optional<double> null_chi2;
-  const auto library = effect_library();
   for (EnsembleHypothesis& h : result.hypotheses) {
     if (!h.plausible || h.delta_bic < options.min_delta_bic) continue;
     if (!null_chi2) {
-      auto out = replay_outcomes(ev, null_model, fresh, every, nullptr, result.replays);
+      fresh = make_plans(ev, scores, options, stream);
+      auto out = replay_outcomes(ev, null_model, fresh, std::vector<bool>(fresh.size(), true), nullptr, result.replays);
       if (!out) return std::unexpected(out.error());
       null_chi2 = chi2_of(compare_all(fresh, *out, options.impact_accuracy));
     }
@@ -592,12 +606,10 @@ Result<void> replay_afresh(const Evaluator& ev, const std::vector<Plan>& fresh, 
     m.base = h.base;
     m.effect = h.effect;
     m.values = h.values;
-    auto out = replay_outcomes(ev, m, fresh, every, nullptr, result.replays);
+    auto out = replay_outcomes(ev, m, fresh, std::vector<bool>(fresh.size(), true), nullptr, result.replays);
     if (!out) return std::unexpected(out.error());
     const double chi2 = chi2_of(compare_all(fresh, *out, options.impact_accuracy));
-    const double k = static_cast<double>(h.values.size());
-    const double dispersion = std::max(1.0, chi2 / hypothesis_dof(result.outcomes, free, h.values.size()));
-    h.fresh_delta_bic = (*null_chi2 - chi2) / dispersion - k * std::log(std::max(1, result.outcomes));
+    h.fresh_delta_bic = margin_over_null(*null_chi2, chi2, result.outcomes, free, h.values.size()).delta_bic;
     h.delta_bic = std::min(h.delta_bic, h.fresh_delta_bic);
   }
   return {};
@@ -652,7 +664,7 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   const Sample& null_sample = null->sample;
   const Eigen::MatrixXd& jacobian = null->jacobian;
   result.calibrated = null_model.base;
-  result.null_comparisons = compare_all(plans, null_sample, options.impact_accuracy);
+  result.null_comparisons = null->comparisons;
   result.null_chi2 = chi2_of(result.null_comparisons);
   const Eigen::VectorXd null_means = means_of(result.null_comparisons);
   const auto library = effect_library();
@@ -671,8 +683,7 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
     if (!h) return std::unexpected(h.error());
     result.hypotheses.push_back(std::move(*h));
   }
-  if (auto ok = replay_afresh(ev, make_plans(ev, scores, options, 190000), null_model, free.size(), options, result);
-      !ok)
+  if (auto ok = replay_afresh(ev, scores, null_model, free.size(), options, 190000, result); !ok)
     return std::unexpected(ok.error());
   std::sort(result.hypotheses.begin(), result.hypotheses.end(),
             [](const EnsembleHypothesis& a, const EnsembleHypothesis& b) { return a.delta_bic > b.delta_bic; });
