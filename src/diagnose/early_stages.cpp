@@ -391,8 +391,8 @@ Result<void> resolution_stage(Context& c, DiagnoseResult& result, const Model& s
     if (!fine) return std::unexpected(fine.error());
     double sum = 0.0;
     for (std::size_t i = 0; i < c.training.size(); ++i) {
-      const double d =
-          replay_difference(c.ev.trials[c.training[i]], (*coarse)[i].replay, (*fine)[i].replay, c.ev.shift_window);
+      const double d = replay_difference((*coarse)[i].replay, (*fine)[i].replay, c.ev.trials[c.training[i]].horizon,
+                                         c.ev.shift_window);
       sum += d * d;
     }
     const double difference = std::sqrt(sum / std::max<std::size_t>(1, c.training.size()));

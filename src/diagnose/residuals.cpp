@@ -414,23 +414,4 @@ std::pair<double, bool> largest_misfit(const Context& c, const Groups& groups) {
   return {worst, large};
 }
 
-/// RMS difference [m] of two replays of the same trial within its fitted window (replay time up
-/// to its horizon), after the alignment a fit makes of a recorded track: a time shift within
-/// +-`shift_window` and the camera origins. What the alignment absorbs, no recording can tell
-/// apart: a tilt's slip a millisecond later, a drop's lowest point a little higher.
-double replay_difference(const TrackedTrial& tt, const std::vector<ReplaySample>& a, const std::vector<ReplaySample>& b,
-                         double shift_window) {
-  Track seen;
-  for (std::size_t k = 0; k < a.size() && a[k].t <= tt.horizon; ++k) {
-    seen.t.push_back(a[k].t);
-    seen.x.push_back(a[k].x);
-    seen.z.push_back(a[k].z);
-  }
-  if (seen.size() == 0 || b.empty()) return 0.0;
-  const Alignment aligned =
-      align(seen, b, Weights(1.0), OriginFit{.x = true, .z = true}, 0.0, shift_window, shift_window / 8.0);
-  if (aligned.values == 0) return 0.0;
-  return std::sqrt(2.0 * aligned.chi_squared / aligned.values);  // both coordinates: a displacement's RMS
-}
-
 }  // namespace clumpforge::diagnosis

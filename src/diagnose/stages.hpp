@@ -210,8 +210,6 @@ std::string experiment_for(const std::string& a, const std::string& b);
 bool large_misfit(const Context& c, const GroupKey& key, const Group& g);
 std::vector<PhaseOf> smooth_misfits(const Context& c, const Groups& groups, const DiagnoseOptions& options);
 std::pair<double, bool> largest_misfit(const Context& c, const Groups& groups);
-double replay_difference(const TrackedTrial& tt, const std::vector<ReplaySample>& a, const std::vector<ReplaySample>& b,
-                         double shift_window);
 
 // ---- fitting.cpp -----------------------------------------------------------------------------
 

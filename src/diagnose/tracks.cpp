@@ -240,4 +240,22 @@ std::vector<FrameResidual> residuals(const Track& track, const std::vector<Repla
   return out;
 }
 
+double replay_difference(const std::vector<ReplaySample>& a, const std::vector<ReplaySample>& b, double horizon,
+                         double shift_window) {
+  if (b.empty()) return 0.0;
+  // Frames a shift could move past b's last sample are left out (b would be held there).
+  const double until = std::min(horizon, b.back().t - shift_window);
+  Track seen;
+  for (std::size_t k = 0; k < a.size() && a[k].t <= until; ++k) {
+    seen.t.push_back(a[k].t);
+    seen.x.push_back(a[k].x);
+    seen.z.push_back(a[k].z);
+  }
+  if (seen.size() == 0) return 0.0;
+  const Alignment aligned =
+      align(seen, b, Weights(1.0), OriginFit{.x = true, .z = true}, 0.0, shift_window, shift_window / 8.0);
+  if (aligned.values == 0) return 0.0;
+  return std::sqrt(2.0 * aligned.chi_squared / aligned.values);  // both coordinates: a displacement's RMS
+}
+
 }  // namespace clumpforge

@@ -86,6 +86,14 @@ Alignment align(const Track& track, const std::vector<ReplaySample>& replay, con
 /// camera ran); for a tilt, the plate angle column; otherwise the first frame.
 double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s, double incline_deg = 30.0);
 
+/// RMS displacement [m] between two replays of one trial up to `horizon` (replay time), after
+/// the alignment a fit makes of a recorded track to a replay: a time shift within
+/// +-`shift_window` and both camera origins. What that alignment absorbs no recording can tell
+/// apart (a tilt's slip a millisecond later, a drop's lowest point a little higher), so two
+/// particle models whose replays differ only so are the same model to the diagnosis.
+double replay_difference(const std::vector<ReplaySample>& a, const std::vector<ReplaySample>& b, double horizon,
+                         double shift_window);
+
 /// One recorded frame against the replay: residuals in units of sigma.
 struct FrameResidual {
   double t = 0.0;             ///< replay time [s]
