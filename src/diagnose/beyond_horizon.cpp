@@ -271,10 +271,9 @@ bool flights_rule_out_offset(DiagnoseResult& result) {
   const auto& p = effect_spec(library, Effect::ComOffset).parameters;
   const double realistic = std::hypot(p[0].realistic, p[1].realistic);
   const FlightWobble& f = *result.flights;
-  // Flights that would have shown the realistic offset: rules_out_offset's other conditions.
-  if (!f.judged || f.detected || !(f.allowance_m > 0.0) || !(f.smallest_offset_m <= realistic)) return false;
-  const double upper = f.offset_high_m / kOffsetRecovered;
-  const bool ruled_out = rules_out_offset(f, realistic);  // here: whether upper <= realistic
+  if (!would_show_offset(f, realistic)) return false;
+  const double upper = offset_upper_bound(f);
+  const bool ruled_out = rules_out_offset(f, realistic);
   result.notes.push_back(
       ruled_out
           ? fmt::format("com_offset not tried beyond the release horizon: the free flights show no wobble ({:.3f} "

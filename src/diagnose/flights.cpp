@@ -156,9 +156,16 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
   return result;
 }
 
+bool would_show_offset(const FlightWobble& wobble, double offset) {
+  return wobble.judged && !wobble.detected && wobble.allowance_m > 0.0 && wobble.smallest_offset_m <= offset;
+}
+
+double offset_upper_bound(const FlightWobble& wobble) {
+  return wobble.offset_high_m / kOffsetRecovered;
+}
+
 bool rules_out_offset(const FlightWobble& wobble, double offset) {
-  return wobble.judged && !wobble.detected && wobble.allowance_m > 0.0 && wobble.smallest_offset_m <= offset &&
-         wobble.offset_high_m / kOffsetRecovered <= offset;
+  return would_show_offset(wobble, offset) && offset_upper_bound(wobble) <= offset;
 }
 
 }  // namespace clumpforge

@@ -87,9 +87,17 @@ struct FlightWobble {
 /// independent simulator's tuber (lab-like case-25); the lower, rounded down.
 inline constexpr double kOffsetRecovered = 0.65;
 
-/// Whether the flights rule out a centre-of-mass offset of `offset` [m]: judged, no wobble
-/// detected, an allowance known, the smallest offset they would have shown at most `offset`,
-/// and the upper end of the offset's 95 % interval over kOffsetRecovered at most `offset` too
+/// Whether the flights would have shown a centre-of-mass offset of `offset` [m] and did not:
+/// judged, no wobble detected, an allowance known, the smallest offset they would have shown
+/// at most `offset`.
+bool would_show_offset(const FlightWobble& wobble, double offset);
+
+/// The upper end of the offset's 95 % interval over the share the estimate recovers
+/// (kOffsetRecovered) [m].
+double offset_upper_bound(const FlightWobble& wobble);
+
+/// Whether the flights rule out a centre-of-mass offset of `offset` [m]: would_show_offset,
+/// and offset_upper_bound at most `offset` too
 /// (a few flights' wobble is itself uncertain: 9 flights of a generated tuber 2.8 mm off showed
 /// none, with an interval up to 1.6 mm).
 bool rules_out_offset(const FlightWobble& wobble, double offset);
