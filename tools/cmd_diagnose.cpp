@@ -174,9 +174,9 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_option("--orientation-prior", args->orientation_prior_deg,
                   "Uncertainty of a recorded release orientation (orientation_wxyz) [deg]; never taken as exact");
   sub->add_option("--roll-release", args->roll_release,
-                  "How the lab set the particle on a roll's incline when no orientation is recorded: on-edge (a "
-                  "flattened particle stands on its rim and is turned at random about its flat faces' normal; a "
-                  "sphere or equant body anyhow) or any (uniform over all orientations)")
+                  "How the lab set the particle on a roll's incline: on-edge (a flattened particle stands on its rim "
+                  "and is turned at random about its flat faces' normal, or, when orientation_wxyz is recorded, at "
+                  "the turn nearest it; a sphere or equant body anyhow) or any (uniform over all orientations)")
       ->check(CLI::IsMember({"on-edge", "any"}))
       ->capture_default_str();
   sub->add_option("--model-accuracy", args->model_accuracy_mm,

@@ -40,8 +40,9 @@ struct DiagnoseOptions {
   double horizon_perturbation = 1e-4;  ///< [rad] release-orientation perturbation for the predictability horizon
   int release_orientations = 12;  ///< drawn from each release prior to find how long the trials stay predictable, >= 2
   double orientation_prior_deg = 15.0;  ///< uncertainty of a recorded release orientation [deg], (0, 180]
-  /// How the lab set the particle on a roll's incline when no orientation is recorded: a
-  /// flattened particle on its rim by default (the way it rolls), or any orientation.
+  /// How the lab set the particle on a roll's incline: a flattened particle on its rim by
+  /// default (the way it rolls; a recorded orientation is set on the rim as near as it goes),
+  /// or any orientation.
   RollPosture roll_release = RollPosture::OnEdge;
   /// [m] how closely any clump and contact law can follow a real particle's tracked point,
   /// [0, 0.01]: residuals are weighed against hypot(camera noise, this). 0 trusts the model

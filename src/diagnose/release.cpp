@@ -30,6 +30,37 @@ Eigen::Quaterniond random_on_edge_orientation(Rng& rng) {
   return on_edge_orientation(angle, rng.uniform() < 0.5);
 }
 
+namespace {
+
+// The rotation about the unit `axis` nearest to `q` (its twist): the turn that maximises
+// |<q, R(axis, angle)>|, angle/2 = atan2(v . axis, w).
+Eigen::Quaterniond twist_about(const Eigen::Quaterniond& q, const Eigen::Vector3d& axis) {
+  const double along = q.vec().dot(axis);
+  if (std::hypot(q.w(), along) < 1e-12) return Eigen::Quaterniond::Identity();
+  return Eigen::Quaterniond(Eigen::AngleAxisd(2.0 * std::atan2(along, q.w()), axis));
+}
+
+}  // namespace
+
+Eigen::Quaterniond nearest_posture(LabTest test, bool on_edge, const Eigen::Quaterniond& q) {
+  const Eigen::Quaterniond unit = q.normalized();
+  if (test == LabTest::Tilt) return twist_about(unit, Eigen::Vector3d::UnitZ());
+  if (test != LabTest::Roll || !on_edge) return unit;
+  Eigen::Quaterniond best = unit;
+  double closest = -1.0;
+  for (bool flip : {false, true}) {
+    const Eigen::Quaterniond edge = on_edge_orientation(0.0, flip);  // R_x(+-90 deg)
+    const Eigen::Quaterniond turn = twist_about(unit * edge.conjugate(), Eigen::Vector3d::UnitY());
+    const Eigen::Quaterniond candidate = (turn * edge).normalized();
+    const double dot = std::abs(candidate.coeffs().dot(unit.coeffs()));
+    if (dot > closest) {
+      closest = dot;
+      best = candidate;
+    }
+  }
+  return best;
+}
+
 std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count,
                                                           std::uint64_t seed, std::uint64_t stream) {
   Rng rng(seed, stream);
@@ -37,16 +68,17 @@ std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const Or
   out.reserve(static_cast<std::size_t>(std::max(0, count)));
   for (int k = 0; k < count; ++k) {
     if (prior.recorded) {
-      if (k == 0) {
-        out.push_back(prior.recorded->normalized());
-        continue;
+      // Uniform in the ball of rotation vectors of radius `spread` (a random axis, an angle
+      // with density proportional to its square), the recorded one first; then set down as
+      // the test sets the particle down (on its rim, lying), as near as it goes.
+      Eigen::Quaterniond q = prior.recorded->normalized();
+      if (k > 0) {
+        Eigen::Vector3d axis(rng.normal(), rng.normal(), rng.normal());
+        if (axis.norm() < 1e-12) axis = Eigen::Vector3d::UnitX();
+        const double angle = prior.spread * std::cbrt(rng.uniform());
+        q = Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())) * q;
       }
-      // Uniform in the ball of rotation vectors of radius `spread`: a random axis, an angle
-      // with density proportional to its square.
-      Eigen::Vector3d axis(rng.normal(), rng.normal(), rng.normal());
-      if (axis.norm() < 1e-12) axis = Eigen::Vector3d::UnitX();
-      const double angle = prior.spread * std::cbrt(rng.uniform());
-      out.push_back((Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized())) * *prior.recorded).normalized());
+      out.push_back(nearest_posture(test, prior.on_edge, q));
     } else if (test == LabTest::Roll && prior.on_edge) {
       out.push_back(random_on_edge_orientation(rng));
     } else if (test == LabTest::Tilt) {

@@ -41,18 +41,25 @@ Eigen::Quaterniond on_edge_orientation(double angle, bool flip);
 /// first, then the side): how the diagnoser's prior and the generator's lab set a roll down.
 Eigen::Quaterniond random_on_edge_orientation(Rng& rng);
 
+/// The orientation nearest to `q` (largest |<q, p>|) among those the test sets a particle
+/// down in: on its rim at any turn (a roll with `on_edge`), lying at any heading about the
+/// vertical (a tilt), `q` itself otherwise (a drop: any orientation).
+Eigen::Quaterniond nearest_posture(LabTest test, bool on_edge, const Eigen::Quaterniond& q);
+
 /// What is known of one trial's release orientation.
 struct OrientationPrior {
   std::optional<Eigen::Quaterniond> recorded;       ///< the lab's, when written down (a prior centre)
   double spread = 15.0 * std::numbers::pi / 180.0;  ///< [rad] how far from `recorded` the release may be, (0, pi]
-  bool on_edge = false;  ///< a roll with nothing recorded: stood on its rim (RollPosture::OnEdge and has_edge)
+  bool on_edge = false;  ///< a roll: stood on its rim (RollPosture::OnEdge and has_edge), recorded or not
 };
 
 /// `count` release orientations the prior allows, reproducibly from (`seed`, `stream`):
 /// uniform over all rotations (drop, roll), on the rim at a uniform turn (a roll with
 /// `on_edge`) or over headings about the vertical (tilt: the particle lies as the test places
 /// it) when nothing was recorded; uniform within a ball of rotation angle `spread` about the
-/// recorded one otherwise, the recorded one first.
+/// recorded one otherwise, the recorded one first, each then set down as the test sets a
+/// particle down (nearest_posture): a lab's written-down orientation is off by tens of
+/// degrees, its apparatus (a rim on the incline, a face on the plate) is not.
 std::vector<Eigen::Quaterniond> draw_release_orientations(LabTest test, const OrientationPrior& prior, int count,
                                                           std::uint64_t seed, std::uint64_t stream);
 

@@ -266,3 +266,42 @@ TEST(EnsembleOrientations, RollsStandAFlattenedParticleOnItsRim) {
   for (const auto& q : drops) mean_abs_y += std::abs((q * Eigen::Vector3d::UnitZ()).y()) / 400.0;
   EXPECT_NEAR(mean_abs_y, 0.5, 0.05);  // sd of the mean 0.29/20 = 0.014
 }
+
+// A recorded orientation is off by tens of degrees; the apparatus is not. A roll's replays
+// drawn around a recorded orientation stand on the rim (flat faces' normal across the slope)
+// at the turn nearest the draw, a tilt's lie at the nearest heading, a drop's stay where drawn.
+// The projection keeps what is already in the posture and never moves a draw farther than the
+// draw lies from the posture family (the nearest member is at most as far as the true one).
+TEST(EnsembleOrientations, RecordedOrientationsAreSetDownAsTheTestSetsTheParticle) {
+  const double deg = std::numbers::pi / 180.0;
+  const Eigen::Quaterniond truth = on_edge_orientation(1.1, true);
+  EXPECT_TRUE(nearest_posture(LabTest::Roll, true, truth).isApprox(truth, 1e-12) ||
+              nearest_posture(LabTest::Roll, true, truth).coeffs().isApprox(-truth.coeffs(), 1e-12));
+  // Written down 20 deg off the rim-standing release, about a tilted axis.
+  const Eigen::Quaterniond recorded =
+      Eigen::Quaterniond(Eigen::AngleAxisd(20.0 * deg, Eigen::Vector3d(1, 2, 3).normalized())) * truth;
+  OrientationPrior prior;
+  prior.recorded = recorded;
+  prior.on_edge = true;
+  const auto rolls = draw_release_orientations(LabTest::Roll, prior, 50, 5, 0);
+  ASSERT_EQ(rolls.size(), 50U);
+  for (const auto& q : rolls) {
+    const Eigen::Vector3d normal = q * Eigen::Vector3d::UnitZ();
+    EXPECT_NEAR(std::abs(normal.y()), 1.0, 1e-12);
+    EXPECT_LT(q.angularDistance(truth), 40.0 * deg);  // 20 off, then within the 15 deg ball, then nearer
+  }
+  // The recorded one first, set down: no farther from the truth than the record.
+  EXPECT_LE(rolls.front().angularDistance(truth), recorded.angularDistance(truth) + 1e-12);
+  // Without a rim (a sphere, or the lab set it down anyhow) the roll's draws are not moved.
+  prior.on_edge = false;
+  const auto anyhow = draw_release_orientations(LabTest::Roll, prior, 5, 5, 0);
+  EXPECT_TRUE(anyhow.front().isApprox(recorded.normalized(), 1e-12));
+  // A tilt: lying as placed, the body z up, at the heading nearest the record.
+  const Eigen::Quaterniond lying(Eigen::AngleAxisd(0.8, Eigen::Vector3d::UnitZ()));
+  const Eigen::Quaterniond tilted = Eigen::Quaterniond(Eigen::AngleAxisd(12.0 * deg, Eigen::Vector3d::UnitX())) * lying;
+  const Eigen::Quaterniond flat = nearest_posture(LabTest::Tilt, false, tilted);
+  EXPECT_NEAR((flat * Eigen::Vector3d::UnitZ()).z(), 1.0, 1e-12);
+  EXPECT_LT(flat.angularDistance(lying), 1e-9);  // a tilt about x leaves the heading
+  // A drop: any orientation, left as drawn.
+  EXPECT_TRUE(nearest_posture(LabTest::Drop, true, recorded).isApprox(recorded, 1e-12));
+}
