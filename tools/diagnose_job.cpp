@@ -33,6 +33,20 @@ nlohmann::json finite_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
 }
 
+// How a rung's replayed outcomes moved from the previous clump's (null when not compared).
+nlohmann::json outcome_shift_json(const std::optional<OutcomeShift>& shift, const std::vector<std::string>& names) {
+  if (!shift) return nlohmann::json();
+  return {{"means", shift->means},
+          {"chi2", finite_or_null(shift->chi2)},
+          {"p", finite_or_null(shift->p)},
+          {"largest_se", finite_or_null(shift->largest)},
+          {"recording", shift->recording < names.size() ? nlohmann::json(names[shift->recording]) : nlohmann::json()},
+          {"outcome", std::string(outcome_name(shift->outcome))},
+          {"from", finite_or_null(shift->from)},
+          {"to", finite_or_null(shift->to)},
+          {"converged", shift->converged()}};
+}
+
 nlohmann::json coefficients_json(const std::vector<SurfaceParameters>& base) {
   nlohmann::json out = nlohmann::json::object();
   for (const auto& b : base) {
@@ -137,14 +151,17 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
     const auto& m = *r.particle_model;
     nlohmann::json rungs = nlohmann::json::array();
     for (const auto& rung : m.rungs) {
-      rungs.push_back({{"clump", rung.name},
-                       {"spheres", rung.spheres},
-                       {"track_difference_mm", finite_or_null(rung.track_difference_m * 1e3)},
-                       {"refitted", rung.refitted},
-                       {"chi2_per_value", rung.refitted ? finite_or_null(rung.chi2_per_value) : nlohmann::json()},
-                       {"worst_phase_chi2_per_value",
-                        rung.refitted ? finite_or_null(rung.worst_phase_chi2_per_value) : nlohmann::json()},
-                       {"explains", rung.explains}});
+      rungs.push_back(
+          {{"clump", rung.name},
+           {"spheres", rung.spheres},
+           {"track_difference_mm", finite_or_null(rung.track_difference_m * 1e3)},
+           {"refitted", rung.refitted},
+           {"chi2_per_value", rung.refitted ? finite_or_null(rung.chi2_per_value) : nlohmann::json()},
+           {"worst_phase_chi2_per_value",
+            rung.refitted ? finite_or_null(rung.worst_phase_chi2_per_value) : nlohmann::json()},
+           {"explains", rung.explains},
+           {"outcome_shift",
+            outcome_shift_json(rung.outcome_shift, r.ensemble ? r.ensemble->recordings : std::vector<std::string>{})}});
     }
     j["particle_model"] = {
         {"diagnosed", m.diagnosed},

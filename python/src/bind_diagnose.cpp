@@ -15,9 +15,10 @@ void bind_enums(py::module_& m) {
       .value("unexplained", Verdict::Unexplained)
       .value("undecidable", Verdict::Undecidable);
   py::enum_<Basis> basis(m, "Basis");
-  for (Basis b : {Basis::Consistent, Basis::SlightMisfit, Basis::FrameByFrame, Basis::Ensemble,
-                  Basis::UnexplainedPhases, Basis::TooFewTrials, Basis::TooNoisy, Basis::SummariesOnly,
-                  Basis::ParticleModel, Basis::UnexplainedOutcomes, Basis::FreeFlights})
+  for (Basis b :
+       {Basis::Consistent, Basis::SlightMisfit, Basis::FrameByFrame, Basis::Ensemble, Basis::UnexplainedPhases,
+        Basis::TooFewTrials, Basis::TooNoisy, Basis::SummariesOnly, Basis::ParticleModel, Basis::UnexplainedOutcomes,
+        Basis::UnconvergedParticleModel, Basis::FreeFlights})
     basis.value(std::string(basis_name(b)).c_str(), b);
   py::enum_<Phase> phase(m, "Phase");
   for (Phase p : {Phase::Hold, Phase::Flight, Phase::Impact, Phase::Rebound, Phase::SecondFlight, Phase::LaterBounces,
@@ -86,6 +87,21 @@ void bind_parts(py::module_& m) {
       .def_readonly("phase", &PhaseOf::phase)
       .def_readonly("chi2_per_value", &PhaseOf::chi2_per_value)
       .def_readonly("where", &PhaseOf::where);
+  py::enum_<Outcome> outcome(m, "Outcome");
+  for (Outcome o : {Outcome::ReboundHeight, Outcome::Drift, Outcome::RollDistance, Outcome::RollTime})
+    outcome.value(std::string(outcome_name(o)).c_str(), o);
+  py::class_<OutcomeShift>(m, "OutcomeShift",
+                           "How a finer clump's replayed outcomes moved from the previous clump's at the same "
+                           "coefficients and orientations.")
+      .def_readonly("means", &OutcomeShift::means)
+      .def_readonly("chi2", &OutcomeShift::chi2)
+      .def_readonly("p", &OutcomeShift::p)
+      .def_readonly("largest", &OutcomeShift::largest, "the largest move in recorded standard errors")
+      .def_readonly("recording", &OutcomeShift::recording)
+      .def_readonly("outcome", &OutcomeShift::outcome)
+      .def_readonly("from_value", &OutcomeShift::from)
+      .def_readonly("to_value", &OutcomeShift::to)
+      .def("converged", &OutcomeShift::converged);
   py::class_<ParticleModelRung>(m, "ParticleModelRung", "One clump the particle-model check tried.")
       .def_readonly("name", &ParticleModelRung::name)
       .def_readonly("spheres", &ParticleModelRung::spheres)
@@ -94,7 +110,8 @@ void bind_parts(py::module_& m) {
       .def_readonly("refitted", &ParticleModelRung::refitted)
       .def_readonly("chi2_per_value", &ParticleModelRung::chi2_per_value)
       .def_readonly("worst_phase_chi2_per_value", &ParticleModelRung::worst_phase_chi2_per_value)
-      .def_readonly("explains", &ParticleModelRung::explains);
+      .def_readonly("explains", &ParticleModelRung::explains)
+      .def_readonly("outcome_shift", &ParticleModelRung::outcome_shift);
   py::class_<ParticleModelCheck>(m, "ParticleModelCheck",
                                  "Whether the particle model, not missing physics, explains a mismatch.")
       .def_readonly("diagnosed", &ParticleModelCheck::diagnosed)

@@ -150,6 +150,10 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
   // question is whether that candidate only absorbed the coarse clump's share.
   const bool coarse_consistent = outcomes_consistent(e.null_comparisons, free.size());
   check.worst_phase_chi2_per_value = largest_z2(e.null_comparisons);
+  // The previous rung's calibrated null: its model and its comparisons.
+  Model previous_model = baseline;
+  previous_model.base = e.calibrated;
+  std::vector<OutcomeComparison> previous = e.null_comparisons;
   for (std::size_t k = 0; k < c.finer.size(); ++k) {
     // The baseline refitted the baseline's way with the finer clump (the coefficients the
     // frames pin change with the clump: a coarse clump rolls otherwise), its whole tracks
@@ -166,10 +170,20 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     auto fine = compare_ensembles(c.ev, fitted->model, *scores, free, candidates, eo);
     if (!fine) return std::unexpected(fine.error());
     c.evaluations += fine->replays;
+    // This clump at the previous one's calibrated coefficients: how far the resolution alone
+    // moves the outcomes.
+    int replays = 0;
+    auto same = compare_model(c.ev, previous_model, *scores, eo, replays);
+    if (!same) return std::unexpected(same.error());
+    c.evaluations += replays;
     ParticleModelRung& rung = check.rungs.at(k + 1);
     rung.refitted = true;
     rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
     rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
+    rung.outcome_shift = outcome_shift(previous, *same);
+    previous = fine->null_comparisons;
+    previous_model = fitted->model;
+    previous_model.base = fine->calibrated;
     rung.explains = fine->outcomes == outcomes && outcomes_consistent(fine->null_comparisons, free.size());
     if (!rung.explains) continue;
     check.resolution_needed = rung.spheres;
@@ -217,6 +231,44 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
   return false;
 }
 
+/// No finer clump explained a mismatch of the outcomes, but the finest one's replayed outcomes
+/// still moved from the previous clump's by a real amount that matters (OutcomeShift): the
+/// particle model is not converged beyond the release horizon, and the mismatch cannot be
+/// blamed on missing physics. The verdict is undecidable and names the resolution to try.
+/// Returns whether it said so.
+bool particle_model_unconverged(const Context& c, DiagnoseResult& result) {
+  if (!result.particle_model) return false;
+  const auto& rungs = result.particle_model->rungs;
+  const auto last = std::find_if(rungs.rbegin(), rungs.rend(), [](const ParticleModelRung& r) { return r.refitted; });
+  if (last == rungs.rend() || !last->outcome_shift || last->outcome_shift->converged()) return false;
+  const ParticleModelRung& before = *std::next(last);
+  const OutcomeShift& shift = *last->outcome_shift;
+  const EnsembleReport& e = *result.ensemble;
+  const double scale = shift.outcome == Outcome::RollTime ? 1.0 : 1e3;
+  const std::string where = fmt::format(
+      ", most the mean {} of {} ({:.3g} -> {:.3g} {}, {:.1f} recorded standard errors)", outcome_name(shift.outcome),
+      recording_label((*c.ev.recordings)[shift.recording], c.names[shift.recording]), shift.from * scale,
+      shift.to * scale, shift.outcome == Outcome::RollTime ? "s" : "mm", shift.largest);
+  if (!result.statement.empty()) result.notes.push_back(fmt::format("frame by frame: {}", result.statement));
+  result.verdict = Verdict::Undecidable;
+  result.basis = Basis::UnconvergedParticleModel;
+  result.statement = fmt::format(
+      "Not decidable with these clumps: the recorded outcomes differ from replays over the unknown release "
+      "orientation (chi^2 {:.1f} over {} recorded means and spreads with {}, {:.1f} with {}), but the particle "
+      "model is not converged beyond the release horizon: from {} to {} spheres, at the same coefficients and "
+      "release orientations, the replayed outcomes still moved (chi^2 {:.1f} over {} means against the replays' "
+      "noise, p = {:.2g}){}. "
+      "Until a finer clump's outcomes agree with the last one's, the mismatch may be the particle model's, not "
+      "missing physics.",
+      e.null_chi2, e.outcomes, result.particle_model->diagnosed, last->chi2_per_value * e.outcomes, last->name,
+      before.spheres, last->spheres, shift.chi2, shift.means, shift.p, where);
+  result.experiment = fmt::format(
+      "diagnose again with clumps of more than {} spheres of the same scan (--mesh with --finer-clumps up to 4, or a "
+      "--library holding finer clumps), until two successive ones replay the same outcomes",
+      last->spheres);
+  return true;
+}
+
 /// Nothing named, yet the calibrated null leaves the recorded outcomes inconsistent with the
 /// replays: a mismatch beyond the release horizon. Unless a finer clump explains it
 /// (finer_clump_explains_outcomes), the verdict is unexplained.
@@ -230,6 +282,7 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
       finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, max_evaluations, std::nullopt);
   if (!explained) return std::unexpected(explained.error());
   if (*explained) return {};
+  if (particle_model_unconverged(c, result)) return {};
   // Unexplained: the outcomes beyond the noise, three standard errors or more.
   std::vector<std::string> far;
   for (const auto& o : e.null_comparisons) {

@@ -79,6 +79,9 @@ struct ParticleModelRung {
   /// z^2 (outcomes beyond the release horizon), as chi2_per_value is per value or per mean.
   double worst_phase_chi2_per_value = 0.0;
   bool explains = false;  ///< it leaves no large misfit: the mismatch was the particle model's
+  /// Beyond the release horizon: how its calibrated null's replayed outcomes moved from the
+  /// previous clump's (empty when not compared on outcomes).
+  std::optional<OutcomeShift> outcome_shift;
 };
 
 /// Whether the particle model, not missing physics, explains a mismatch.
@@ -185,18 +188,20 @@ struct PhaseOf {
 
 /// What a verdict rests on, beside the verdict itself.
 enum class Basis {
-  Consistent,           ///< none: every phase at the noise level once the coefficients are fitted
-  SlightMisfit,         ///< none: a small misfit with no shape the trials share remains
-  FrameByFrame,         ///< named or ambiguous from the trials' tracks within the release horizon
-  Ensemble,             ///< named or ambiguous from the recorded outcomes against replays over the release
-  UnexplainedPhases,    ///< unexplained: phases beyond the noise no candidate explains
-  UnexplainedOutcomes,  ///< unexplained: recorded outcomes beyond the release horizon no candidate (nor a finer
-                        ///< clump) brings within the noise of replays over the release
-  TooFewTrials,         ///< undecidable: fewer than two usable tracked trials
-  TooNoisy,             ///< undecidable: the tracks' noise hides what the effects would do
-  SummariesOnly,        ///< no tracks: what the summaries decide
-  ParticleModel,        ///< none: the mismatch goes with a finer clump of the same body (see ParticleModelCheck)
-  FreeFlights,          ///< named from the drops' free flights after the first contact (see diagnose/flights.hpp)
+  Consistent,                ///< none: every phase at the noise level once the coefficients are fitted
+  SlightMisfit,              ///< none: a small misfit with no shape the trials share remains
+  FrameByFrame,              ///< named or ambiguous from the trials' tracks within the release horizon
+  Ensemble,                  ///< named or ambiguous from the recorded outcomes against replays over the release
+  UnexplainedPhases,         ///< unexplained: phases beyond the noise no candidate explains
+  UnexplainedOutcomes,       ///< unexplained: recorded outcomes beyond the release horizon no candidate (nor a finer
+                             ///< clump) brings within the noise of replays over the release
+  UnconvergedParticleModel,  ///< undecidable: such outcomes, but the finest clump's replayed outcomes still
+                             ///< moved with resolution (ParticleModelRung::outcome_shift)
+  TooFewTrials,              ///< undecidable: fewer than two usable tracked trials
+  TooNoisy,                  ///< undecidable: the tracks' noise hides what the effects would do
+  SummariesOnly,             ///< no tracks: what the summaries decide
+  ParticleModel,             ///< none: the mismatch goes with a finer clump of the same body (see ParticleModelCheck)
+  FreeFlights,               ///< named from the drops' free flights after the first contact (see diagnose/flights.hpp)
 };
 std::string_view basis_name(Basis basis);
 

@@ -99,17 +99,50 @@ OutcomeComparison compare_outcome(const std::vector<double>& recorded, const std
   c.ensemble_sd = e.sd;
   c.recorded_n = static_cast<int>(recorded.size());
   c.ensemble_n = static_cast<int>(ensemble.size());
-  // Sums of squares about each sample's own mean, pooled.
-  const double ss_r = r.sd * r.sd * std::max(0, c.recorded_n - 1), ss_e = e.sd * e.sd * std::max(0, c.ensemble_n - 1);
-  const int dof = c.recorded_n + c.ensemble_n - 2;
-  const double pooled = dof > 0 ? (ss_r + ss_e) / dof : 0.0;
-  const double se2 = c.recorded_n > 0 && c.ensemble_n > 0
-                         ? pooled * (1.0 / c.recorded_n + 1.0 / c.ensemble_n) + floor * floor
-                         : floor * floor;
-  c.z = se2 > 0.0 ? (c.recorded_mean - c.ensemble_mean) / std::sqrt(se2) : 0.0;
+  const double se = comparison_se(c);
+  c.z = se > 0.0 ? (c.recorded_mean - c.ensemble_mean) / se : 0.0;
   c.recorded_value = c.recorded_mean;
   c.ensemble_value = c.ensemble_mean;
   return c;
+}
+
+double comparison_se(const OutcomeComparison& c) {
+  // Sums of squares about each sample's own mean, pooled.
+  const double ss_r = c.recorded_sd * c.recorded_sd * std::max(0, c.recorded_n - 1),
+               ss_e = c.ensemble_sd * c.ensemble_sd * std::max(0, c.ensemble_n - 1);
+  const int dof = c.recorded_n + c.ensemble_n - 2;
+  const double pooled = dof > 0 ? (ss_r + ss_e) / dof : 0.0;
+  const double se2 = c.recorded_n > 0 && c.ensemble_n > 0
+                         ? pooled * (1.0 / c.recorded_n + 1.0 / c.ensemble_n) + c.floor * c.floor
+                         : c.floor * c.floor;
+  return std::sqrt(se2);
+}
+
+OutcomeShift outcome_shift(const std::vector<OutcomeComparison>& coarse, const std::vector<OutcomeComparison>& fine) {
+  OutcomeShift shift;
+  for (const OutcomeComparison& b : fine) {
+    if (b.statistic != Statistic::Mean) continue;
+    const auto a = std::find_if(coarse.begin(), coarse.end(), [&](const OutcomeComparison& x) {
+      return x.statistic == Statistic::Mean && x.recording == b.recording && x.outcome == b.outcome;
+    });
+    if (a == coarse.end() || a->ensemble_n < 2 || b.ensemble_n < 2) continue;
+    const double moved = b.ensemble_mean - a->ensemble_mean;
+    const double noise = std::sqrt(a->ensemble_sd * a->ensemble_sd / a->ensemble_n +
+                                   b.ensemble_sd * b.ensemble_sd / b.ensemble_n + b.floor * b.floor);
+    if (!(noise > 0.0)) continue;
+    ++shift.means;
+    shift.chi2 += moved * moved / (noise * noise);
+    const double se = comparison_se(b), matters = se > 0.0 ? std::abs(moved) / se : 0.0;
+    if (matters >= shift.largest) {
+      shift.largest = matters;
+      shift.recording = b.recording;
+      shift.outcome = b.outcome;
+      shift.from = a->ensemble_mean;
+      shift.to = b.ensemble_mean;
+    }
+  }
+  shift.p = shift.means > 0 ? chi2_upper_tail(shift.chi2, shift.means) : 1.0;
+  return shift;
 }
 
 namespace {
@@ -148,6 +181,8 @@ struct Plan {
 };
 
 using Sample = std::vector<std::vector<std::vector<double>>>;  ///< [plan][outcome][replay]
+
+constexpr std::uint64_t kNullStream = 90000;  ///< the null's orientations (compare_ensembles, compare_model)
 
 PathSample recorded_path(const Track& track, const TrialScore& score) {
   const double x0 = score.replay.empty() ? 0.0 : interpolate(score.replay, 0.0).x;
@@ -635,6 +670,17 @@ std::vector<Eigen::Quaterniond> ensemble_orientations(LabTest test, const std::v
   return out;
 }
 
+Result<std::vector<OutcomeComparison>> compare_model(const Evaluator& ev, const Model& model,
+                                                     const std::vector<TrialScore>& scores,
+                                                     const EnsembleOptions& options, int& replays) {
+  if (scores.size() != ev.trials.size())
+    return fail(ErrorCode::InvalidArgument, "one full-duration score per tracked trial is needed");
+  const std::vector<Plan> plans = make_plans(ev, scores, options, kNullStream);
+  auto out = replay_outcomes(ev, model, plans, std::vector<bool>(plans.size(), true), nullptr, replays);
+  if (!out) return std::unexpected(out.error());
+  return compare_all(plans, *out, options.impact_accuracy);
+}
+
 Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& baseline,
                                          const std::vector<TrialScore>& scores,
                                          const std::vector<FreeCoefficient>& free,
@@ -643,7 +689,7 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   if (scores.size() != ev.trials.size())
     return fail(ErrorCode::InvalidArgument, "one full-duration score per tracked trial is needed");
   EnsembleResult result;
-  const std::vector<Plan> plans = make_plans(ev, scores, options, 90000);
+  const std::vector<Plan> plans = make_plans(ev, scores, options, kNullStream);
   if (plans.empty()) return result;
   for (const Plan& p : plans) result.trials += static_cast<double>(p.recorded.front().size()) / plans.size();
   const std::vector<bool> every(plans.size(), true);

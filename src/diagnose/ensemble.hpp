@@ -70,6 +70,33 @@ OutcomeComparison compare_outcome(const std::vector<double>& recorded, const std
 OutcomeComparison compare_spread(const std::vector<double>& recorded, const std::vector<double>& ensemble,
                                  double floor);
 
+/// The standard error a mean's comparison is in: sqrt(s_p^2 (1/n + 1/K) + floor^2)
+/// (compare_outcome; a spread's comparison keeps the values' sds, not the deviations').
+double comparison_se(const OutcomeComparison& c);
+
+/// How the replayed outcomes move from one clump to a finer one of the same body: both
+/// replayed at the same coefficients (the first clump's calibrated null) from the same release
+/// orientations, compared recorded mean by recorded mean. The move is real when it stands out of the two replay
+/// samples' noise and the floor (chi^2 of shift / sqrt(s_a^2/K_a + s_b^2/K_b + floor^2) over the means, upper tail
+/// below kReal; independent samples, though the orientations are shared) and it matters when it is a recorded standard
+/// error or more (comparison_se): a clump whose outcomes still move by that much with resolution cannot say whether a
+/// mismatch beyond the release horizon is missing physics or its own coarseness.
+struct OutcomeShift {
+  static constexpr double kReal = 0.01;      ///< upper-tail probability below which the move is real
+  static constexpr double kMatters = 1.0;    ///< [recorded standard errors] a move that matters
+  int means = 0;                             ///< recorded means both clumps were compared on
+  double chi2 = 0.0;                         ///< of the shifts against the replays' sampling noise
+  double p = 1.0;                            ///< its upper tail with `means` degrees of freedom
+  double largest = 0.0;                      ///< the largest |shift| in recorded standard errors
+  std::size_t recording = 0;                 ///< that mean's recording
+  Outcome outcome = Outcome::ReboundHeight;  ///< and outcome
+  double from = 0.0, to = 0.0;               ///< its replayed value with each clump
+  bool converged() const { return !(means > 0 && p < kReal && largest >= kMatters); }
+};
+/// The shift from `coarse` to `fine` (comparisons of the same recordings, compare_model); only
+/// the means are compared (a spread's sampling noise is not the mean's).
+OutcomeShift outcome_shift(const std::vector<OutcomeComparison>& coarse, const std::vector<OutcomeComparison>& fine);
+
 struct EnsembleOptions {
   int replays = 12;  ///< release orientations per recording, >= 4
   double orientation_prior_deg = 15.0;
@@ -137,5 +164,13 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
                                          const std::vector<TrialScore>& scores,
                                          const std::vector<FreeCoefficient>& free,
                                          const std::vector<Effect>& candidates, const EnsembleOptions& options);
+
+/// The recorded outcomes against replays of `model` as it is (nothing calibrated, no
+/// candidate), from the orientations compare_ensembles draws for its null: a second clump's
+/// outcomes at a first one's calibrated coefficients, for outcome_shift. `replays` counts the
+/// DEM replays run.
+Result<std::vector<OutcomeComparison>> compare_model(const Evaluator& ev, const Model& model,
+                                                     const std::vector<TrialScore>& scores,
+                                                     const EnsembleOptions& options, int& replays);
 
 }  // namespace clumpforge

@@ -289,6 +289,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
                                            const std::vector<FreeCoefficient>& free,
                                            const std::vector<Effect>& candidates, const EnsembleOptions& eo,
                                            int max_evaluations, std::optional<LetThrough> let_through);
+bool particle_model_unconverged(const Context& c, DiagnoseResult& result);
 Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Model& baseline,
                                   const std::vector<FreeCoefficient>& free, const std::vector<Effect>& candidates,
                                   const EnsembleOptions& eo, int max_evaluations);

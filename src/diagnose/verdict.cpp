@@ -187,6 +187,8 @@ std::string_view basis_name(Basis basis) {
       return "particle_model";
     case Basis::UnexplainedOutcomes:
       return "unexplained_outcomes";
+    case Basis::UnconvergedParticleModel:
+      return "unconverged_particle_model";
     case Basis::FreeFlights:
       return "free_flights";
   }

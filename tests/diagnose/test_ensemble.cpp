@@ -305,3 +305,62 @@ TEST(EnsembleOrientations, RecordedOrientationsAreSetDownAsTheTestSetsTheParticl
   // A drop: any orientation, left as drawn.
   EXPECT_TRUE(nearest_posture(LabTest::Drop, true, recorded).isApprox(recorded, 1e-12));
 }
+
+// The particle model's convergence beyond the release horizon: two clumps' replayed outcomes at
+// the same coefficients. A move is flagged only when it is real against the two replay samples'
+// noise (chi^2 upper tail below 1 %) and matters against the recorded standard error (1 se or
+// more); spreads are not compared. Samples are built so each figure is known: a replay sample
+// of 12 values with mean m and sd 0.01, recorded 4 values with sd 0.01.
+TEST(EnsembleConvergence, AnOutcomeShiftCountsWhenItIsRealAndMatters) {
+  auto sample = [](double mean, double sd, int n) {
+    std::vector<double> v;
+    for (int i = 0; i < n; ++i) v.push_back(mean + sd * (i % 2 == 0 ? 1.0 : -1.0));  // sd * sqrt(n/(n-1))
+    return v;
+  };
+  auto comparisons = [&](double replay_mean, double recorded_sd) {
+    std::vector<OutcomeComparison> out;
+    for (std::size_t r = 0; r < 2; ++r) {
+      OutcomeComparison m = compare_outcome(sample(0.05, recorded_sd, 4), sample(replay_mean, 0.01, 12), 1e-4);
+      m.recording = r;
+      m.outcome = Outcome::Drift;
+      m.statistic = Statistic::Mean;
+      out.push_back(m);
+      OutcomeComparison s = compare_spread(sample(0.05, recorded_sd, 4), sample(5.0, 1.0, 12), 1e-4);
+      s.recording = r;
+      s.outcome = Outcome::Drift;
+      out.push_back(s);  // a spread far off: not compared
+    }
+    return out;
+  };
+  const auto coarse = comparisons(0.10, 0.01);
+  // The same outcomes: nothing moved.
+  const OutcomeShift none = outcome_shift(coarse, coarse);
+  EXPECT_EQ(none.means, 2);
+  EXPECT_NEAR(none.chi2, 0.0, 1e-12);
+  EXPECT_TRUE(none.converged());
+  // The first recording's mean moved by 0.02: the replays' noise is sqrt(2 / 12) * 0.0104 =
+  // 0.0043, so chi^2 = (0.02 / 0.0043)^2 = 22 over 2 means (p ~ 2e-5); the recorded se is
+  // 0.0062, so 3.2 se.
+  auto moved = comparisons(0.12, 0.01);
+  moved[2] = coarse[2];  // only the first recording's mean moves
+  moved[2].recording = 1;
+  const OutcomeShift shift = outcome_shift(coarse, moved);
+  EXPECT_EQ(shift.means, 2);
+  EXPECT_NEAR(shift.chi2, 21.5, 1.5);
+  EXPECT_LT(shift.p, OutcomeShift::kReal);
+  EXPECT_NEAR(shift.largest, 0.02 / comparison_se(moved[0]), 1e-9);
+  EXPECT_GT(shift.largest, 2.0);
+  EXPECT_EQ(shift.recording, 0U);
+  EXPECT_NEAR(shift.from, 0.10, 1e-12);
+  EXPECT_NEAR(shift.to, 0.12, 1e-12);
+  EXPECT_FALSE(shift.converged());
+  // The same move against recordings ten times as scattered: real, but under a recorded se.
+  const OutcomeShift small = outcome_shift(comparisons(0.10, 0.1), comparisons(0.12, 0.1));
+  EXPECT_LT(small.p, OutcomeShift::kReal);
+  EXPECT_LT(small.largest, OutcomeShift::kMatters);
+  EXPECT_TRUE(small.converged());
+  // A move within the replays' noise (0.004 against 0.0043 per mean): not real.
+  const OutcomeShift noise = outcome_shift(coarse, comparisons(0.104, 0.01));
+  EXPECT_GT(noise.p, 0.1);
+  EXPECT_TRUE(noise.converged());
+}

@@ -170,6 +170,10 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
         cf.diagnose(small, recordings, roll_release="flat")
     assert "particle_model" in dir(cf.DiagnoseResult)
     assert cf.Basis.particle_model != cf.Basis.unexplained_outcomes
+    # Beyond the release horizon a mismatch on a clump not converged there is undecidable.
+    assert cf.Basis.unconverged_particle_model != cf.Basis.unexplained_outcomes
+    assert {"means", "chi2", "p", "largest", "outcome", "converged"} <= set(dir(cf.OutcomeShift))
+    assert "outcome_shift" in dir(cf.ParticleModelRung)
     # The drops' free flights: what they say about the tracked point, and the basis they name on.
     assert "flights" in dir(cf.DiagnoseResult)
     assert {"judged", "wobble_m", "allowance_m", "detected", "offset_m", "smallest_offset_m"} <= set(dir(cf.FlightWobble))
