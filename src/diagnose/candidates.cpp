@@ -237,9 +237,43 @@ Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result,
   return fits;
 }
 
+namespace {
+
+/// The largest misfit_per_value a signal `kept` (one value per cell of `keys`, in noise units)
+/// would leave in a phase on its own (the noise not counted), over phases with 10 values or
+/// more but the hold.
+double largest_signal_misfit(const Context& c, const std::vector<std::pair<GroupKey, Axis>>& keys,
+                             const Eigen::VectorXd& kept) {
+  if (static_cast<Eigen::Index>(keys.size()) != kept.size()) return 0.0;
+  Groups groups;
+  for (std::size_t j = 0; j < keys.size(); ++j) {
+    const auto& [key, axis] = keys[j];
+    Group& g = groups[key];
+    const double r = kept(static_cast<Eigen::Index>(j));
+    g.chi2 += r * r;
+    ++g.values;
+    if (axis == Axis::X) {
+      g.sq_x += r * r;
+      ++g.count_x;
+    } else {
+      g.sq_z += r * r;
+      ++g.count_z;
+    }
+  }
+  double largest = 0.0;
+  for (const auto& [key, g] : groups) {
+    if (key.phase == Phase::Hold || g.values < 10) continue;
+    largest = std::max(largest, misfit_per_value(c, key, g));
+  }
+  return largest;
+}
+
+}  // namespace
+
 /// For a `none`: the smallest effect of each candidate the data could have shown (its
 /// signal at a fifth of its realistic magnitude, the part the coefficients could absorb
-/// projected out, scaled quadratically to the delta-BIC margin; a lower bound), in each
+/// projected out, scaled quadratically to the delta-BIC margin and to a large misfit in one
+/// phase, whichever needs more; a lower bound), in each
 /// hypothesis report; returns the statements and the candidates not testable even at
 /// their strong magnitude.
 Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_limits(Context& c,
@@ -252,12 +286,20 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
   // the baseline's at a fifth of its realistic magnitude) with the part the coefficients
   // could absorb projected out (their own finite-difference directions), scaled
   // quadratically to the delta-BIC margin.
+  // The baseline's cells' groups (recording, phase) and axes, for the large-misfit rule.
+  std::vector<std::pair<GroupKey, Axis>> keys;
   auto cells = [&](const Model& m) -> Result<Eigen::VectorXd> {
     auto scores = evaluate(c.ev, m, c.training, false, true);
     c.evaluations += static_cast<int>(c.training.size());
     if (!scores) return std::unexpected(scores.error());
     std::vector<double> all_cells;
-    for (const auto& sc : *scores) all_cells.insert(all_cells.end(), sc.residuals.begin(), sc.residuals.end());
+    const bool first = keys.empty();
+    for (std::size_t k = 0; k < scores->size(); ++k) {
+      const TrialScore& sc = (*scores)[k];
+      all_cells.insert(all_cells.end(), sc.residuals.begin(), sc.residuals.end());
+      if (!first) continue;
+      for (const auto& [phase, axis] : sc.cells) keys.push_back({{c.ev.trials[c.training[k]].recording, phase}, axis});
+    }
     return Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));
   };
   auto base_cells = cells(baseline);
@@ -284,26 +326,31 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
     for (const auto& p : spec.parameters) probe.values.push_back(p.log_scale ? p.realistic : 0.2 * p.realistic);
     auto probe_cells = cells(probe);
     if (!probe_cells) return std::unexpected(probe_cells.error());
-    double signal = 0.0;
+    double signal = 0.0, misfit = 0.0;
     if (probe_cells->size() == base_cells->size()) {
       const Eigen::VectorXd d = *base_cells - *probe_cells;
       const Eigen::VectorXd kept =
           absorb.cols() > 0 ? Eigen::VectorXd(d - absorb * absorb.colPivHouseholderQr().solve(d)) : d;
       signal = kept.squaredNorm();
+      misfit = largest_signal_misfit(c, keys, kept);
     }
     const double needed =
         options.min_delta_bic + static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
+    // Named frame by frame only over a large misfit too: some phase's chi^2 per value at
+    // kLargeMisfit, of which the noise gives one.
+    const double needed_misfit = kLargeMisfit - 1.0;
     const auto& first = spec.parameters[0];
     if (first.log_scale) {
-      report.smallest_detectable = signal >= needed ? first.realistic : NAN;
-      limits.push_back(signal >= needed
-                           ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.realistic)
-                           : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.realistic));
+      const bool shows = signal >= needed && misfit >= needed_misfit;
+      report.smallest_detectable = shows ? first.realistic : NAN;
+      limits.push_back(shows ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.realistic)
+                             : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.realistic));
     } else {
       const double null_value = effect_off(spec)[0];
       const double probed = 0.2 * first.realistic;
-      report.smallest_detectable =
-          signal > 0.0 ? null_value + (probed - null_value) * std::sqrt(needed / signal) : kNever;
+      // Both grow as the magnitude's square while the response is linear.
+      const double scale = std::max(std::sqrt(needed / signal), std::sqrt(needed_misfit / misfit));
+      report.smallest_detectable = signal > 0.0 && misfit > 0.0 ? null_value + (probed - null_value) * scale : kNever;
       limits.push_back(fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable));
     }
     // Beyond its strong magnitude (or never): the predictable parts of these tracks cannot

@@ -96,8 +96,6 @@ struct ParticleModelCheck {
   std::optional<int> resolution_needed;     ///< spheres of the first finer clump that explains the mismatch
 };
 
-enum class Axis { X, Z };
-
 struct PhaseReport {
   std::string recording;  ///< recording name
   Phase phase = Phase::Flight;

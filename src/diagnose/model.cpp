@@ -120,11 +120,20 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
     }
     score.summary = replay_summary(samples, recording.test);
     if (keep_residuals) {
-      // The same cells every time (frames up to the cutoff, non-empty cells), in order.
+      // The same cells every time (frames up to the cutoff, non-empty cells), in order, each
+      // with its phase as phase_groups files it.
+      const PhaseMarks marks = phase_marks(samples, recording.test);
       for (const auto& f : residuals(track, samples, sigma, score.alignment)) {
         if (f.t + score.alignment.shift > tt.cutoff) break;
-        if (std::isfinite(f.rx)) score.residuals.push_back(f.rx);
-        if (std::isfinite(f.rz)) score.residuals.push_back(f.rz);
+        const Phase phase = phase_at(marks, recording.test, f.t);
+        if (std::isfinite(f.rx)) {
+          score.residuals.push_back(f.rx);
+          score.cells.emplace_back(phase, Axis::X);
+        }
+        if (std::isfinite(f.rz)) {
+          score.residuals.push_back(f.rz);
+          score.cells.emplace_back(phase, Axis::Z);
+        }
       }
     }
     if (keep_replays) score.replay = std::move(samples);

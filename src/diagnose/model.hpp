@@ -11,6 +11,7 @@
 #include "core/run_context.hpp"
 #include "dem/lab.hpp"
 #include "diagnose/effects.hpp"
+#include "diagnose/phases.hpp"
 #include "diagnose/tracks.hpp"
 
 namespace clumpforge {
@@ -56,6 +57,8 @@ struct TrialScore {
   std::vector<ReplaySample> replay;                           ///< kept when asked
   double summary = std::numeric_limits<double>::quiet_NaN();  ///< the replay's summary value (SI, deg for tilt)
   std::vector<double> residuals;  ///< (recorded - replay) / sigma of every fitted cell, when asked
+  /// Each residual's phase (of this replay) and axis, in the same order, when residuals are asked.
+  std::vector<std::pair<Phase, Axis>> cells;
 };
 
 /// The set-up shared by every evaluation of a diagnosis.

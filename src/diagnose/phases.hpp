@@ -26,6 +26,9 @@ enum class Phase {
 };
 std::string_view phase_name(Phase phase);  ///< "flight", "impact", ..., as reports and JSON use them
 
+/// A camera axis: x horizontal, z up.
+enum class Axis { X, Z };
+
 /// Event times of one replay [s, replay time]; infinity when the event does not happen.
 struct PhaseMarks {
   double first_contact = 0.0, first_release = 0.0, second_contact = 0.0;  ///< drop

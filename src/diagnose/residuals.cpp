@@ -360,14 +360,17 @@ std::string experiment_for(const std::string& a, const std::string& b) {
 /// alone: before the first contact only the release and the air act on the body, and neither
 /// the clump's shape nor its contact law enters.
 bool large_misfit(const Context& c, const GroupKey& key, const Group& g) {
-  if (g.values == 0) return false;
+  return g.values > 0 && misfit_per_value(c, key, g) >= kLargeMisfit;
+}
+
+double misfit_per_value(const Context& c, const GroupKey& key, const Group& g) {
   double per_value = std::max(g.count_x > 0 ? g.sq_x / g.count_x : 0.0, g.count_z > 0 ? g.sq_z / g.count_z : 0.0);
   const double camera = key.recording < c.camera_noise.size() ? c.camera_noise[key.recording] : 0.0;
   if (key.phase == Phase::Flight && std::isfinite(camera) && camera > 0.0) {
     const double scale = c.ev.sigma[key.recording] / camera;
     per_value *= scale * scale;
   }
-  return per_value >= kLargeMisfit;
+  return per_value;
 }
 
 /// Phases beyond the noise that no particle model's inaccuracy leaves: a smooth discrepancy

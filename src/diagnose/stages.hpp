@@ -208,6 +208,9 @@ std::vector<PhaseReport> locate(const Context& c, const Groups& groups);
 double flagged_excess(const Groups& groups, const std::vector<GroupKey>& flagged);
 std::string experiment_for(const std::string& a, const std::string& b);
 bool large_misfit(const Context& c, const GroupKey& key, const Group& g);
+/// The figure large_misfit holds to kLargeMisfit: the group's chi^2 per value on its worse
+/// axis, a drop's first flight scaled to the camera noise alone.
+double misfit_per_value(const Context& c, const GroupKey& key, const Group& g);
 std::vector<PhaseOf> smooth_misfits(const Context& c, const Groups& groups, const DiagnoseOptions& options);
 std::pair<double, bool> largest_misfit(const Context& c, const Groups& groups);
 
