@@ -19,6 +19,27 @@
 
 namespace clumpforge::diagnosis {
 
+namespace {
+
+/// An outcome as the statements show it: lengths in mm, a roll's time in s.
+struct Shown {
+  double scale = 1e3;
+  std::string_view unit = "mm";
+};
+Shown shown(Outcome outcome) {
+  return outcome == Outcome::RollTime ? Shown{1.0, "s"} : Shown{};
+}
+
+/// A verdict reached beyond the release horizon replaces the frame-by-frame one, whose
+/// statement is kept as a note.
+void supersede(DiagnoseResult& result, Verdict verdict, Basis basis) {
+  if (!result.statement.empty()) result.notes.push_back(fmt::format("frame by frame: {}", result.statement));
+  result.verdict = verdict;
+  result.basis = basis;
+}
+
+}  // namespace
+
 /// The largest z^2 of `comparisons`.
 double largest_z2(const std::vector<OutcomeComparison>& comparisons) {
   double worst = 0.0;
@@ -244,14 +265,12 @@ bool particle_model_unconverged(const Context& c, DiagnoseResult& result) {
   const ParticleModelRung& before = *std::next(last);
   const OutcomeShift& shift = *last->outcome_shift;
   const EnsembleReport& e = *result.ensemble;
-  const double scale = shift.outcome == Outcome::RollTime ? 1.0 : 1e3;
+  const Shown as = shown(shift.outcome);
   const std::string where = fmt::format(
       ", most the mean {} of {} ({:.3g} -> {:.3g} {}, {:.1f} recorded standard errors)", outcome_name(shift.outcome),
-      recording_label((*c.ev.recordings)[shift.recording], c.names[shift.recording]), shift.from * scale,
-      shift.to * scale, shift.outcome == Outcome::RollTime ? "s" : "mm", shift.largest);
-  if (!result.statement.empty()) result.notes.push_back(fmt::format("frame by frame: {}", result.statement));
-  result.verdict = Verdict::Undecidable;
-  result.basis = Basis::UnconvergedParticleModel;
+      recording_label((*c.ev.recordings)[shift.recording], c.names[shift.recording]), shift.from * as.scale,
+      shift.to * as.scale, as.unit, shift.largest);
+  supersede(result, Verdict::Undecidable, Basis::UnconvergedParticleModel);
   result.statement = fmt::format(
       "Not decidable with these clumps: the recorded outcomes differ from replays over the unknown release "
       "orientation (chi^2 {:.1f} over {} recorded means and spreads with {}, {:.1f} with {}), but the particle "
@@ -288,17 +307,15 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
   for (const auto& o : e.null_comparisons) {
     if (std::abs(o.z) < 3.0) continue;
     const bool drop = o.outcome == Outcome::ReboundHeight || o.outcome == Outcome::Drift;
-    const double scale = o.outcome == Outcome::RollTime ? 1.0 : 1e3;
-    const std::string where = fmt::format(
-        "{} {} of {} (recorded {:.3g}, replayed {:.3g} {}, z = {:.1f})", statistic_name(o.statistic),
-        outcome_name(o.outcome), recording_label((*c.ev.recordings)[o.recording], c.names[o.recording]),
-        o.recorded_value * scale, o.ensemble_value * scale, o.outcome == Outcome::RollTime ? "s" : "mm", o.z);
+    const Shown as = shown(o.outcome);
+    const std::string where =
+        fmt::format("{} {} of {} (recorded {:.3g}, replayed {:.3g} {}, z = {:.1f})", statistic_name(o.statistic),
+                    outcome_name(o.outcome), recording_label((*c.ev.recordings)[o.recording], c.names[o.recording]),
+                    o.recorded_value * as.scale, o.ensemble_value * as.scale, as.unit, o.z);
     result.unexplained.push_back({c.names[o.recording], drop ? Phase::Rebound : Phase::Rest, o.z * o.z, where});
     far.push_back(where);
   }
-  if (!result.statement.empty()) result.notes.push_back(fmt::format("frame by frame: {}", result.statement));
-  result.verdict = Verdict::Unexplained;
-  result.basis = Basis::UnexplainedOutcomes;
+  supersede(result, Verdict::Unexplained, Basis::UnexplainedOutcomes);
   result.statement = fmt::format(
       "Mismatch beyond the release horizon not explained by any known effect: the recorded outcomes differ from "
       "replays over the unknown release orientation (chi^2 {:.1f} over {} recorded means and spreads, p = {:.2g}){}; "
@@ -447,9 +464,7 @@ std::optional<FlightWobble> flights_of(const Context& c, const std::vector<Recor
 void say_flights(DiagnoseResult& result, const FlightWobble& f) {
   const auto library = effect_library();
   const EffectSpec& spec = effect_spec(library, Effect::ComOffset);
-  if (!result.statement.empty()) result.notes.push_back(fmt::format("frame by frame: {}", result.statement));
-  result.verdict = Verdict::Named;
-  result.basis = Basis::FreeFlights;
+  supersede(result, Verdict::Named, Basis::FreeFlights);
   result.effect = Effect::ComOffset;
   result.candidates.clear();
   result.unexplained.clear();

@@ -57,6 +57,15 @@ ConcealOptions one_metre_drops(std::optional<Effect> effect = std::nullopt, std:
   return conceal;
 }
 
+// The generator's body: the finer 340-sphere fill of the same scan.
+Clump generator_body() {
+  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
+  EXPECT_TRUE(library) << library.error().message;
+  auto finer = select_clump(std::move(*library), "adaptive-340", "tuber-default.h5");
+  EXPECT_TRUE(finer) << finer.error().message;
+  return *finer;
+}
+
 }  // namespace
 
 TEST(DiagnoseMeasurement, NoiseLevelFromThirdDifferences) {
@@ -245,10 +254,7 @@ TEST(DiagnoseDecision, PassingCandidatesCompeteOnEveryTrial) {
 // (the same for every case); the answer is only compared afterwards.
 TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
   const Clump clump = diagnosis_clump();
-  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
-  ASSERT_TRUE(library) << library.error().message;
-  auto finer = select_clump(std::move(*library), "adaptive-340", "tuber-default.h5");
-  ASSERT_TRUE(finer) << finer.error().message;
+  const Clump finer = generator_body();
   const MaterialTable table = default_material_table();
   DiagnoseOptions options;
   options.effects = {Effect::AirDrag, Effect::ViscoelasticRestitution, Effect::StaticKineticFriction};
@@ -257,7 +263,7 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
     SCOPED_TRACE(with_drag);
     const ConcealOptions conceal = with_drag ? one_metre_drops(Effect::AirDrag, {1.5}) : one_metre_drops();
     ASSERT_EQ(conceal.orientation, OrientationRecord::None);
-    auto made = make_concealed_recordings(*finer, table, conceal);
+    auto made = make_concealed_recordings(finer, table, conceal);
     ASSERT_TRUE(made) << made.error().message;
     auto result = diagnose(clump, table, made->recordings, made->names, options);
     ASSERT_TRUE(result) << result.error().message;
@@ -287,10 +293,7 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
 // b88cdad it said 0.078 (the delta-BIC alone, generated air_drag-realistic at 240 fps).
 TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) {
   const Clump clump = diagnosis_clump();
-  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
-  ASSERT_TRUE(library) << library.error().message;
-  auto finer = select_clump(std::move(*library), "adaptive-340", "tuber-default.h5");
-  ASSERT_TRUE(finer) << finer.error().message;
+  const Clump finer = generator_body();
   const MaterialTable table = default_material_table();
   // The benchmark's small set (drops from 0.2 and 1 m, a 100 mm roll, a tilt; 4 trials), its
   // air_drag-realistic case's seed.
@@ -301,7 +304,7 @@ TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) 
   conceal.seed = 1001;
   conceal.frame_rate_hz = 240.0;
   conceal.noise_m = 5e-4;
-  auto made = make_concealed_recordings(*finer, table, conceal);
+  auto made = make_concealed_recordings(finer, table, conceal);
   ASSERT_TRUE(made) << made.error().message;
   DiagnoseOptions options;
   options.effects = {Effect::AirDrag};
