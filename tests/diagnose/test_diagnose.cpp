@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/rng.hpp"
+#include "diagnose/bodies.hpp"
 #include "diagnose/conceal.hpp"
 #include "diagnose/diagnose.hpp"
 #include "diagnose/tracks.hpp"
@@ -55,15 +56,6 @@ ConcealOptions one_metre_drops(std::optional<Effect> effect = std::nullopt, std:
   conceal.effect = effect;
   conceal.values = std::move(values);
   return conceal;
-}
-
-// The generator's body: the finer 340-sphere fill of the same scan.
-Clump generator_body() {
-  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
-  EXPECT_TRUE(library) << library.error().message;
-  auto finer = select_clump(std::move(*library), "adaptive-340", "tuber-default.h5");
-  EXPECT_TRUE(finer) << finer.error().message;
-  return *finer;
 }
 
 }  // namespace
@@ -254,7 +246,7 @@ TEST(DiagnoseDecision, PassingCandidatesCompeteOnEveryTrial) {
 // (the same for every case); the answer is only compared afterwards.
 TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
   const Clump clump = diagnosis_clump();
-  const Clump finer = generator_body();
+  const Clump finer = test::generator_tuber();
   const MaterialTable table = default_material_table();
   DiagnoseOptions options;
   options.effects = {Effect::AirDrag, Effect::ViscoelasticRestitution, Effect::StaticKineticFriction};
@@ -293,7 +285,7 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
 // b88cdad it said 0.078 (the delta-BIC alone, generated air_drag-realistic at 240 fps).
 TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) {
   const Clump clump = diagnosis_clump();
-  const Clump finer = generator_body();
+  const Clump finer = test::generator_tuber();
   const MaterialTable table = default_material_table();
   // The benchmark's small set (drops from 0.2 and 1 m, a 100 mm roll, a tilt; 4 trials), its
   // air_drag-realistic case's seed.

@@ -8,6 +8,7 @@
 
 #include "core/rng.hpp"
 #include "dem/materials.hpp"
+#include "diagnose/bodies.hpp"
 #include "diagnose/conceal.hpp"
 #include "diagnose/flights.hpp"
 #include "io/clump_library.hpp"
@@ -69,15 +70,6 @@ Track tumbling_drop(const Eigen::Vector3d& offset, std::uint64_t seed) {
     track.z.push_back(cz + p.z() + rng.normal(0.0, kNoise));
   }
   return track;
-}
-
-// The bundled tuber's finest clump, the generator's.
-Clump tuber_340() {
-  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
-  EXPECT_TRUE(library) << library.error().message;
-  auto clump = select_clump(std::move(*library), "adaptive-340", "tuber-default.h5");
-  EXPECT_TRUE(clump) << clump.error().message;
-  return *clump;
 }
 
 Recording drops_of(const Eigen::Vector3d& offset, int trials, std::uint64_t seed) {
@@ -189,7 +181,7 @@ TEST(FreeFlights, FlightsStartAfterTheFirstPossibleContactAndSplitAtDips) {
 
 TEST(FreeFlights, SilhouetteWanderOfASphereIsNoneAndOfTheTuberSmall) {
   EXPECT_EQ(silhouette_wander({Sphere{Eigen::Vector3d::Zero(), 0.009}}, 5e-5, 50, 1), 0.0);
-  const Clump clump = tuber_340();
+  const Clump clump = test::generator_tuber();
   const double wander = silhouette_wander(clump.spheres, 5e-5, 200, 3);
   RecordProperty("wander_um", static_cast<int>(wander * 1e6));
   // Per coordinate about its mean: below SilhouetteCamera's 0.149 mm RMS distance from the
@@ -205,7 +197,7 @@ TEST(FreeFlights, GeneratedTuberDropsSeenBySilhouetteShowARealisticOffsetAndNotA
   // with no release recorded; judged with the reach and wander of the diagnosis's own
   // adaptive-32 clump, not the generator's. A control: nothing claimed. The realistic offset
   // (1.0 mm along the 1st axis, 0.5 mm along the 3rd: 1.12 mm): claimed, its size a low estimate.
-  const Clump generator = tuber_340();
+  const Clump generator = test::generator_tuber();
   auto diagnosis = read_clump_library(test::source_dir() / "clumps" / "tuber-default-diagnosis.h5");
   ASSERT_TRUE(diagnosis);
   const Clump& clump = diagnosis->front();
