@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""How a tuber's outcomes after the first contact change with the clump's resolution.
+
+Generates the same trials (seed, coefficients, release orientations) with each clump given,
+by `clumpforge-conceal` (no effect, orientation none), and prints per recording the mean and
+sd over the trials of the distance from the first tracked point to the rest point (the
+median of the last ten frames): a drop's drift, a roll's distance. The diagnosis's step 0
+chooses the resolution inside the fitted windows; this shows how far the outcomes beyond them
+are from converged (docs/diagnose.md, Limits).
+
+  bench/outcomes_by_resolution.py --conceal build/tools/clumpforge-conceal \
+      clumps/tuber-default-ladder.h5:adaptive-32 clumps/tuber-default-ladder.h5:adaptive-128 \
+      clumps/tuber-default.h5:adaptive-340
+"""
+import argparse
+import csv
+import json
+import math
+import pathlib
+import statistics
+import subprocess
+import sys
+import tempfile
+
+
+def rest_distance(track: pathlib.Path) -> float:
+    rows = []
+    with track.open() as f:
+        for r in csv.DictReader(f):
+            try:
+                x, z = float(r["x_m"]), float(r["z_m"])
+            except (KeyError, ValueError):
+                continue
+            if math.isfinite(x) and math.isfinite(z):
+                rows.append(x)
+    if len(rows) < 10:
+        return math.nan
+    return abs(statistics.median(rows[-10:]) - rows[0])
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("clumps", nargs="+", help="LIBRARY.h5:NAME, coarsest first")
+    p.add_argument("--conceal", default="build/tools/clumpforge-conceal")
+    p.add_argument("--trials", type=int, default=16)
+    p.add_argument("--seed", type=int, default=77)
+    p.add_argument("--surface", default="Q235")
+    p.add_argument("--restitution", type=float, default=0.634823744)
+    p.add_argument("--static-friction", type=float, default=0.405234611)
+    p.add_argument("--rolling-friction", type=float, default=0.0252642907)
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    a = p.parse_args()
+    results = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for spec in a.clumps:
+            library, _, name = spec.rpartition(":")
+            if not library or not name:
+                print(f"outcomes_by_resolution: '{spec}' is not LIBRARY.h5:NAME", file=sys.stderr)
+                return 2
+            out = pathlib.Path(tmp) / name
+            cmd = [a.conceal, library, "--clump", name, "--effect", "none", "--seed", str(a.seed), "--surface",
+                   a.surface, "--restitution", str(a.restitution), "--static-friction", str(a.static_friction),
+                   "--rolling-friction", str(a.rolling_friction), "--small", "--trials", str(a.trials), "-o", str(out)]
+            done = subprocess.run(cmd, capture_output=True, text=True)
+            if done.returncode != 0:
+                print(f"outcomes_by_resolution: {spec}: {done.stderr.strip()}", file=sys.stderr)
+                return 1
+            for rec in ("drop-0.2m", "drop-1m", "roll-100mm"):
+                values = [rest_distance(t) for t in sorted((out / rec).glob("trial-*.csv"))]
+                values = [v for v in values if math.isfinite(v)]
+                results.setdefault(rec, {})[name] = {
+                    "mean_mm": 1e3 * statistics.mean(values),
+                    "sd_mm": 1e3 * statistics.stdev(values) if len(values) > 1 else math.nan,
+                    "trials": len(values),
+                }
+    if a.json:
+        print(json.dumps(results, indent=2))
+        return 0
+    names = [s.rpartition(":")[2] for s in a.clumps]
+    print("| recording (rest distance, mm) | " + " | ".join(names) + " |")
+    print("|---|" + "---:|" * len(names))
+    for rec, by in results.items():
+        cells = " | ".join(f"{by[n]['mean_mm']:.0f} +- {by[n]['sd_mm']:.0f}" for n in names)
+        print(f"| {rec} | {cells} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
