@@ -191,22 +191,25 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     auto fine = compare_ensembles(c.ev, fitted->model, *scores, free, candidates, eo);
     if (!fine) return std::unexpected(fine.error());
     c.evaluations += fine->replays;
-    // This clump at the previous one's calibrated coefficients: how far the resolution alone
-    // moves the outcomes.
-    int replays = 0;
-    auto same = compare_model(c.ev, previous_model, *scores, eo, replays);
-    if (!same) return std::unexpected(same.error());
-    c.evaluations += replays;
     ParticleModelRung& rung = check.rungs.at(k + 1);
     rung.refitted = true;
     rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
     rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
-    rung.outcome_shift = outcome_shift(previous, *same);
-    previous = fine->null_comparisons;
-    previous_model = fitted->model;
-    previous_model.base = fine->calibrated;
     rung.explains = fine->outcomes == outcomes && outcomes_consistent(fine->null_comparisons, free.size());
-    if (!rung.explains) continue;
+    if (!rung.explains) {
+      // This clump at the previous one's calibrated coefficients: how far the resolution alone
+      // moves the outcomes (what particle_model_unconverged judges; a clump that explains
+      // ends the check, so it is not needed there).
+      int replays = 0;
+      auto same = compare_model(c.ev, previous_model, *scores, eo, replays);
+      if (!same) return std::unexpected(same.error());
+      c.evaluations += replays;
+      rung.outcome_shift = outcome_shift(previous, *same);
+      previous = fine->null_comparisons;
+      previous_model = fitted->model;
+      previous_model.base = fine->calibrated;
+      continue;
+    }
     check.resolution_needed = rung.spheres;
     const auto passing = passing_hypotheses(*fine, eo.min_delta_bic, result.notes);
     if (passing.empty()) {

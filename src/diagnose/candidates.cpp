@@ -248,17 +248,7 @@ double largest_signal_misfit(const Context& c, const std::vector<std::pair<Group
   Groups groups;
   for (std::size_t j = 0; j < keys.size(); ++j) {
     const auto& [key, axis] = keys[j];
-    Group& g = groups[key];
-    const double r = kept(static_cast<Eigen::Index>(j));
-    g.chi2 += r * r;
-    ++g.values;
-    if (axis == Axis::X) {
-      g.sq_x += r * r;
-      ++g.count_x;
-    } else {
-      g.sq_z += r * r;
-      ++g.count_z;
-    }
+    groups[key].add(kept(static_cast<Eigen::Index>(j)), axis);
   }
   double largest = 0.0;
   for (const auto& [key, g] : groups) {
@@ -289,15 +279,14 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
   // The baseline's cells' groups (recording, phase) and axes, for the large-misfit rule.
   std::vector<std::pair<GroupKey, Axis>> keys;
   auto cells = [&](const Model& m) -> Result<Eigen::VectorXd> {
-    auto scores = evaluate(c.ev, m, c.training, false, true);
+    // Cells' phases only once, with the baseline (the probes' cells are the same cells).
+    auto scores = evaluate(c.ev, m, c.training, false, keys.empty() ? Residuals::ValuesAndCells : Residuals::Values);
     c.evaluations += static_cast<int>(c.training.size());
     if (!scores) return std::unexpected(scores.error());
     std::vector<double> all_cells;
-    const bool first = keys.empty();
     for (std::size_t k = 0; k < scores->size(); ++k) {
       const TrialScore& sc = (*scores)[k];
       all_cells.insert(all_cells.end(), sc.residuals.begin(), sc.residuals.end());
-      if (!first) continue;
       for (const auto& [phase, axis] : sc.cells) keys.push_back({{c.ev.trials[c.training[k]].recording, phase}, axis});
     }
     return Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));

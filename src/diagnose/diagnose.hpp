@@ -79,8 +79,9 @@ struct ParticleModelRung {
   /// z^2 (outcomes beyond the release horizon), as chi2_per_value is per value or per mean.
   double worst_phase_chi2_per_value = 0.0;
   bool explains = false;  ///< it leaves no large misfit: the mismatch was the particle model's
-  /// Beyond the release horizon: how its calibrated null's replayed outcomes moved from the
-  /// previous clump's (empty when not compared on outcomes).
+  /// Beyond the release horizon: how its replayed outcomes moved from the previous clump's at
+  /// that clump's calibrated coefficients (empty when not compared on outcomes, or when it
+  /// explains them).
   std::optional<OutcomeShift> outcome_shift;
 };
 

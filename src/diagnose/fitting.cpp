@@ -197,7 +197,7 @@ Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::v
   const ResidualFunction residuals = [&](const Eigen::VectorXd& x) -> Result<Eigen::VectorXd> {
     auto scores =
         evaluate(c.ev, apply_parameters(start, parameters, std::vector<double>(x.data(), x.data() + x.size())), which,
-                 false, true);
+                 false, Residuals::Values);
     c.evaluations += static_cast<int>(which.size());
     if (!scores) return std::unexpected(scores.error());
     std::size_t n = 0;

@@ -72,7 +72,7 @@ Result<void> check_cancelled(const Evaluator& evaluator) {
 }
 
 Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model, const std::vector<std::size_t>& which,
-                                         bool keep_replays, bool keep_residuals) {
+                                         bool keep_replays, Residuals residuals_kept) {
   if (auto ok = check_cancelled(ev); !ok) return std::unexpected(ok.error());
   const auto& recordings = *ev.recordings;
   // One lab world per recording that is needed.
@@ -119,20 +119,18 @@ Result<std::vector<TrialScore>> evaluate(const Evaluator& ev, const Model& model
                 tt.shift_guess + first_phase_end + (recording.test == LabTest::Drop ? 0.0 : ev.shift_range[which[k]]));
     }
     score.summary = replay_summary(samples, recording.test);
-    if (keep_residuals) {
+    if (residuals_kept != Residuals::None) {
       // The same cells every time (frames up to the cutoff, non-empty cells), in order, each
-      // with its phase as phase_groups files it.
-      const PhaseMarks marks = phase_marks(samples, recording.test);
+      // with its phase as phase_groups files it when asked.
+      const bool cells = residuals_kept == Residuals::ValuesAndCells;
+      const PhaseMarks marks = cells ? phase_marks(samples, recording.test) : PhaseMarks{};
       for (const auto& f : residuals(track, samples, sigma, score.alignment)) {
         if (f.t + score.alignment.shift > tt.cutoff) break;
-        const Phase phase = phase_at(marks, recording.test, f.t);
-        if (std::isfinite(f.rx)) {
-          score.residuals.push_back(f.rx);
-          score.cells.emplace_back(phase, Axis::X);
-        }
-        if (std::isfinite(f.rz)) {
-          score.residuals.push_back(f.rz);
-          score.cells.emplace_back(phase, Axis::Z);
+        const Phase phase = cells ? phase_at(marks, recording.test, f.t) : Phase::Hold;
+        for (const auto& [r, axis] : {std::pair{f.rx, Axis::X}, std::pair{f.rz, Axis::Z}}) {
+          if (!std::isfinite(r)) continue;
+          score.residuals.push_back(r);
+          if (cells) score.cells.emplace_back(phase, axis);
         }
       }
     }

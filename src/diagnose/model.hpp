@@ -57,7 +57,7 @@ struct TrialScore {
   std::vector<ReplaySample> replay;                           ///< kept when asked
   double summary = std::numeric_limits<double>::quiet_NaN();  ///< the replay's summary value (SI, deg for tilt)
   std::vector<double> residuals;  ///< (recorded - replay) / sigma of every fitted cell, when asked
-  /// Each residual's phase (of this replay) and axis, in the same order, when residuals are asked.
+  /// Each residual's phase (of this replay) and axis, in the same order (Residuals::ValuesAndCells).
   std::vector<std::pair<Phase, Axis>> cells;
 };
 
@@ -85,11 +85,15 @@ struct Evaluator {
 /// Cancelled when the evaluator's caller asked to stop.
 Result<void> check_cancelled(const Evaluator& evaluator);
 
+/// What of each fitted cell an evaluation keeps: nothing (the chi^2 only), its residual (a
+/// fit's residual vector), or its residual with its phase and axis (TrialScore::cells).
+enum class Residuals { None, Values, ValuesAndCells };
+
 /// Replays and scores the trials `which` (indices into evaluator.trials) under `model`,
 /// in parallel; results do not depend on the thread count.
 Result<std::vector<TrialScore>> evaluate(const Evaluator& evaluator, const Model& model,
                                          const std::vector<std::size_t>& which, bool keep_replays,
-                                         bool keep_residuals = false);
+                                         Residuals residuals = Residuals::None);
 
 /// The lab options of `model` for one recording (its surface's coefficients, the effect).
 LabOptions lab_options_for(const Evaluator& evaluator, const Model& model, const Recording& recording);

@@ -62,16 +62,8 @@ void accumulate(Groups& groups, std::size_t recording, LabTest test, const Track
     segment->tau.push_back(f.t - entered);
     segment->rx.push_back(f.rx);
     segment->rz.push_back(f.rz);
-    auto add = [&g](double r, double& sum, double& squares, int& count) {
-      if (!std::isfinite(r)) return;
-      g.chi2 += r * r;
-      sum += r;
-      squares += r * r;
-      ++count;
-      ++g.values;
-    };
-    add(f.rx, g.sum_x, g.sq_x, g.count_x);
-    add(f.rz, g.sum_z, g.sq_z, g.count_z);
+    g.add(f.rx, Axis::X);
+    g.add(f.rz, Axis::Z);
   }
 }
 

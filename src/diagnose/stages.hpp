@@ -12,6 +12,7 @@
 /// - beyond_horizon.cpp: the free flights, and the outcomes over the unknown release compared
 ///   with replay ensembles;
 /// - verdict.cpp: the decision between the hypotheses and what the result says.
+#include <cmath>
 #include <limits>
 #include <map>
 #include <optional>
@@ -93,6 +94,15 @@ struct Group {
   int count_x = 0, count_z = 0;
   double sq_x = 0.0, sq_z = 0.0;
   std::vector<Segment> segments;
+  /// Counts one residual `r` (noise units) on `axis`; a non-finite one (an empty cell) is left out.
+  void add(double r, Axis axis) {
+    if (!std::isfinite(r)) return;
+    chi2 += r * r;
+    ++values;
+    (axis == Axis::X ? sum_x : sum_z) += r;
+    (axis == Axis::X ? sq_x : sq_z) += r * r;
+    ++(axis == Axis::X ? count_x : count_z);
+  }
 };
 
 using Groups = std::map<GroupKey, Group>;
