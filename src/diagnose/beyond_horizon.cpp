@@ -47,29 +47,6 @@ double largest_z2(const std::vector<OutcomeComparison>& comparisons) {
   return worst;
 }
 
-/// Degrees of freedom of a null with `free` coefficients calibrated on `outcomes` recorded
-/// means (at least one).
-double null_dof(int outcomes, std::size_t free) {
-  return std::max(1.0, outcomes - static_cast<double>(free));
-}
-
-/// Whether replays of a model with `fitted` parameters calibrated on the outcomes are
-/// consistent with the recordings: the means' chi^2 (over their number less `fitted`, at
-/// least one) and the spreads' (over their number) each have an upper tail of
-/// kConsistentTail / 2 or more. Tested apart, a mean far off is not diluted by spreads that
-/// agree, nor the reverse.
-bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted) {
-  double chi2[2] = {0.0, 0.0};
-  int count[2] = {0, 0};
-  for (const auto& o : comparisons) {
-    const int k = o.statistic == Statistic::Mean ? 0 : 1;
-    chi2[k] += o.z * o.z;
-    ++count[k];
-  }
-  return chi2_upper_tail(chi2[0], null_dof(count[0], fitted)) >= 0.5 * kConsistentTail &&
-         (count[1] == 0 || chi2_upper_tail(chi2[1], count[1]) >= 0.5 * kConsistentTail);
-}
-
 /// The hypotheses beyond the release horizon that pass, best first: each beats the calibrated
 /// null by the margin at a plausible value and leaves the outcomes consistent with the
 /// recordings (outcomes_consistent, its parameters fitted): a better fit that still misses by
@@ -188,7 +165,9 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     auto scores = score(c, fitted->model, c.all, true);
     c.ev.full_duration = false;
     if (!scores) return std::unexpected(scores.error());
-    auto fine = compare_ensembles(c.ev, fitted->model, *scores, free, candidates, eo);
+    EnsembleOptions pursue = eo;
+    if (let_through) pursue.pursue = let_through->effect;
+    auto fine = compare_ensembles(c.ev, fitted->model, *scores, free, candidates, pursue);
     if (!fine) return std::unexpected(fine.error());
     c.evaluations += fine->replays;
     ParticleModelRung& rung = check.rungs.at(k + 1);

@@ -40,7 +40,15 @@ struct EffectSpec {
   std::string name;         ///< the verdict's name, e.g. "air_drag"
   std::string description;  ///< one line, for reports
   std::vector<EffectParameter> parameters;
-  std::vector<LabTest> tests;  ///< where it shows (the fit uses these recordings)
+  std::vector<LabTest> tests;  ///< where it shows in the tracks (the frame fits use these recordings)
+  /// Where it moves the recorded outcomes beyond the release horizon (rebound heights, drifts,
+  /// roll distances), when more than `tests`: a flattened tuber rolling on its rim drops onto
+  /// the incline at every turn, so a speed-dependent restitution acts on its rolls' outcomes,
+  /// while a sphere's rolling track shows no impact to fit. Empty: `tests`.
+  std::vector<LabTest> outcome_tests_beyond_horizon = {};
+  const std::vector<LabTest>& outcome_tests() const {
+    return outcome_tests_beyond_horizon.empty() ? tests : outcome_tests_beyond_horizon;
+  }
 };
 
 /// The whole library, in a fixed order.

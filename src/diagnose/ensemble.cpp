@@ -383,18 +383,24 @@ struct Proposal {
 
 /// A candidate's response at its realistic and strong magnitudes (new replays, the same
 /// orientations), its detectability, and the surrogate's best level: a proposal when the
-/// surrogate's delta-BIC reaches the margin.
+/// surrogate's delta-BIC reaches the margin, or, when `pursue` (the null leaves the outcomes
+/// inconsistent, or a coarser clump let this candidate through), when its strong magnitude
+/// would show (Detectability) whatever the surrogate predicts: the surrogate is linear about
+/// the null, and an effect that needs the coefficients moved far (a restitution falling with
+/// the impact speed: higher at a 0.2 m drop, lower at 1 m) is found only by calibrating them
+/// with it (confirm). Such a proposal starts at the surrogate's best level, or the strong one.
 Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<Plan>& plans, const Model& null_model,
                                         const Sample& null_sample, const Eigen::VectorXd& null_means,
                                         const Eigen::VectorXd& recorded, const Eigen::VectorXd& inverse_se,
                                         const Eigen::MatrixXd& jacobian, const std::vector<FreeCoefficient>& free,
-                                        const EffectSpec& spec, const EnsembleOptions& options,
+                                        const EffectSpec& spec, const EnsembleOptions& options, bool pursue,
                                         EnsembleResult& result) {
   const auto& recs = *ev.recordings;
   std::vector<bool> run(plans.size());
   bool any = false;
   for (std::size_t p = 0; p < plans.size(); ++p) {
-    run[p] = std::find(spec.tests.begin(), spec.tests.end(), recs[plans[p].recording].test) != spec.tests.end();
+    const auto& tests = spec.outcome_tests();
+    run[p] = std::find(tests.begin(), tests.end(), recs[plans[p].recording].test) != tests.end();
     any = any || run[p];
   }
   if (!any) return std::nullopt;
@@ -408,6 +414,7 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     response[level - 1] = means_of(compare_all(plans, *out, options.impact_accuracy)) - null_means;
   }
   const double penalty = static_cast<double>(spec.parameters.size()) * std::log(std::max(1, result.outcomes));
+  bool detectable = false;
   {
     // Its strong magnitude's signal with what the free coefficients absorb projected out;
     // the standard errors fall as 1/sqrt(trials), so the signal grows with them.
@@ -420,6 +427,7 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     Detectability d{spec.effect, kept.squaredNorm(), options.min_delta_bic + penalty,
                     std::numeric_limits<double>::infinity()};
     if (d.strong_signal > 0.0) d.trials_needed = std::ceil(result.trials * d.needed / d.strong_signal);
+    detectable = d.strong_signal >= d.needed;
     result.detectability.push_back(d);
   }
   Proposal best{spec.effect, 0.0, result.null_chi2, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()))};
@@ -434,41 +442,8 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     if (chi2 < best.predicted) best = {spec.effect, u, chi2, free.empty() ? Eigen::VectorXd() : delta};
   }
   if (best.level > 0.0 && result.null_chi2 - best.predicted - penalty >= options.min_delta_bic) return best;
-  return std::nullopt;
-}
-
-/// A proposal judged by new replays at its level, and (when that beats the null by the
-/// margin) at 0.6 and 1.6 times it: the surrogate is linear, the outcomes are not.
-Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>& plans, const Model& null_model,
-                                   const std::vector<FreeCoefficient>& free, const EffectSpec& spec, const Proposal& p,
-                                   const EnsembleOptions& options, EnsembleResult& result) {
-  const std::vector<bool> every(plans.size(), true);
-  EnsembleHypothesis best;
-  best.chi2 = std::numeric_limits<double>::infinity();
-  for (double factor : {1.0, 0.6, 1.6}) {
-    if (factor != 1.0 && best.delta_bic < options.min_delta_bic) break;
-    Model m = free.empty() ? null_model : with_coefficients(null_model, free, p.delta);
-    m.effect = spec.effect;
-    m.values = effect_values(spec, p.level * factor);
-    auto out = replay_outcomes(ev, m, plans, every, nullptr, result.replays);
-    if (!out) return std::unexpected(out.error());
-    auto cmp = compare_all(plans, *out, options.impact_accuracy);
-    if (chi2_of(cmp) >= best.chi2) continue;
-    best.effect = spec.effect;
-    best.values = m.values;
-    best.base = m.base;
-    best.chi2 = chi2_of(cmp);
-    const Margin margin =
-        margin_over_null(result.null_chi2, best.chi2, result.outcomes, free.size(), spec.parameters.size());
-    best.dispersion = margin.dispersion;
-    best.delta_bic = margin.delta_bic;
-    best.comparisons = std::move(cmp);
-    best.plausible = true;
-    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
-      const auto& q = spec.parameters[k];
-      best.plausible = best.plausible && m.values[k] >= q.plausible_low && m.values[k] <= q.plausible_high;
-    }
-  }
+  if (!pursue || !detectable) return std::nullopt;
+  if (best.level == 0.0) best.level = 2.0;
   return best;
 }
 
@@ -533,55 +508,104 @@ Eigen::MatrixXd fit_surrogate(const std::vector<SurrogatePoint>& points, const E
   return out;
 }
 
-struct CalibratedNull {
-  Model model;
-  Sample sample;
-  std::vector<OutcomeComparison> comparisons;  ///< of `sample` against the recordings
-  Eigen::MatrixXd jacobian;                    ///< d(statistic)/d(coefficient) at the null, from the surrogate
+/// What a calibration moves: the free coefficients and, for a candidate, its level (0 none, 1
+/// realistic, 2 strong; effect_values), the last coordinate.
+struct Coordinates {
+  const std::vector<FreeCoefficient>& free;
+  const EffectSpec* effect = nullptr;
+  Eigen::Index size() const { return static_cast<Eigen::Index>(free.size()) + (effect ? 1 : 0); }
 };
 
-/// The null calibrated on the outcomes: steps of Gauss-Newton on the regression surrogate
-/// (fit_surrogate), each within a trust region and judged by new replays; a step that does not
-/// lower chi^2 halves the region and is kept as a point of the surrogate, one that does widens
-/// it. Each free coefficient is first moved alone (coefficient_step), replaying only the
-/// recordings of its surface.
-Result<CalibratedNull> calibrate_null(const Evaluator& ev, const std::vector<Plan>& plans, const Model& baseline,
-                                      const std::vector<FreeCoefficient>& free, const Sample& base,
-                                      const std::vector<OutcomeComparison>& base_cmp, const Eigen::VectorXd& recorded,
-                                      const Eigen::VectorXd& inverse_se, const EnsembleOptions& options,
-                                      EnsembleResult& result) {
+/// The largest level a candidate is calibrated to (effect_values extrapolates beyond strong).
+constexpr double kMaxLevel = 3.0;
+
+/// A model and its candidate's level, as a point of the calibration.
+struct Point {
+  Model model;
+  double level = 0.0;
+};
+
+Eigen::VectorXd coordinates_of(const Point& p, const Coordinates& c) {
+  Eigen::VectorXd x(c.size());
+  x.head(static_cast<Eigen::Index>(c.free.size())) = coefficients_of(p.model, c.free);
+  if (c.effect) x(c.size() - 1) = p.level;
+  return x;
+}
+
+Point moved(const Point& p, const Coordinates& c, const Eigen::VectorXd& delta) {
+  Point out{c.free.empty() ? p.model
+                           : with_coefficients(p.model, c.free, delta.head(static_cast<Eigen::Index>(c.free.size()))),
+            p.level};
+  if (c.effect) {
+    out.level = std::clamp(p.level + delta(c.size() - 1), 0.0, kMaxLevel);
+    out.model.effect = c.effect->effect;
+    out.model.values = effect_values(*c.effect, out.level);
+  }
+  return out;
+}
+
+struct CalibratedModel {
+  Point point;
+  Sample sample;
+  std::vector<OutcomeComparison> comparisons;  ///< of `sample` against the recordings
+  Eigen::MatrixXd jacobian;                    ///< d(statistic)/d(coordinate) at the result, from the surrogate
+};
+
+/// A model calibrated on the outcomes (the null, or a candidate with its level): steps of
+/// Gauss-Newton on the regression surrogate (fit_surrogate), each within a trust region and
+/// judged by new replays; a step that does not lower chi^2 halves the region and is kept as a
+/// point of the surrogate, one that does widens it. Each coordinate is first moved alone,
+/// replaying only the recordings it acts on (a coefficient: its surface's; a level: the
+/// effect's tests).
+Result<CalibratedModel> calibrate_outcomes(const Evaluator& ev, const std::vector<Plan>& plans, const Point& start,
+                                           const Coordinates& coords, const Sample& base,
+                                           const std::vector<OutcomeComparison>& base_cmp,
+                                           const Eigen::VectorXd& recorded, const Eigen::VectorXd& inverse_se,
+                                           const EnsembleOptions& options, EnsembleResult& result) {
   const auto& recs = *ev.recordings;
-  const auto k = static_cast<Eigen::Index>(free.size());
+  const Eigen::Index k = coords.size(), kc = static_cast<Eigen::Index>(coords.free.size());
   const auto rows = static_cast<Eigen::Index>(base_cmp.size());
-  CalibratedNull null{baseline, base, base_cmp, Eigen::MatrixXd::Zero(rows, k)};
-  if (free.empty()) return null;
+  CalibratedModel null{start, base, base_cmp, Eigen::MatrixXd::Zero(rows, k)};
+  if (k == 0) return null;
   Eigen::MatrixXi acts(rows, k);
   Eigen::VectorXd scale(k), radius(k);
+  const Eigen::VectorXd origin = coordinates_of(start, coords);
+  // Whether coordinate q acts on a recording: a coefficient on its surface's, a level on its effect's tests.
+  auto acts_on = [&](Eigen::Index q, const Recording& r) {
+    if (q < kc) return r.surface == start.model.base[coords.free[static_cast<std::size_t>(q)].surface].surface;
+    const auto& tests = coords.effect->outcome_tests();
+    return std::find(tests.begin(), tests.end(), r.test) != tests.end();
+  };
+  std::vector<std::vector<bool>> run(static_cast<std::size_t>(k), std::vector<bool>(plans.size()));
   for (Eigen::Index q = 0; q < k; ++q) {
-    const FreeCoefficient& f = free[static_cast<std::size_t>(q)];
-    for (Eigen::Index j = 0; j < rows; ++j)
-      acts(j, q) = recs[base_cmp[static_cast<std::size_t>(j)].recording].surface == baseline.base[f.surface].surface;
-    scale(q) = std::abs(coefficient_step(f.coefficient, 0.0));
-    radius(q) = step_radius(f.coefficient);
-  }
-  std::vector<SurrogatePoint> points{{coefficients_of(baseline, free), log_values(base_cmp)}};
-  for (Eigen::Index q = 0; q < k; ++q) {
-    const FreeCoefficient& f = free[static_cast<std::size_t>(q)];
-    Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
-    delta(q) = coefficient_step(f.coefficient, points.front().c(q));
-    const Model moved = with_coefficients(baseline, free, delta);
-    std::vector<bool> run(plans.size());
     for (std::size_t p = 0; p < plans.size(); ++p)
-      run[p] = recs[plans[p].recording].surface == baseline.base[f.surface].surface;
-    auto out = replay_outcomes(ev, moved, plans, run, &base, result.replays);
+      run[static_cast<std::size_t>(q)][p] = acts_on(q, recs[plans[p].recording]);
+    for (Eigen::Index j = 0; j < rows; ++j)
+      acts(j, q) = acts_on(q, recs[base_cmp[static_cast<std::size_t>(j)].recording]);
+    if (q < kc) {
+      const Coefficient c = coords.free[static_cast<std::size_t>(q)].coefficient;
+      scale(q) = std::abs(coefficient_step(c, 0.0));
+      radius(q) = step_radius(c);
+    } else {
+      scale(q) = 1.0;  // a level's first step, toward the middle of [0, kMaxLevel]
+      radius(q) = 1.0;
+    }
+  }
+  std::vector<SurrogatePoint> points{{origin, log_values(base_cmp)}};
+  for (Eigen::Index q = 0; q < k; ++q) {
+    Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
+    delta(q) = q < kc ? coefficient_step(coords.free[static_cast<std::size_t>(q)].coefficient, origin(q))
+                      : (origin(q) < 0.5 * kMaxLevel ? scale(q) : -scale(q));
+    const Point one = moved(start, coords, delta);
+    auto out = replay_outcomes(ev, one.model, plans, run[static_cast<std::size_t>(q)], &base, result.replays);
     if (!out) return std::unexpected(out.error());
-    points.push_back({coefficients_of(moved, free), log_values(compare_all(plans, *out, options.impact_accuracy))});
+    points.push_back({coordinates_of(one, coords), log_values(compare_all(plans, *out, options.impact_accuracy))});
   }
   Eigen::VectorXd target(rows);
   for (Eigen::Index j = 0; j < rows; ++j)
     target(j) = std::log(above_floor(recorded(j), base_cmp[static_cast<std::size_t>(j)]));
   for (int iteration = 0; iteration < 4; ++iteration) {
-    const Eigen::VectorXd centre = coefficients_of(null.model, free);
+    const Eigen::VectorXd centre = coordinates_of(null.point, coords);
     const Eigen::MatrixXd s = fit_surrogate(points, centre, scale, acts);
     // Weighted so that each residual is the statistic's z at the centre: the values' logarithmic
     // mean times the inverse standard error.
@@ -596,15 +620,15 @@ Result<CalibratedNull> calibrate_null(const Evaluator& ev, const std::vector<Pla
     double shrink = 1.0;
     for (Eigen::Index q = 0; q < k; ++q)
       if (std::abs(step(q)) > radius(q)) shrink = std::min(shrink, radius(q) / std::abs(step(q)));
-    const Model trial = with_coefficients(null.model, free, shrink * step);
-    const Eigen::VectorXd taken = coefficients_of(trial, free) - centre;
+    const Point trial = moved(null.point, coords, shrink * step);
+    const Eigen::VectorXd taken = coordinates_of(trial, coords) - centre;
     if (taken.cwiseQuotient(scale).norm() < 1e-3) break;
-    auto out = replay_outcomes(ev, trial, plans, std::vector<bool>(plans.size(), true), nullptr, result.replays);
+    auto out = replay_outcomes(ev, trial.model, plans, std::vector<bool>(plans.size(), true), nullptr, result.replays);
     if (!out) return std::unexpected(out.error());
     const auto cmp = compare_all(plans, *out, options.impact_accuracy);
-    points.push_back({coefficients_of(trial, free), log_values(cmp)});
+    points.push_back({coordinates_of(trial, coords), log_values(cmp)});
     if (chi2_of(cmp) < chi2_of(null.comparisons)) {
-      null.model = trial;
+      null.point = trial;
       null.sample = std::move(*out);
       null.comparisons = cmp;
       radius *= 1.5;
@@ -612,13 +636,53 @@ Result<CalibratedNull> calibrate_null(const Evaluator& ev, const std::vector<Pla
       radius *= 0.5;
     }
   }
-  // The response at the null, in the statistics' own units, for the candidates' surrogate.
-  const Eigen::MatrixXd s = fit_surrogate(points, coefficients_of(null.model, free), scale, acts);
+  // The response at the result, in the statistics' own units, for the candidates' surrogate.
+  const Eigen::MatrixXd s = fit_surrogate(points, coordinates_of(null.point, coords), scale, acts);
   for (Eigen::Index j = 0; j < rows; ++j) {
     const OutcomeComparison& c = null.comparisons[static_cast<std::size_t>(j)];
     null.jacobian.row(j) = above_floor(c.ensemble_value, c) * s.row(j).tail(k);
   }
   return null;
+}
+
+/// A proposal judged by new replays: the effect from the proposed level, calibrated on the
+/// outcomes with the free coefficients the null's way (calibrate_outcomes, the level one more
+/// coordinate), from the surrogate's coefficient change kept within one trust radius. The
+/// surrogate of the proposal is linear about the null and the outcomes are not: a restitution
+/// that falls with the impact speed asks for coefficients far from the null's and a level of
+/// its own, which only new replays find.
+Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>& plans, const Model& null_model,
+                                   const std::vector<FreeCoefficient>& free, const EffectSpec& spec, const Proposal& p,
+                                   const Eigen::VectorXd& recorded, const Eigen::VectorXd& inverse_se,
+                                   const EnsembleOptions& options, EnsembleResult& result) {
+  const Coordinates coords{free, &spec};
+  Eigen::VectorXd start = Eigen::VectorXd::Zero(coords.size());
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    const double r = step_radius(free[k].coefficient);
+    start(static_cast<Eigen::Index>(k)) = std::clamp(p.delta(static_cast<Eigen::Index>(k)), -r, r);
+  }
+  const Point from = moved(Point{null_model, p.level}, coords, start);
+  auto out = replay_outcomes(ev, from.model, plans, std::vector<bool>(plans.size(), true), nullptr, result.replays);
+  if (!out) return std::unexpected(out.error());
+  auto fitted = calibrate_outcomes(ev, plans, from, coords, *out, compare_all(plans, *out, options.impact_accuracy),
+                                   recorded, inverse_se, options, result);
+  if (!fitted) return std::unexpected(fitted.error());
+  EnsembleHypothesis h;
+  h.effect = spec.effect;
+  h.values = fitted->point.model.values;
+  h.base = fitted->point.model.base;
+  h.chi2 = chi2_of(fitted->comparisons);
+  const Margin margin =
+      margin_over_null(result.null_chi2, h.chi2, result.outcomes, free.size(), spec.parameters.size());
+  h.dispersion = margin.dispersion;
+  h.delta_bic = margin.delta_bic;
+  h.comparisons = std::move(fitted->comparisons);
+  h.plausible = true;
+  for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
+    const auto& q = spec.parameters[k];
+    h.plausible = h.plausible && h.values[k] >= q.plausible_low && h.values[k] <= q.plausible_high;
+  }
+  return h;
 }
 
 /// The hypotheses that reach the margin replayed again, with the null, from orientations drawn
@@ -670,6 +734,22 @@ std::vector<Eigen::Quaterniond> ensemble_orientations(LabTest test, const std::v
   return out;
 }
 
+double null_dof(int outcomes, std::size_t free) {
+  return std::max(1.0, outcomes - static_cast<double>(free));
+}
+
+bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted) {
+  double chi2[2] = {0.0, 0.0};
+  int count[2] = {0, 0};
+  for (const auto& o : comparisons) {
+    const int k = o.statistic == Statistic::Mean ? 0 : 1;
+    chi2[k] += o.z * o.z;
+    ++count[k];
+  }
+  return chi2_upper_tail(chi2[0], null_dof(count[0], fitted)) >= 0.5 * kConsistentTail &&
+         (count[1] == 0 || chi2_upper_tail(chi2[1], count[1]) >= 0.5 * kConsistentTail);
+}
+
 Result<std::vector<OutcomeComparison>> compare_model(const Evaluator& ev, const Model& model,
                                                      const std::vector<TrialScore>& scores,
                                                      const EnsembleOptions& options, int& replays) {
@@ -704,9 +784,10 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
     const double diff = c.recorded_value - c.ensemble_value;
     inverse_se(static_cast<Eigen::Index>(j)) = c.z != 0.0 ? std::abs(c.z / diff) : 1.0 / std::max(c.floor, 1e-12);
   }
-  auto null = calibrate_null(ev, plans, baseline, free, *base, base_cmp, recorded, inverse_se, options, result);
+  auto null = calibrate_outcomes(ev, plans, Point{baseline}, Coordinates{free}, *base, base_cmp, recorded, inverse_se,
+                                 options, result);
   if (!null) return std::unexpected(null.error());
-  const Model& null_model = null->model;
+  const Model& null_model = null->point.model;
   const Sample& null_sample = null->sample;
   const Eigen::MatrixXd& jacobian = null->jacobian;
   result.calibrated = null_model.base;
@@ -714,18 +795,20 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   result.null_chi2 = chi2_of(result.null_comparisons);
   const Eigen::VectorXd null_means = means_of(result.null_comparisons);
   const auto library = effect_library();
+  const bool unexplained = !outcomes_consistent(result.null_comparisons, free.size());
   std::vector<Proposal> proposals;
   for (Effect e : candidates) {
     auto proposal = propose(ev, plans, null_model, null_sample, null_means, recorded, inverse_se, jacobian, free,
-                            effect_spec(library, e), options, result);
+                            effect_spec(library, e), options, unexplained || options.pursue == e, result);
     if (!proposal) return std::unexpected(proposal.error());
     if (*proposal) proposals.push_back(**proposal);
   }
-  std::sort(proposals.begin(), proposals.end(),
-            [](const Proposal& a, const Proposal& b) { return a.predicted < b.predicted; });
+  std::stable_sort(proposals.begin(), proposals.end(),
+                   [](const Proposal& a, const Proposal& b) { return a.predicted < b.predicted; });
   if (proposals.size() > 3) proposals.resize(3);
   for (const Proposal& p : proposals) {
-    auto h = confirm(ev, plans, null_model, free, effect_spec(library, p.effect), p, options, result);
+    auto h =
+        confirm(ev, plans, null_model, free, effect_spec(library, p.effect), p, recorded, inverse_se, options, result);
     if (!h) return std::unexpected(h.error());
     result.hypotheses.push_back(std::move(*h));
   }

@@ -16,6 +16,7 @@
 /// replays, never from the surrogate).
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -104,7 +105,25 @@ struct EnsembleOptions {
   double impact_accuracy = 0.01;
   double min_delta_bic = 10.0;
   std::uint64_t seed = 1;
+  /// A candidate calibrated with its level even when the null is consistent (a finer clump's
+  /// check of the one its coarser clump let through).
+  std::optional<Effect> pursue;
 };
+
+/// Recorded outcomes are consistent with replays while their chi^2 tail is at least this (the
+/// margin a candidate must leave them within).
+constexpr double kConsistentTail = 1e-4;
+
+/// Degrees of freedom of a null with `free` coefficients calibrated on `outcomes` recorded
+/// means (at least one).
+double null_dof(int outcomes, std::size_t free);
+
+/// Whether replays of a model with `fitted` parameters calibrated on the outcomes are
+/// consistent with the recordings: the means' chi^2 (over their number less `fitted`, at
+/// least one) and the spreads' (over their number) each have an upper tail of
+/// kConsistentTail / 2 or more. Tested apart, a mean far off is not diluted by spreads that
+/// agree, nor the reverse.
+bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted);
 
 /// The release orientations of a recording's replays: from the uniform prior when `recorded`
 /// is empty, else mirroring the recorded sample, in turn from a ball of the prior's spread

@@ -48,10 +48,6 @@ constexpr double kLargeMisfit = 10.0;
 /// the fitted windows (the delta-BIC margin: no evidence either way).
 constexpr double kUnpinned = 10.0;
 
-/// Recorded outcomes are consistent with replays while their chi^2 tail is at least this (the
-/// margin a candidate must leave them within, see judge_ensembles).
-constexpr double kConsistentTail = 1e-4;
-
 struct FitParameter {
   bool effect = false;
   std::size_t index = 0;  ///< effect parameter index, or surface index
@@ -285,8 +281,6 @@ void track_plots(const Context& c, DiagnoseResult& result, const std::vector<Tri
 // ---- beyond_horizon.cpp ----------------------------------------------------------------------
 
 double largest_z2(const std::vector<OutcomeComparison>& comparisons);
-double null_dof(int outcomes, std::size_t free);
-bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted);
 std::vector<const EnsembleHypothesis*> passing_hypotheses(const EnsembleResult& ens, double min_delta_bic,
                                                           std::vector<std::string>& notes);
 void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
