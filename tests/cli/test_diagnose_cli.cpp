@@ -174,6 +174,17 @@ TEST(DiagnoseCli, SummariesOnlySayWhatTheyCanDecide) {
   EXPECT_TRUE(std::filesystem::exists(dir / "out" / "report.json"));
 }
 
+// One tuber case of ../shared/data/lab-like (a simulator that shares no code with this project)
+// diagnosed from its mesh with no finer clump, as the JSON report; empty when the command failed.
+nlohmann::json diagnose_lab_like_tuber(const std::string& case_id, const std::filesystem::path& out) {
+  const auto set = test::shared_dir() / "data" / "lab-like";
+  const auto run = test::run_clumpforge(
+      fmt::format("diagnose --recordings '{}' --mesh '{}' --finer-clumps 0 --json --output '{}'",
+                  (set / case_id).string(), (set / "meshes" / "tuber.stl").string(), out.string()));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return run.exit_code == 0 ? nlohmann::json::parse(run.out) : nlohmann::json::object();
+}
+
 TEST(DiagnoseCli, AnotherSimulatorsTuberControlIsConsistentWithTheDiagnosedClumpAlone) {
   // Control case-07 of ../shared/data/lab-like (a simulator that shares no code with this
   // project, its own fine lattice of the tuber; nine set-ups of six trials, no release
@@ -184,12 +195,8 @@ TEST(DiagnoseCli, AnotherSimulatorsTuberControlIsConsistentWithTheDiagnosedClump
   // left this case's outcomes inconsistent with the diagnosed clump, and without a finer clump
   // named `adhesion` here: this test failed on it.)
   test::ScratchDir dir("diagnose-lab-like-control");
-  const auto set = test::shared_dir() / "data" / "lab-like";
-  const auto run = test::run_clumpforge(
-      fmt::format("diagnose --recordings '{}' --mesh '{}' --finer-clumps 0 --json --output '{}'",
-                  (set / "case-07").string(), (set / "meshes" / "tuber.stl").string(), (dir / "out").string()));
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto j = nlohmann::json::parse(run.out);
+  const auto j = diagnose_lab_like_tuber("case-07", dir / "out");
+  ASSERT_FALSE(j.empty());
   EXPECT_EQ(j["verdict"], "none") << j["statement"];
   EXPECT_EQ(j["basis"], "consistent") << j["statement"];
   ASSERT_TRUE(j.contains("ensemble") && j["ensemble"].is_object());
@@ -210,12 +217,8 @@ TEST(DiagnoseCli, AnotherSimulatorsSpeedDependentRestitutionIsFoundByCalibrating
   // restitution must be named, on both draws of orientations (delta-BIC and fresh delta-BIC at
   // least the margin of 10). Before this the verdict was the particle model's or `unexplained`.
   test::ScratchDir dir("diagnose-lab-like-speed-restitution");
-  const auto set = test::shared_dir() / "data" / "lab-like";
-  const auto run = test::run_clumpforge(
-      fmt::format("diagnose --recordings '{}' --mesh '{}' --finer-clumps 0 --json --output '{}'",
-                  (set / "case-08").string(), (set / "meshes" / "tuber.stl").string(), (dir / "out").string()));
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto j = nlohmann::json::parse(run.out);
+  const auto j = diagnose_lab_like_tuber("case-08", dir / "out");
+  ASSERT_FALSE(j.empty());
   const std::string verdict = j["verdict"];
   EXPECT_TRUE(verdict == "elastic_plastic_restitution" || verdict == "viscoelastic_restitution") << j["statement"];
   EXPECT_EQ(j["basis"], "ensemble") << j["statement"];
