@@ -212,8 +212,8 @@ TEST(DiagnoseCli, AnotherSimulatorsSpeedDependentRestitutionIsFoundByCalibrating
   // release orientations; diagnosed from the mesh (64 spheres by convergence to the scan) with
   // no finer clump. Frame by frame nothing decides it. Beyond the release horizon the
   // calibrated null leaves the outcomes inconsistent, and the linear surrogate about the null
-  // predicted no candidate reaching the margin (chi^2 51.1 against 55.1): the steel e must rise
-  // at 0.2 m and fall at 1 m, far from the null's. Calibrated with its level, a speed-dependent
+  // found no candidate reaching the margin: the steel e must rise at 0.2 m and fall at 1 m, far
+  // from the null's. Calibrated with its level, a speed-dependent
   // restitution must be named, on both draws of orientations (delta-BIC and fresh delta-BIC at
   // least the margin of 10). Before this the verdict was the particle model's or `unexplained`.
   test::ScratchDir dir("diagnose-lab-like-speed-restitution");
