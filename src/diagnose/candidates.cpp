@@ -184,12 +184,7 @@ Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result,
       report.heldout_delta_chi2 = located.sum(held) - total_chi_squared(*held_scores);
     }
     report.improves_heldout = !held.empty() && report.heldout_delta_chi2 > 0.0;
-    report.plausible = true;
-    for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
-      const double v = fit->model.values[k];
-      const auto& p = spec.parameters[k];
-      report.plausible = report.plausible && v >= p.plausible_low && v <= p.plausible_high;
-    }
+    report.plausible = spec.plausible(fit->model.values);
     if (spec.effect == Effect::ComOffset) {
       const double offset = std::hypot(fit->model.values[0], fit->model.values[1]);
       report.plausible = offset >= 2e-4 && offset <= 3e-3;

@@ -49,6 +49,12 @@ struct EffectSpec {
   const std::vector<LabTest>& outcome_tests() const {
     return outcome_tests_beyond_horizon.empty() ? tests : outcome_tests_beyond_horizon;
   }
+  /// Whether every parameter value lies within its plausible range.
+  bool plausible(const std::vector<double>& values) const {
+    for (std::size_t k = 0; k < parameters.size(); ++k)
+      if (values[k] < parameters[k].plausible_low || values[k] > parameters[k].plausible_high) return false;
+    return true;
+  }
 };
 
 /// The whole library, in a fixed order.

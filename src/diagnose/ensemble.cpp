@@ -565,8 +565,8 @@ Result<CalibratedModel> calibrate_outcomes(const Evaluator& ev, const std::vecto
   const auto& recs = *ev.recordings;
   const Eigen::Index k = coords.size(), kc = static_cast<Eigen::Index>(coords.free.size());
   const auto rows = static_cast<Eigen::Index>(base_cmp.size());
-  CalibratedModel null{start, base, base_cmp, Eigen::MatrixXd::Zero(rows, k)};
-  if (k == 0) return null;
+  CalibratedModel fit{start, base, base_cmp, Eigen::MatrixXd::Zero(rows, k)};
+  if (k == 0) return fit;
   Eigen::MatrixXi acts(rows, k);
   Eigen::VectorXd scale(k), radius(k);
   const Eigen::VectorXd origin = coordinates_of(start, coords);
@@ -605,7 +605,7 @@ Result<CalibratedModel> calibrate_outcomes(const Evaluator& ev, const std::vecto
   for (Eigen::Index j = 0; j < rows; ++j)
     target(j) = std::log(above_floor(recorded(j), base_cmp[static_cast<std::size_t>(j)]));
   for (int iteration = 0; iteration < 4; ++iteration) {
-    const Eigen::VectorXd centre = coordinates_of(null.point, coords);
+    const Eigen::VectorXd centre = coordinates_of(fit.point, coords);
     const Eigen::MatrixXd s = fit_surrogate(points, centre, scale, acts);
     // Weighted so that each residual is the statistic's z at the centre: the values' logarithmic
     // mean times the inverse standard error.
@@ -620,29 +620,29 @@ Result<CalibratedModel> calibrate_outcomes(const Evaluator& ev, const std::vecto
     double shrink = 1.0;
     for (Eigen::Index q = 0; q < k; ++q)
       if (std::abs(step(q)) > radius(q)) shrink = std::min(shrink, radius(q) / std::abs(step(q)));
-    const Point trial = moved(null.point, coords, shrink * step);
+    const Point trial = moved(fit.point, coords, shrink * step);
     const Eigen::VectorXd taken = coordinates_of(trial, coords) - centre;
     if (taken.cwiseQuotient(scale).norm() < 1e-3) break;
     auto out = replay_outcomes(ev, trial.model, plans, std::vector<bool>(plans.size(), true), nullptr, result.replays);
     if (!out) return std::unexpected(out.error());
     const auto cmp = compare_all(plans, *out, options.impact_accuracy);
     points.push_back({coordinates_of(trial, coords), log_values(cmp)});
-    if (chi2_of(cmp) < chi2_of(null.comparisons)) {
-      null.point = trial;
-      null.sample = std::move(*out);
-      null.comparisons = cmp;
+    if (chi2_of(cmp) < chi2_of(fit.comparisons)) {
+      fit.point = trial;
+      fit.sample = std::move(*out);
+      fit.comparisons = cmp;
       radius *= 1.5;
     } else {
       radius *= 0.5;
     }
   }
   // The response at the result, in the statistics' own units, for the candidates' surrogate.
-  const Eigen::MatrixXd s = fit_surrogate(points, coordinates_of(null.point, coords), scale, acts);
+  const Eigen::MatrixXd s = fit_surrogate(points, coordinates_of(fit.point, coords), scale, acts);
   for (Eigen::Index j = 0; j < rows; ++j) {
-    const OutcomeComparison& c = null.comparisons[static_cast<std::size_t>(j)];
-    null.jacobian.row(j) = above_floor(c.ensemble_value, c) * s.row(j).tail(k);
+    const OutcomeComparison& c = fit.comparisons[static_cast<std::size_t>(j)];
+    fit.jacobian.row(j) = above_floor(c.ensemble_value, c) * s.row(j).tail(k);
   }
-  return null;
+  return fit;
 }
 
 /// A proposal judged by new replays: the effect from the proposed level, calibrated on the
@@ -677,11 +677,7 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
   h.dispersion = margin.dispersion;
   h.delta_bic = margin.delta_bic;
   h.comparisons = std::move(fitted->comparisons);
-  h.plausible = true;
-  for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
-    const auto& q = spec.parameters[k];
-    h.plausible = h.plausible && h.values[k] >= q.plausible_low && h.values[k] <= q.plausible_high;
-  }
+  h.plausible = spec.plausible(h.values);
   return h;
 }
 
