@@ -231,6 +231,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
     for (const auto& d : e.detectability) {
       detect.push_back({{"name", effect_spec(library, d.effect).name},
                         {"strong_signal", d.strong_signal},
+                        {"replay_noise", d.replay_noise},
                         {"needed", d.needed},
                         {"trials_needed", finite_or_null(d.trials_needed)}});
     }

@@ -339,6 +339,45 @@ bool flights_rule_out_offset(DiagnoseResult& result) {
   return ruled_out;
 }
 
+/// What the outcomes decided: a candidate replayed at its fitted level and judged against the
+/// calibrated null (a hypothesis) was tested on the recordings, so it is decidable (and, not
+/// named, absent). One the surrogate never proposed stays undecidable, whatever its first-order
+/// detectability says: on the generated benchmark that estimate (the diagnosed clump's response,
+/// less what the coefficients absorb to first order) called 6 concealed effects decidable that
+/// then went unnamed. The experiment says how many trials per set-up would show each at its
+/// strong magnitude, where the estimate asks for more than were recorded.
+void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens) {
+  const auto library = effect_library();
+  std::vector<std::string> more_trials;
+  for (const auto& d : ens.detectability) {
+    const std::string& name = effect_spec(library, d.effect).name;
+    const bool tried = std::any_of(ens.hypotheses.begin(), ens.hypotheses.end(),
+                                   [&](const EnsembleHypothesis& h) { return h.effect == d.effect; });
+    if (tried) {
+      std::erase(result.undecidable, name);
+      continue;
+    }
+    if (std::find(result.undecidable.begin(), result.undecidable.end(), name) == result.undecidable.end()) continue;
+    if (!std::isfinite(d.trials_needed) || d.trials_needed > 1000)
+      more_trials.push_back(fmt::format("{} (the outcomes do not respond to it)", name));
+    else if (d.trials_needed > ens.trials)
+      more_trials.push_back(fmt::format("{} about {:.0f}", name, d.trials_needed));
+    else
+      more_trials.push_back(
+          fmt::format("{} more than {:.0f} (to first order these would do, yet no candidate came "
+                      "near the margin to be tried)",
+                      name, ens.trials));
+  }
+  if (result.verdict == Verdict::None && !more_trials.empty()) {
+    result.experiment = fmt::format(
+        "{}; or repeat each set-up more often: compared as a sample with replays over the unknown release, the "
+        "recorded outcomes would show each at its strong magnitude with these trials per set-up: {}",
+        result.experiment.empty() ? std::string("record each trial's release orientation to a few degrees")
+                                  : result.experiment,
+        fmt::join(more_trials, ", "));
+  }
+}
+
 /// Beyond the release horizons: the recorded trials against replays from the release prior
 /// (diagnose/ensemble.hpp). The coefficients the frame fits left unpinned are calibrated on
 /// the outcomes; a candidate is named when its replays beat that null by the delta-BIC
@@ -383,29 +422,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
                     coefficient_of(ens->calibrated[f.surface].interaction, f.coefficient)));
   }
   result.ensemble = std::move(report);
-  const auto library = effect_library();
-  // What the outcomes could decide: a candidate whose strong magnitude would have shown is
-  // decidable (and, not named below, absent); for the others, the trials per set-up at which
-  // it would show.
-  std::vector<std::string> more_trials;
-  for (const auto& d : ens->detectability) {
-    const std::string& name = effect_spec(library, d.effect).name;
-    if (d.strong_signal >= d.needed) {
-      std::erase(result.undecidable, name);
-    } else if (std::find(result.undecidable.begin(), result.undecidable.end(), name) != result.undecidable.end()) {
-      more_trials.push_back(std::isfinite(d.trials_needed) && d.trials_needed <= 1000
-                                ? fmt::format("{} about {:.0f}", name, d.trials_needed)
-                                : fmt::format("{} (the outcomes do not respond to it)", name));
-    }
-  }
-  if (result.verdict == Verdict::None && !more_trials.empty()) {
-    result.experiment = fmt::format(
-        "{}; or repeat each set-up more often: compared as a sample with replays over the unknown release, the "
-        "recorded outcomes would show each at its strong magnitude with these trials per set-up: {}",
-        result.experiment.empty() ? std::string("record each trial's release orientation to a few degrees")
-                                  : result.experiment,
-        fmt::join(more_trials, ", "));
-  }
+  say_what_outcomes_decide(result, *ens);
   std::vector<const EnsembleHypothesis*> passing = passing_hypotheses(*ens, options.min_delta_bic, result.notes);
   if (!ens->outcomes || ens->hypotheses.empty() || passing.empty()) {
     if (ens->outcomes > 0 && result.verdict == Verdict::None)

@@ -169,6 +169,22 @@ OutcomeComparison compare_spread(const std::vector<double>& recorded, const std:
   return c;
 }
 
+ResponseSignal response_signal(const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
+                               const Eigen::VectorXd& inverse_se, const Eigen::MatrixXd& jacobian) {
+  const Eigen::Index n = response.size();
+  const Eigen::VectorXd weighted = inverse_se.cwiseProduct(response);
+  // I - P, P the projection on the weighted jacobian's columns (what the coefficients absorb).
+  Eigen::MatrixXd keep = Eigen::MatrixXd::Identity(n, n);
+  if (jacobian.cols() > 0) {
+    const Eigen::MatrixXd a = inverse_se.asDiagonal() * jacobian;
+    keep -= a * a.colPivHouseholderQr().solve(Eigen::MatrixXd::Identity(n, n));
+  }
+  ResponseSignal out;
+  out.raw = (keep * weighted).squaredNorm();
+  for (Eigen::Index j = 0; j < n; ++j) out.noise += inverse_se(j) * inverse_se(j) * variance(j) * keep(j, j);
+  return out;
+}
+
 namespace {
 
 /// One recording compared: its recorded outcomes and the orientations its replays start from.
@@ -299,6 +315,34 @@ std::vector<OutcomeComparison> compare_all(const std::vector<Plan>& plans, const
   return out;
 }
 
+/// The sampling variance of each statistic's difference between two replay samples of the same
+/// plans (compare_all's order): paired replay by replay when both hold the same replays (the same
+/// orientations), else as independent samples. A spread's terms are the absolute deviations
+/// from each sample's median.
+Eigen::VectorXd difference_variance(const std::vector<Plan>& plans, const Sample& a, const Sample& b) {
+  const auto variance_of_mean = [](const std::vector<double>& x) {
+    return x.size() > 1 ? std::pow(sample_spread(x).sd, 2) / static_cast<double>(x.size()) : 0.0;
+  };
+  std::vector<double> out;
+  for (std::size_t p = 0; p < plans.size(); ++p) {
+    for (std::size_t o = 0; o < plans[p].outcomes.size(); ++o) {
+      const std::vector<double>& x = a[p][o];
+      const std::vector<double>& y = b[p][o];
+      for (const bool spread : {false, true}) {
+        const std::vector<double> u = spread ? absolute_deviations(x) : x, v = spread ? absolute_deviations(y) : y;
+        if (u.size() == v.size()) {
+          std::vector<double> d(u.size());
+          for (std::size_t k = 0; k < u.size(); ++k) d[k] = v[k] - u[k];
+          out.push_back(variance_of_mean(d));
+        } else {
+          out.push_back(variance_of_mean(u) + variance_of_mean(v));
+        }
+      }
+    }
+  }
+  return Eigen::Map<const Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size()));
+}
+
 double chi2_of(const std::vector<OutcomeComparison>& c) {
   double sum = 0.0;
   for (const auto& x : c) sum += x.z * x.z;
@@ -405,6 +449,7 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
   }
   if (!any) return std::nullopt;
   std::array<Eigen::VectorXd, 2> response;
+  Eigen::VectorXd strong_variance;
   for (int level = 1; level <= 2; ++level) {
     Model m = null_model;
     m.effect = spec.effect;
@@ -412,19 +457,17 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     auto out = replay_outcomes(ev, m, plans, run, &null_sample, result.replays);
     if (!out) return std::unexpected(out.error());
     response[level - 1] = means_of(compare_all(plans, *out, options.impact_accuracy)) - null_means;
+    if (level == 2) strong_variance = difference_variance(plans, null_sample, *out);
   }
   const double penalty = static_cast<double>(spec.parameters.size()) * std::log(std::max(1, result.outcomes));
   bool detectable = false;
   {
-    // Its strong magnitude's signal with what the free coefficients absorb projected out;
-    // the standard errors fall as 1/sqrt(trials), so the signal grows with them.
-    const Eigen::VectorXd weighted = inverse_se.asDiagonal() * response[1];
-    Eigen::VectorXd kept = weighted;
-    if (!free.empty()) {
-      const Eigen::MatrixXd a = inverse_se.asDiagonal() * jacobian;
-      kept = weighted - a * a.colPivHouseholderQr().solve(weighted);
-    }
-    Detectability d{spec.effect, kept.squaredNorm(), options.min_delta_bic + penalty,
+    // Its strong magnitude's signal with what the free coefficients absorb projected out and the
+    // replays' own noise taken off; the standard errors fall as 1/sqrt(trials), so the signal
+    // grows with them.
+    const ResponseSignal s = response_signal(response[1], strong_variance, inverse_se,
+                                             free.empty() ? Eigen::MatrixXd(jacobian.rows(), 0) : jacobian);
+    Detectability d{spec.effect, s.signal(), s.noise, options.min_delta_bic + penalty,
                     std::numeric_limits<double>::infinity()};
     if (d.strong_signal > 0.0) d.trials_needed = std::ceil(result.trials * d.needed / d.strong_signal);
     detectable = d.strong_signal >= d.needed;

@@ -14,6 +14,7 @@
 /// (common random numbers), a surrogate linear in the coefficients picks its best magnitude,
 /// and new replays at that point decide (delta-BIC against the calibrated null, computed from
 /// replays, never from the surrogate).
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -153,10 +154,25 @@ struct EnsembleHypothesis {
 /// recording at which that signal would reach the delta-BIC margin.
 struct Detectability {
   Effect effect = Effect::AirDrag;
-  double strong_signal = 0.0;
+  double strong_signal = 0.0;  ///< ResponseSignal::signal(): the replays' own noise taken off
+  double replay_noise = 0.0;   ///< ResponseSignal::noise: what that noise alone adds to the raw signal
   double needed = 0.0;         ///< delta-chi^2 the margin asks for (margin + k ln n)
   double trials_needed = 0.0;  ///< per recording; infinity when the outcomes do not respond
 };
+
+/// A candidate's response (its replays' statistics less the null's, from the same orientations),
+/// in standard errors of the recorded outcomes (`inverse_se`), with what the free coefficients
+/// absorb to first order (`jacobian`, one column each; none when empty) projected out. A
+/// response is a difference of two replay samples, so their sampling noise adds to its squared
+/// norm even where the effect changes nothing; `variance` is each statistic's sampling variance
+/// and `noise` that expectation, weighted and projected alike: E[raw] = |signal|^2 + noise.
+struct ResponseSignal {
+  double raw = 0.0;    ///< the squared norm of the projected, weighted response
+  double noise = 0.0;  ///< sum_j w_j^2 variance_j (I - P)_jj
+  double signal() const { return std::max(0.0, raw - noise); }  ///< the unbiased estimate, held at 0
+};
+ResponseSignal response_signal(const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
+                               const Eigen::VectorXd& inverse_se, const Eigen::MatrixXd& jacobian);
 
 struct EnsembleResult {
   std::vector<SurfaceParameters> calibrated;  ///< the null: free coefficients fitted to the outcomes

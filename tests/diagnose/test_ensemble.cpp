@@ -117,6 +117,52 @@ TEST(EnsembleComparison, FalsePositiveRateOnSamplesOfOneDistribution) {
   EXPECT_LE(static_cast<double>(sets_beyond) / kSets, 0.01);
 }
 
+TEST(EnsembleDetectability, ReplayNoiseIsTakenOffACandidatesSignal) {
+  // A candidate's response is the difference of two replay samples, so noise alone gives it a
+  // squared norm: about one per statistic here (variance = se^2), less what the two
+  // coefficients absorb. Over 4000 draws of pure noise the raw signal's mean is that noise
+  // (the trace of I - P: 24 - 2 = 22), and raw - noise averages to 0; with a true response r
+  // added, raw - noise averages to |(I - P) W r|^2. Tolerances: 4 standard errors of the mean.
+  Rng rng(23);
+  constexpr int kStats = 24, kDraws = 4000;
+  Eigen::VectorXd inverse_se(kStats), variance(kStats), truth(kStats);
+  Eigen::MatrixXd jacobian(kStats, 2);
+  for (int j = 0; j < kStats; ++j) {
+    const double se = 0.002 * (1.0 + 0.1 * j);
+    inverse_se(j) = 1.0 / se;
+    variance(j) = se * se;
+    jacobian(j, 0) = 1.0;
+    jacobian(j, 1) = j % 3 - 1.0;
+    truth(j) = (j % 4 == 0 ? 1.5 : 0.0) * se;  // six statistics 1.5 se off
+  }
+  const ResponseSignal expected = response_signal(truth, Eigen::VectorXd::Zero(kStats), inverse_se, jacobian);
+  double raw_noise = 0.0, raw_noise2 = 0.0, unbiased_noise = 0.0, unbiased_signal = 0.0, unbiased_signal2 = 0.0;
+  double noise = 0.0;
+  for (int d = 0; d < kDraws; ++d) {
+    Eigen::VectorXd e(kStats);
+    for (int j = 0; j < kStats; ++j) e(j) = rng.normal(0.0, std::sqrt(variance(j)));
+    const ResponseSignal pure = response_signal(e, variance, inverse_se, jacobian);
+    const ResponseSignal with = response_signal(Eigen::VectorXd(truth + e), variance, inverse_se, jacobian);
+    noise = pure.noise;
+    raw_noise += pure.raw;
+    raw_noise2 += pure.raw * pure.raw;
+    unbiased_noise += pure.raw - pure.noise;
+    unbiased_signal += with.raw - with.noise;
+    unbiased_signal2 += std::pow(with.raw - with.noise, 2);
+  }
+  EXPECT_NEAR(noise, kStats - 2.0, 1e-9);
+  const double mean_raw = raw_noise / kDraws;
+  const double sd_raw = std::sqrt(raw_noise2 / kDraws - mean_raw * mean_raw);
+  EXPECT_NEAR(mean_raw, noise, 4.0 * sd_raw / std::sqrt(kDraws));
+  EXPECT_NEAR(unbiased_noise / kDraws, 0.0, 4.0 * sd_raw / std::sqrt(kDraws));
+  const double mean_signal = unbiased_signal / kDraws;
+  const double sd_signal = std::sqrt(unbiased_signal2 / kDraws - mean_signal * mean_signal);
+  EXPECT_GT(expected.raw, 5.0);
+  EXPECT_NEAR(mean_signal, expected.raw, 4.0 * sd_signal / std::sqrt(kDraws));
+  // Without the coefficients nothing is absorbed: the noise is one per statistic.
+  EXPECT_NEAR(response_signal(truth, variance, inverse_se, Eigen::MatrixXd(kStats, 0)).noise, kStats, 1e-9);
+}
+
 TEST(EnsembleComparison, StandardisedDifferenceOfSpreads) {
   // Recorded {0, 1, 2, 3}: absolute deviations from the median 1.5 are {1.5, 0.5, 0.5, 1.5},
   // mean 1, sum of squares about it 1; replays that all agree deviate by 0. Pooled over 6
