@@ -21,6 +21,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 #include "core/atomic_file.hpp"
@@ -215,6 +216,143 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   return 0;
 }
 
+/// One diagnosed case as the scorer sees it.
+struct CaseScore {
+  std::string truth, magnitude, verdict;
+  double heldout_before = NAN, heldout_after = NAN, seconds = NAN;
+  bool detected = false;
+  bool ruled_out = false;  ///< the concealed effect is not among the report's undecidable ones
+  std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
+};
+
+/// A case's report.json read for the score (nullopt when it is not JSON).
+std::optional<CaseScore> read_outcome(const fs::path& report, const std::string& truth, const std::string& magnitude) {
+  std::ifstream in(report);
+  const auto j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded()) return std::nullopt;
+  CaseScore o;
+  o.truth = truth;
+  o.magnitude = magnitude;
+  o.verdict = j.value("verdict", "?");
+  o.detected = o.verdict == truth;
+  o.heldout_before = j["fit"]["before"].value("heldout_rms_mm", NAN);
+  o.heldout_after = j["fit"]["after"].value("heldout_rms_mm", NAN);
+  o.seconds = j.value("seconds", NAN);
+  if (j.contains("undecidable") && j["undecidable"].is_array()) {
+    const auto& u = j["undecidable"];
+    o.ruled_out = std::find(u.begin(), u.end(), truth) == u.end();
+  }
+  if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
+    for (const auto& cmp : j["ensemble"]["comparisons"])
+      o.ensemble_z.emplace_back(cmp.value("statistic", "mean") + " " + cmp.value("outcome", "?"), cmp.value("z", NAN));
+  }
+  return o;
+}
+
+/// The generated set's score: the confusion matrix, detection per effect and magnitude, the
+/// controls' false positives, what the reports wrongly called decided, the median held-out
+/// improvement and time, and how the calibrated null sits on the controls; summary.md and
+/// summary.json in `out`.
+void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::vector<EffectSpec>& library,
+                             const std::string& out) {
+  // Confusion matrix: rows are the truth (effect and magnitude), columns the verdicts.
+  std::vector<std::string> columns;
+  for (const auto& spec : library) columns.push_back(spec.name);
+  for (const char* v : {"none", "ambiguous", "unexplained", "undecidable"}) columns.emplace_back(v);
+  std::map<std::string, std::map<std::string, int>> matrix;
+  std::vector<std::string> rows;
+  for (const auto& o : outcomes) {
+    const std::string row = o.truth == "none" ? "none (controls)" : fmt::format("{} ({})", o.truth, o.magnitude);
+    if (!matrix.contains(row)) rows.push_back(row);
+    ++matrix[row][o.verdict];
+  }
+  std::string md = "| truth \\ verdict |";
+  for (const auto& col : columns) md += fmt::format(" {} |", col);
+  md += "\n|---|";
+  for (std::size_t i = 0; i < columns.size(); ++i) md += "---:|";
+  md += "\n";
+  for (const auto& row : rows) {
+    md += fmt::format("| {} |", row);
+    for (const auto& col : columns)
+      md += fmt::format(" {} |", matrix[row][col] ? std::to_string(matrix[row][col]) : std::string("."));
+    md += "\n";
+  }
+  int control_count = 0, false_positives = 0, named_controls = 0, effect_count = 0, ruled_out = 0;
+  std::vector<double> improvements, seconds;
+  nlohmann::json summary;
+  for (const auto& o : outcomes) {
+    seconds.push_back(o.seconds);
+    if (o.truth == "none") {
+      ++control_count;
+      false_positives += o.verdict != "none";
+      // Blamed on an effect: a name, or an ambiguous pair (unexplained and undecidable blame none).
+      named_controls += o.verdict != "none" && o.verdict != "unexplained" && o.verdict != "undecidable";
+    } else {
+      if (o.detected && o.heldout_before > 0.0)
+        improvements.push_back((o.heldout_before - o.heldout_after) / o.heldout_before);
+      ++effect_count;
+      ruled_out += !o.detected && o.ruled_out;
+    }
+  }
+  md += "\n| effect | realistic | strong |\n|---|---:|---:|\n";
+  for (const auto& spec : library) {
+    std::string cells;
+    for (const char* m : {"realistic", "strong"}) {
+      int n = 0, hit = 0;
+      for (const auto& o : outcomes) {
+        if (o.truth == spec.name && o.magnitude == m) {
+          ++n;
+          hit += o.detected;
+        }
+      }
+      cells += n ? fmt::format(" {}/{} |", hit, n) : std::string(" - |");
+      summary["detection"][spec.name][m] = n ? static_cast<double>(hit) / n : NAN;
+    }
+    md += fmt::format("| {} |{}\n", spec.name, cells);
+  }
+  const double fpr = control_count ? static_cast<double>(false_positives) / control_count : NAN;
+  md += fmt::format("\nfalse-positive rate on {} controls (any verdict but none): {}/{} = {:.1f} %\n", control_count,
+                    false_positives, control_count, 100.0 * fpr);
+  md += fmt::format("controls blamed on an effect (named or ambiguous): {}/{}\n", named_controls, control_count);
+  md += fmt::format("effects missed that the report called decided (not in its undecidable list): {}/{}\n", ruled_out,
+                    effect_count);
+  md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
+                    100.0 * median(improvements));
+  md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
+  // On the controls the calibrated null's replays should sit on the recorded outcomes within
+  // their standard errors (z about 0 +- 1): a mean z away from 0 is a bias of the diagnosed
+  // particle model against the generator's, which the ensemble stage may blame on an effect.
+  std::map<std::string, std::vector<double>> control_z;
+  for (const auto& o : outcomes) {
+    if (o.truth != "none") continue;
+    for (const auto& [name, z] : o.ensemble_z) {
+      if (std::isfinite(z)) control_z[name].push_back(z);
+    }
+  }
+  if (!control_z.empty()) {
+    md +=
+        "\n| outcome (controls, calibrated null) | comparisons | mean z | z > 2 | z < -2 |\n"
+        "|---|---:|---:|---:|---:|\n";
+    for (const auto& [name, zs] : control_z) {
+      const double mean = std::accumulate(zs.begin(), zs.end(), 0.0) / static_cast<double>(zs.size());
+      const auto above = std::count_if(zs.begin(), zs.end(), [](double z) { return z > 2.0; });
+      const auto below = std::count_if(zs.begin(), zs.end(), [](double z) { return z < -2.0; });
+      md += fmt::format("| {} | {} | {:+.2f} | {} | {} |\n", name, zs.size(), mean, above, below);
+      summary["control_ensemble_bias"][name] = {{"comparisons", zs.size()}, {"mean_z", mean}};
+    }
+  }
+  std::cout << "\n" << md;
+  summary["false_positive_rate"] = fpr;
+  summary["controls_blamed_on_an_effect"] = named_controls;
+  summary["controls"] = control_count;
+  summary["effects_missed_yet_called_decided"] = ruled_out;
+  summary["median_heldout_improvement"] = median(improvements);
+  summary["median_seconds"] = median(seconds);
+  summary["matrix_markdown"] = md;
+  std::ofstream(fs::path(out) / "summary.md") << md;
+  std::ofstream(fs::path(out) / "summary.json") << summary.dump(2) << "\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -373,13 +511,7 @@ int main(int argc, char** argv) {
     cases = std::move(interleaved);
   }
   fs::create_directories(out);
-  struct Outcome {
-    std::string truth, magnitude, verdict;
-    double heldout_before = NAN, heldout_after = NAN, seconds = NAN;
-    bool detected = false;
-    std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
-  };
-  std::vector<Outcome> outcomes;
+  std::vector<CaseScore> outcomes;
   std::vector<std::string> ids;
   for (const auto& c : cases) ids.push_back(c.id);
   auto make_and_diagnose = [&](std::size_t i) {
@@ -415,120 +547,17 @@ int main(int argc, char** argv) {
     const fs::path report = fs::path(out) / c.id / "report.json";
     const std::string truth = c.effect ? effect_spec(library, *c.effect).name : "none";
     if (!fs::exists(report)) continue;
-    std::ifstream in(report);
-    const auto j = nlohmann::json::parse(in, nullptr, false);
-    if (j.is_discarded()) {
+    auto o = read_outcome(report, truth, c.magnitude);
+    if (!o) {
       std::cerr << c.id << ": unreadable report\n";
       return 1;
     }
-    Outcome o;
-    o.truth = truth;
-    o.magnitude = c.magnitude;
-    o.verdict = j.value("verdict", "?");
-    o.detected = o.verdict == truth;
-    o.heldout_before = j["fit"]["before"].value("heldout_rms_mm", NAN);
-    o.heldout_after = j["fit"]["after"].value("heldout_rms_mm", NAN);
-    o.seconds = j.value("seconds", NAN);
-    if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
-      for (const auto& cmp : j["ensemble"]["comparisons"])
-        o.ensemble_z.emplace_back(cmp.value("statistic", "mean") + " " + cmp.value("outcome", "?"),
-                                  cmp.value("z", NAN));
-    }
     std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id,
-                             truth, o.verdict, o.heldout_before, o.heldout_after, o.seconds)
+                             truth, o->verdict, o->heldout_before, o->heldout_after, o->seconds)
               << std::flush;
-    outcomes.push_back(o);
+    outcomes.push_back(*o);
   }
 
-  // Confusion matrix: rows are the truth (effect and magnitude), columns the verdicts.
-  std::vector<std::string> columns;
-  for (const auto& spec : library) columns.push_back(spec.name);
-  for (const char* v : {"none", "ambiguous", "unexplained", "undecidable"}) columns.emplace_back(v);
-  std::map<std::string, std::map<std::string, int>> matrix;
-  std::vector<std::string> rows;
-  for (const auto& o : outcomes) {
-    const std::string row = o.truth == "none" ? "none (controls)" : fmt::format("{} ({})", o.truth, o.magnitude);
-    if (!matrix.contains(row)) rows.push_back(row);
-    ++matrix[row][o.verdict];
-  }
-  std::string md = "| truth \\ verdict |";
-  for (const auto& col : columns) md += fmt::format(" {} |", col);
-  md += "\n|---|";
-  for (std::size_t i = 0; i < columns.size(); ++i) md += "---:|";
-  md += "\n";
-  for (const auto& row : rows) {
-    md += fmt::format("| {} |", row);
-    for (const auto& col : columns)
-      md += fmt::format(" {} |", matrix[row][col] ? std::to_string(matrix[row][col]) : std::string("."));
-    md += "\n";
-  }
-  int control_count = 0, false_positives = 0, named_controls = 0;
-  std::vector<double> improvements, seconds;
-  nlohmann::json summary;
-  for (const auto& o : outcomes) {
-    seconds.push_back(o.seconds);
-    if (o.truth == "none") {
-      ++control_count;
-      false_positives += o.verdict != "none";
-      // Blamed on an effect: a name, or an ambiguous pair (unexplained and undecidable blame none).
-      named_controls += o.verdict != "none" && o.verdict != "unexplained" && o.verdict != "undecidable";
-    } else if (o.detected && o.heldout_before > 0.0) {
-      improvements.push_back((o.heldout_before - o.heldout_after) / o.heldout_before);
-    }
-  }
-  md += "\n| effect | realistic | strong |\n|---|---:|---:|\n";
-  for (const auto& spec : library) {
-    std::string cells;
-    for (const char* m : {"realistic", "strong"}) {
-      int n = 0, hit = 0;
-      for (const auto& o : outcomes) {
-        if (o.truth == spec.name && o.magnitude == m) {
-          ++n;
-          hit += o.detected;
-        }
-      }
-      cells += n ? fmt::format(" {}/{} |", hit, n) : std::string(" - |");
-      summary["detection"][spec.name][m] = n ? static_cast<double>(hit) / n : NAN;
-    }
-    md += fmt::format("| {} |{}\n", spec.name, cells);
-  }
-  const double fpr = control_count ? static_cast<double>(false_positives) / control_count : NAN;
-  md += fmt::format("\nfalse-positive rate on {} controls (any verdict but none): {}/{} = {:.1f} %\n", control_count,
-                    false_positives, control_count, 100.0 * fpr);
-  md += fmt::format("controls blamed on an effect (named or ambiguous): {}/{}\n", named_controls, control_count);
-  md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
-                    100.0 * median(improvements));
-  md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
-  // On the controls the calibrated null's replays should sit on the recorded outcomes within
-  // their standard errors (z about 0 +- 1): a mean z away from 0 is a bias of the diagnosed
-  // particle model against the generator's, which the ensemble stage may blame on an effect.
-  std::map<std::string, std::vector<double>> control_z;
-  for (const auto& o : outcomes) {
-    if (o.truth != "none") continue;
-    for (const auto& [name, z] : o.ensemble_z) {
-      if (std::isfinite(z)) control_z[name].push_back(z);
-    }
-  }
-  if (!control_z.empty()) {
-    md +=
-        "\n| outcome (controls, calibrated null) | comparisons | mean z | z > 2 | z < -2 |\n"
-        "|---|---:|---:|---:|---:|\n";
-    for (const auto& [name, zs] : control_z) {
-      const double mean = std::accumulate(zs.begin(), zs.end(), 0.0) / static_cast<double>(zs.size());
-      const auto above = std::count_if(zs.begin(), zs.end(), [](double z) { return z > 2.0; });
-      const auto below = std::count_if(zs.begin(), zs.end(), [](double z) { return z < -2.0; });
-      md += fmt::format("| {} | {} | {:+.2f} | {} | {} |\n", name, zs.size(), mean, above, below);
-      summary["control_ensemble_bias"][name] = {{"comparisons", zs.size()}, {"mean_z", mean}};
-    }
-  }
-  std::cout << "\n" << md;
-  summary["false_positive_rate"] = fpr;
-  summary["controls_blamed_on_an_effect"] = named_controls;
-  summary["controls"] = control_count;
-  summary["median_heldout_improvement"] = median(improvements);
-  summary["median_seconds"] = median(seconds);
-  summary["matrix_markdown"] = md;
-  std::ofstream(fs::path(out) / "summary.md") << md;
-  std::ofstream(fs::path(out) / "summary.json") << summary.dump(2) << "\n";
+  write_generated_summary(outcomes, library, out);
   return 0;
 }
