@@ -342,10 +342,10 @@ bool flights_rule_out_offset(DiagnoseResult& result) {
 /// What the outcomes decided: a candidate replayed at its fitted level and judged against the
 /// calibrated null (a hypothesis) was tested on the recordings, so it is decidable (and, not
 /// named, absent). One the surrogate never proposed stays undecidable, whatever its first-order
-/// detectability says: on the generated benchmark that estimate (the diagnosed clump's response,
-/// less what the coefficients absorb to first order) called 6 concealed effects decidable that
-/// then went unnamed. The experiment says how many trials per set-up would show each at its
-/// strong magnitude, where the estimate asks for more than were recorded.
+/// detectability says: on the generated 1000 fps benchmark that estimate (the diagnosed clump's
+/// response, less what the coefficients absorb to first order) called the concealed effect
+/// decidable at its strong magnitude in three strong cases that then went unnamed. The experiment says how many trials
+/// per set-up would show each at its strong magnitude, where the estimate asks for more than were recorded.
 void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens) {
   const auto library = effect_library();
   std::vector<std::string> more_trials;
