@@ -359,7 +359,9 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
     }
     if (std::find(result.undecidable.begin(), result.undecidable.end(), name) == result.undecidable.end()) continue;
     if (!std::isfinite(d.trials_needed) || d.trials_needed > 1000)
-      more_trials.push_back(fmt::format("{} (the outcomes do not respond to it)", name));
+      more_trials.push_back(d.replay_noise > 0.0
+                                ? fmt::format("{} (its response is within the replays' own noise)", name)
+                                : fmt::format("{} (the outcomes do not respond to it)", name));
     else if (d.trials_needed > ens.trials)
       more_trials.push_back(fmt::format("{} about {:.0f}", name, d.trials_needed));
     else
