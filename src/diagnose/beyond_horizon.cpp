@@ -344,7 +344,8 @@ bool flights_rule_out_offset(DiagnoseResult& result) {
 /// named, absent). One the surrogate never proposed stays undecidable, whatever its first-order
 /// detectability says: on the generated 1000 fps benchmark that estimate (the diagnosed clump's
 /// response, less what the coefficients absorb to first order) called the concealed effect
-/// decidable at its strong magnitude in three strong cases that then went unnamed. The experiment says how many trials
+/// decidable at its strong magnitude in two strong cases that then went unnamed (the
+/// viscoelastic and elastic-plastic restitutions). The experiment says how many trials
 /// per set-up would show each at its strong magnitude, where the estimate asks for more than were recorded.
 void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens) {
   const auto library = effect_library();
