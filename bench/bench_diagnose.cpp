@@ -221,12 +221,13 @@ struct CaseScore {
   std::string truth, magnitude, verdict;
   double heldout_before = NAN, heldout_after = NAN, seconds = NAN;
   bool detected = false;
-  bool ruled_out = false;  ///< the concealed effect is not among the report's undecidable ones
+  bool called_decided = false;  ///< the concealed effect is not among the report's undecidable ones
   std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
 };
 
 /// A case's report.json read for the score (nullopt when it is not JSON).
-std::optional<CaseScore> read_outcome(const fs::path& report, const std::string& truth, const std::string& magnitude) {
+std::optional<CaseScore> read_case_score(const fs::path& report, const std::string& truth,
+                                         const std::string& magnitude) {
   std::ifstream in(report);
   const auto j = nlohmann::json::parse(in, nullptr, false);
   if (j.is_discarded()) return std::nullopt;
@@ -240,7 +241,7 @@ std::optional<CaseScore> read_outcome(const fs::path& report, const std::string&
   o.seconds = j.value("seconds", NAN);
   if (j.contains("undecidable") && j["undecidable"].is_array()) {
     const auto& u = j["undecidable"];
-    o.ruled_out = std::find(u.begin(), u.end(), truth) == u.end();
+    o.called_decided = std::find(u.begin(), u.end(), truth) == u.end();
   }
   if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
     for (const auto& cmp : j["ensemble"]["comparisons"])
@@ -277,7 +278,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
       md += fmt::format(" {} |", matrix[row][col] ? std::to_string(matrix[row][col]) : std::string("."));
     md += "\n";
   }
-  int control_count = 0, false_positives = 0, named_controls = 0, strong_count = 0, ruled_out = 0;
+  int control_count = 0, false_positives = 0, named_controls = 0, strong_count = 0, missed_decided = 0;
   std::vector<double> improvements, seconds;
   nlohmann::json summary;
   for (const auto& o : outcomes) {
@@ -292,7 +293,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
         improvements.push_back((o.heldout_before - o.heldout_after) / o.heldout_before);
       strong_count += o.magnitude == "strong";
       // The decidable list speaks of the strong magnitude: a missed realistic one may lie below it.
-      ruled_out += o.magnitude == "strong" && !o.detected && o.ruled_out;
+      missed_decided += o.magnitude == "strong" && !o.detected && o.called_decided;
     }
   }
   md += "\n| effect | realistic | strong |\n|---|---:|---:|\n";
@@ -316,7 +317,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
                     false_positives, control_count, 100.0 * fpr);
   md += fmt::format("controls blamed on an effect (named or ambiguous): {}/{}\n", named_controls, control_count);
   md += fmt::format("strong effects missed that the report called decided (not in its undecidable list): {}/{}\n",
-                    ruled_out, strong_count);
+                    missed_decided, strong_count);
   md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
                     100.0 * median(improvements));
   md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
@@ -346,7 +347,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   summary["false_positive_rate"] = fpr;
   summary["controls_blamed_on_an_effect"] = named_controls;
   summary["controls"] = control_count;
-  summary["strong_effects_missed_yet_called_decided"] = ruled_out;
+  summary["strong_effects_missed_yet_called_decided"] = missed_decided;
   summary["median_heldout_improvement"] = median(improvements);
   summary["median_seconds"] = median(seconds);
   summary["matrix_markdown"] = md;
@@ -548,7 +549,7 @@ int main(int argc, char** argv) {
     const fs::path report = fs::path(out) / c.id / "report.json";
     const std::string truth = c.effect ? effect_spec(library, *c.effect).name : "none";
     if (!fs::exists(report)) continue;
-    auto o = read_outcome(report, truth, c.magnitude);
+    auto o = read_case_score(report, truth, c.magnitude);
     if (!o) {
       std::cerr << c.id << ": unreadable report\n";
       return 1;

@@ -301,6 +301,7 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
   }
   Eigen::MatrixXd absorb(base_cells->size(), static_cast<Eigen::Index>(directions.size()));
   for (std::size_t k = 0; k < directions.size(); ++k) absorb.col(static_cast<Eigen::Index>(k)) = directions[k];
+  const Eigen::MatrixXd keep = residual_projection(absorb, absorb.rows());
   std::vector<std::string> limits, untestable;
   for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
     auto& report = result.hypotheses[h];
@@ -313,8 +314,7 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
     double signal = 0.0, misfit = 0.0;
     if (probe_cells->size() == base_cells->size()) {
       const Eigen::VectorXd d = *base_cells - *probe_cells;
-      const Eigen::VectorXd kept =
-          absorb.cols() > 0 ? Eigen::VectorXd(d - absorb * absorb.colPivHouseholderQr().solve(d)) : d;
+      const Eigen::VectorXd kept = keep * d;
       signal = kept.squaredNorm();
       misfit = largest_signal_misfit(c, keys, kept);
     }

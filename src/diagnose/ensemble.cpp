@@ -11,6 +11,7 @@
 
 #include "diagnose/release.hpp"
 #include "diagnose/tracks.hpp"
+#include "numerics/least_squares.hpp"
 #include "numerics/statistics.hpp"
 
 namespace clumpforge {
@@ -173,12 +174,7 @@ ResponseSignal response_signal(const Eigen::VectorXd& response, const Eigen::Vec
                                const Eigen::VectorXd& inverse_se, const Eigen::MatrixXd& jacobian) {
   const Eigen::Index n = response.size();
   const Eigen::VectorXd weighted = inverse_se.cwiseProduct(response);
-  // I - P, P the projection on the weighted jacobian's columns (what the coefficients absorb).
-  Eigen::MatrixXd keep = Eigen::MatrixXd::Identity(n, n);
-  if (jacobian.cols() > 0) {
-    const Eigen::MatrixXd a = inverse_se.asDiagonal() * jacobian;
-    keep -= a * a.colPivHouseholderQr().solve(Eigen::MatrixXd::Identity(n, n));
-  }
+  const Eigen::MatrixXd keep = residual_projection(inverse_se.asDiagonal() * jacobian, n);
   ResponseSignal out;
   out.raw = (keep * weighted).squaredNorm();
   for (Eigen::Index j = 0; j < n; ++j) out.noise += inverse_se(j) * inverse_se(j) * variance(j) * keep(j, j);
@@ -465,8 +461,7 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     // Its strong magnitude's signal with what the free coefficients absorb projected out and the
     // replays' own noise taken off; the standard errors fall as 1/sqrt(trials), so the signal
     // grows with them.
-    const ResponseSignal s = response_signal(response[1], strong_variance, inverse_se,
-                                             free.empty() ? Eigen::MatrixXd(jacobian.rows(), 0) : jacobian);
+    const ResponseSignal s = response_signal(response[1], strong_variance, inverse_se, jacobian);
     Detectability d{spec.effect, s.signal(), s.noise, options.min_delta_bic + penalty,
                     std::numeric_limits<double>::infinity()};
     if (d.strong_signal > 0.0) d.trials_needed = std::ceil(result.trials * d.needed / d.strong_signal);

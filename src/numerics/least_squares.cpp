@@ -92,4 +92,10 @@ Result<LeastSquaresResult> levenberg_marquardt(const ResidualFunction& residuals
   return out;
 }
 
+Eigen::MatrixXd residual_projection(const Eigen::MatrixXd& a, Eigen::Index n) {
+  Eigen::MatrixXd keep = Eigen::MatrixXd::Identity(n, n);
+  if (a.cols() > 0) keep -= a * a.colPivHouseholderQr().solve(Eigen::MatrixXd::Identity(n, n));
+  return keep;
+}
+
 }  // namespace clumpforge

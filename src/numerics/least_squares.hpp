@@ -41,4 +41,9 @@ struct LeastSquaresResult {
 Result<LeastSquaresResult> levenberg_marquardt(const ResidualFunction& residuals, Eigen::VectorXd start,
                                                const LeastSquaresOptions& options);
 
+/// I - P, P the least-squares projection on the columns of `a` (n rows): (I - P) v is what of v
+/// a fit on those columns leaves; the identity when `a` has no columns. What free coefficients
+/// absorb of an effect's response is projected out so (the diagnosis's detectability).
+Eigen::MatrixXd residual_projection(const Eigen::MatrixXd& a, Eigen::Index n);
+
 }  // namespace clumpforge
