@@ -6,7 +6,9 @@
 // atomically into --out, which every rank must see); the leader scores. Prints the confusion matrix,
 // the detection rate per effect, the false-positive rate on the controls and the median
 // held-out improvement; writes summary.json and summary.md into --out. Resumable: a case
-// whose report.json exists is not run again.
+// whose report.json exists is not run again, and one whose recordings are stored (with its
+// answer.json) is not made again, so deleting a run's reports diagnoses the same recordings
+// with another build.
 //   bench_diagnose --library clumps/tuber-default-diagnosis.h5 -o bench-out/diagnose
 //   mpirun -np 4 bench_diagnose --recordings-set ../shared/data/lab-like -o bench-out/lab-like
 #include <fmt/format.h>
@@ -222,6 +224,7 @@ struct CaseScore {
   double heldout_before = NAN, heldout_after = NAN, seconds = NAN;
   bool detected = false;
   bool called_decided = false;  ///< the concealed effect is not among the report's undecidable ones
+  int undecidable = 0;          ///< how many effects the report lists as undecidable
   std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
 };
 
@@ -242,6 +245,7 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   if (j.contains("undecidable") && j["undecidable"].is_array()) {
     const auto& u = j["undecidable"];
     o.called_decided = std::find(u.begin(), u.end(), truth) == u.end();
+    o.undecidable = static_cast<int>(u.size());
   }
   if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
     for (const auto& cmp : j["ensemble"]["comparisons"])
@@ -279,7 +283,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
     md += "\n";
   }
   int control_count = 0, false_positives = 0, named_controls = 0, strong_count = 0, missed_decided = 0;
-  std::vector<double> improvements, seconds;
+  std::vector<double> improvements, seconds, decided_absent;
   nlohmann::json summary;
   for (const auto& o : outcomes) {
     seconds.push_back(o.seconds);
@@ -288,6 +292,8 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
       false_positives += o.verdict != "none";
       // Blamed on an effect: a name, or an ambiguous pair (unexplained and undecidable blame none).
       named_controls += o.verdict != "none" && o.verdict != "unexplained" && o.verdict != "undecidable";
+      // What a `none` on a control rules out: the effects it does not call undecidable.
+      if (o.verdict == "none") decided_absent.push_back(static_cast<double>(library.size()) - o.undecidable);
     } else {
       if (o.detected && o.heldout_before > 0.0)
         improvements.push_back((o.heldout_before - o.heldout_after) / o.heldout_before);
@@ -318,6 +324,8 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   md += fmt::format("controls blamed on an effect (named or ambiguous): {}/{}\n", named_controls, control_count);
   md += fmt::format("strong effects missed that the report called decided (not in its undecidable list): {}/{}\n",
                     missed_decided, strong_count);
+  md += fmt::format("effects a control's `none` decides absent (not undecidable), median of {}: {:.0f} of {}\n",
+                    decided_absent.size(), median(decided_absent), library.size());
   md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
                     100.0 * median(improvements));
   md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
@@ -348,6 +356,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   summary["controls_blamed_on_an_effect"] = named_controls;
   summary["controls"] = control_count;
   summary["strong_effects_missed_yet_called_decided"] = missed_decided;
+  summary["median_effects_decided_absent_on_controls"] = median(decided_absent);
   summary["median_heldout_improvement"] = median(improvements);
   summary["median_seconds"] = median(seconds);
   summary["matrix_markdown"] = md;
@@ -355,10 +364,8 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   std::ofstream(fs::path(out) / "summary.json") << summary.dump(2) << "\n";
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"Blind benchmark of clumpforge diagnose on concealed-effect recordings"};
+/// The benchmark's command line.
+struct BenchOptions {
   // The diagnosed clump (adaptive-32) with finer fills of the same scan (64, 128), against
   // which the diagnosis checks its particle model before it blames missing physics.
   std::string clump_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default-ladder.h5",
@@ -367,19 +374,6 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   std::vector<std::string> only;
   bool full_set = false, existing_only = false;
-  app.add_option("--library", clump_file,
-                 "Clump library diagnosed against (default clumps/tuber-default-ladder.h5: its clumps with more "
-                 "spheres than --clump are the finer clumps of the particle-model check)");
-  app.add_option("--clump", clump_name, "Which clump of the library is diagnosed (default adaptive-32)");
-  app.add_option("-o,--output,--out", out, "Working directory (recordings, answers, reports, summary)");
-  app.add_option("--controls", controls, "Effect-free controls");
-  app.add_option("--trials", trials, "Trials per recording");
-  app.add_option("--seed", seed, "Seed of the whole benchmark");
-  app.add_option("--effects", only, "Only these effects (default: the library)");
-  app.add_flag("--full-set", full_set,
-               "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
-  app.add_flag("--existing-only", existing_only,
-               "Score only the cases already diagnosed in --out (a partial run's figures), run none");
   // The recordings come from a finer clump of the same scan than the one diagnosed (340 spheres
   // against the diagnosis's 32), as real data never comes from the diagnoser's own model.
   std::string recordings_set, orientation = "none",
@@ -388,108 +382,107 @@ int main(int argc, char** argv) {
   int spheres = 0, threads = 0;
   double fps = 1000.0, noise = 1e-4;
   bool no_pre_roll = false;
-  app.add_option("--orientation", orientation,
-                 "What each generated trial records of its release orientation: none (default), noisy:DEG, exact");
-  app.add_option("--fps", fps, "Camera frame rate of the generated tracks [Hz] (labs: 1000, 240)");
-  app.add_option("--noise", noise, "Camera noise of the generated tracks [m] (1e-4 at 1000 fps, 5e-4 at 240 fps)");
-  app.add_flag("--no-pre-roll", no_pre_roll, "Generated tracks begin after the release");
   std::string camera_target = "silhouette";
   double pixel_mm = 0.1;
-  app.add_option("--camera", camera_target,
+};
+
+void add_options(CLI::App& app, BenchOptions& o) {
+  app.add_option("--library", o.clump_file,
+                 "Clump library diagnosed against (default clumps/tuber-default-ladder.h5: its clumps with more "
+                 "spheres than --clump are the finer clumps of the particle-model check)");
+  app.add_option("--clump", o.clump_name, "Which clump of the library is diagnosed (default adaptive-32)");
+  app.add_option("-o,--output,--out", o.out, "Working directory (recordings, answers, reports, summary)");
+  app.add_option("--controls", o.controls, "Effect-free controls");
+  app.add_option("--trials", o.trials, "Trials per recording");
+  app.add_option("--seed", o.seed, "Seed of the whole benchmark");
+  app.add_option("--effects", o.only, "Only these effects (default: the library)");
+  app.add_flag("--full-set", o.full_set,
+               "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
+  app.add_flag("--existing-only", o.existing_only,
+               "Score only the cases already diagnosed in --out (a partial run's figures), run none");
+  app.add_option("--orientation", o.orientation,
+                 "What each generated trial records of its release orientation: none (default), noisy:DEG, exact");
+  app.add_option("--fps", o.fps, "Camera frame rate of the generated tracks [Hz] (labs: 1000, 240)");
+  app.add_option("--noise", o.noise, "Camera noise of the generated tracks [m] (1e-4 at 1000 fps, 5e-4 at 240 fps)");
+  app.add_flag("--no-pre-roll", o.no_pre_roll, "Generated tracks begin after the release");
+  app.add_option("--camera", o.camera_target,
                  "What the generated tracks follow: silhouette (the side view's centroid, default) or body-point");
-  app.add_option("--pixel", pixel_mm, "Silhouette camera: pixel size [mm]");
-  app.add_option("--generator-library", generator_file,
+  app.add_option("--pixel", o.pixel_mm, "Silhouette camera: pixel size [mm]");
+  app.add_option("--generator-library", o.generator_file,
                  "Clump library the recordings are made with (default: clumps/tuber-default.h5, its adaptive-340: "
                  "a finer clump of the same scan than the diagnosed one; empty: --library's clump)");
-  app.add_option("--generator-clump", generator_name, "Which clump of the generator's library (a name)");
-  app.add_option("--recordings-set", recordings_set,
+  app.add_option("--generator-clump", o.generator_name, "Which clump of the generator's library (a name)");
+  app.add_option("--recordings-set", o.recordings_set,
                  "Score a recording set made elsewhere (case-NN/ folders and ANSWERS.json, e.g. "
                  "../shared/data/lab-like) instead of generating one");
-  app.add_option("--spheres", spheres,
+  app.add_option("--spheres", o.spheres,
                  "With --recordings-set: spheres of the adaptive clump each case's mesh is filled with (0: by "
                  "convergence to the scan, as diagnose does)");
-  app.add_option("--threads", threads, "Threads per process (0: the cores shared among the MPI ranks on a node)");
-  CLI11_PARSE(app, argc, argv);
-  // Under mpirun the ranks share the cases; on its own, one process.
-  auto team = Team::join({.threads_per_rank = threads});
-  if (!team) {
-    std::cerr << team.error().message << "\n";
-    return 1;
-  }
-  if (!recordings_set.empty())
-    return run_recordings_set(recordings_set, out, cli::DiagnoseJob{.spheres = spheres}, existing_only, *team);
+  app.add_option("--threads", o.threads, "Threads per process (0: the cores shared among the MPI ranks on a node)");
+}
 
-  auto clumps = read_clump_library(clump_file);
-  if (!clumps) {
-    std::cerr << clumps.error().message << "\n";
-    return 1;
+/// The clump the recordings are made with: a finer (or other) clump than the one diagnosed,
+/// as real data never comes from the diagnoser's own model; the diagnosed one when no
+/// generator library is given.
+Result<Clump> generator_clump(const BenchOptions& o) {
+  auto library = read_clump_library(o.clump_file);
+  if (!library) return std::unexpected(library.error());
+  auto diagnosed = select_clump(std::move(*library), o.clump_name, o.clump_file);
+  if (!diagnosed || o.generator_file.empty()) return diagnosed;
+  auto generator_library = read_clump_library(o.generator_file);
+  if (!generator_library) return std::unexpected(generator_library.error());
+  return select_clump(std::move(*generator_library), o.generator_name, o.generator_file);
+}
+
+/// Effect, control, effect, ...: a partial run already shows both rates.
+std::vector<Case> interleaved(const std::vector<Case>& cases) {
+  std::vector<Case> effects, controls, out;
+  for (const auto& c : cases) (c.effect ? effects : controls).push_back(c);
+  for (std::size_t i = 0; i < std::max(effects.size(), controls.size()); ++i) {
+    if (i < effects.size()) out.push_back(effects[i]);
+    if (i < controls.size()) out.push_back(controls[i]);
   }
-  auto clump = select_clump(std::move(*clumps), clump_name, clump_file);
-  if (!clump) {
-    std::cerr << clump.error().message << "\n";
-    return 1;
-  }
-  // The recordings come from a finer (or other) clump than the one diagnosed, as real data
-  // never comes from the diagnoser's own model.
-  Clump generator = *clump;
-  if (!generator_file.empty()) {
-    auto library_g = read_clump_library(generator_file);
-    auto chosen = library_g ? select_clump(std::move(*library_g), generator_name, generator_file)
-                            : Result<Clump>(std::unexpected(library_g.error()));
-    if (!chosen) {
-      std::cerr << chosen.error().message << "\n";
-      return 1;
-    }
-    generator = std::move(*chosen);
-  }
-  const MaterialTable table = default_material_table();
-  const auto library = effect_library();
-  std::vector<Case> cases;
+  return out;
+}
+
+/// The generated cases: every effect of the library (or --effects) at its realistic and
+/// strong magnitude, then the controls with varied base coefficients, interleaved.
+Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialTable& table) {
   ConcealOptions camera;
-  camera.frame_rate_hz = fps;
-  camera.noise_m = noise;
-  camera.pre_roll = !no_pre_roll;
-  if (auto ok = parse_camera(camera_target, pixel_mm, camera); !ok) {
-    std::cerr << ok.error().message << "\n";
-    return 1;
-  }
-  if (auto ok = parse_orientation_record(orientation, camera); !ok) {
-    std::cerr << ok.error().message << "\n";
-    return 1;
-  }
+  camera.frame_rate_hz = o.fps;
+  camera.noise_m = o.noise;
+  camera.pre_roll = !o.no_pre_roll;
+  if (auto ok = parse_camera(o.camera_target, o.pixel_mm, camera); !ok) return std::unexpected(ok.error());
+  if (auto ok = parse_orientation_record(o.orientation, camera); !ok) return std::unexpected(ok.error());
   auto base_options = [&](const std::string& surface, std::uint64_t case_seed) {
-    ConcealOptions o = camera;
-    o.surface = surface;
-    o.trials = trials;
-    o.seed = case_seed;
-    if (!full_set) {
-      o.drop_heights = {0.2, 1.0};
-      o.roll_starts = {0.10};
+    ConcealOptions c = camera;
+    c.surface = surface;
+    c.trials = o.trials;
+    c.seed = case_seed;
+    if (!o.full_set) {
+      c.drop_heights = {0.2, 1.0};
+      c.roll_starts = {0.10};
     }
-    return o;
+    return c;
   };
+  std::vector<Case> cases;
   std::uint64_t k = 0;
-  for (const auto& spec : library) {
-    if (!only.empty() && std::find(only.begin(), only.end(), spec.name) == only.end()) continue;
+  for (const auto& spec : effect_library()) {
+    if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), spec.name) == o.only.end()) continue;
     for (std::string magnitude : {"realistic", "strong"}) {
-      Case c;
-      c.id = fmt::format("{}-{}", spec.name, magnitude);
-      c.effect = spec.effect;
-      c.magnitude = magnitude;
-      c.options = base_options(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", seed * 1000 + ++k);
+      Case c{.id = fmt::format("{}-{}", spec.name, magnitude), .effect = spec.effect, .magnitude = magnitude};
+      c.options = base_options(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", o.seed * 1000 + ++k);
       c.options.effect = spec.effect;
       for (const auto& p : spec.parameters)
         c.options.values.push_back(magnitude == "realistic" ? p.realistic : p.strong);
       cases.push_back(std::move(c));
     }
   }
-  for (int i = 0; i < controls; ++i) {
-    Case c;
-    c.id = fmt::format("control-{:02d}", i + 1);
-    c.magnitude = "control";
+  for (int i = 0; i < o.controls; ++i) {
     const std::string surface = i % 2 == 0 ? "Q235" : "soil";
-    c.options = base_options(surface, seed * 1000 + 500 + static_cast<std::uint64_t>(i));
-    Rng rng(seed, 9000 + static_cast<std::uint64_t>(i));
+    Case c{.id = fmt::format("control-{:02d}", i + 1), .magnitude = "control"};
+    c.options = base_options(surface, o.seed * 1000 + 500 + static_cast<std::uint64_t>(i));
+    Rng rng(o.seed, 9000 + static_cast<std::uint64_t>(i));
     Interaction base = *table.interaction("tuber", surface);
     base.restitution = std::min(0.95, base.restitution * rng.uniform(0.85, 1.1));
     base.static_friction *= rng.uniform(0.85, 1.15);
@@ -497,54 +490,40 @@ int main(int argc, char** argv) {
     c.options.base = base;
     cases.push_back(std::move(c));
   }
+  return interleaved(cases);
+}
 
-  // Interleaved (effect, control, effect, ...): a partial run already shows both rates.
-  {
-    std::vector<Case> effects_first(cases.begin(), cases.end());
-    std::vector<Case> interleaved;
-    std::size_t e = 0, c = 0;
-    const auto first_control =
-        std::find_if(effects_first.begin(), effects_first.end(), [](const Case& x) { return !x.effect; });
-    const std::size_t n_effects = static_cast<std::size_t>(first_control - effects_first.begin());
-    while (e < n_effects || c < effects_first.size() - n_effects) {
-      if (e < n_effects) interleaved.push_back(effects_first[e++]);
-      if (c < effects_first.size() - n_effects) interleaved.push_back(effects_first[n_effects + c++]);
-    }
-    cases = std::move(interleaved);
+/// One generated case: its recordings and answer written into `dir` (unless stored there
+/// already), then diagnosed blind
+/// (the diagnosis sees the recordings directory and the clump, nothing else).
+bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTable& table, const BenchOptions& o) {
+  const fs::path dir = fs::path(o.out) / c.id;
+  const cli::DiagnoseJob job{
+      .recordings = {(dir / "recordings").string()}, .library = o.clump_file, .clump_name = o.clump_name};
+  // Recordings already made (their answer is written last) are diagnosed as they are: delete a
+  // run's reports to diagnose its recordings again with another build.
+  if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
+    return diagnose_case(c.id, job, dir / "report.json");
+  auto made = make_concealed_recordings(generator, table, c.options);
+  if (!made) {
+    std::cerr << c.id << ": " << made.error().message << "\n";
+    return false;
   }
-  fs::create_directories(out);
-  std::vector<CaseScore> outcomes;
-  std::vector<std::string> ids;
-  for (const auto& c : cases) ids.push_back(c.id);
-  auto make_and_diagnose = [&](std::size_t i) {
-    const Case& c = cases[i];
-    const fs::path dir = fs::path(out) / c.id;
-    auto made = make_concealed_recordings(generator, table, c.options);
-    if (!made) {
-      std::cerr << c.id << ": " << made.error().message << "\n";
+  fs::remove_all(dir);
+  for (std::size_t r = 0; r < made->recordings.size(); ++r) {
+    if (auto ok = write_recording(dir / "recordings" / made->names[r], made->recordings[r]); !ok) {
+      std::cerr << ok.error().message << "\n";
       return false;
     }
-    fs::remove_all(dir);
-    for (std::size_t r = 0; r < made->recordings.size(); ++r) {
-      if (auto ok = write_recording(dir / "recordings" / made->names[r], made->recordings[r]); !ok) {
-        std::cerr << ok.error().message << "\n";
-        return false;
-      }
-    }
-    std::ofstream(dir / "answer.json") << answer_json(c.options, *made);
-    // Blind: the diagnosis sees the recordings directory and the clump, nothing else.
-    return diagnose_case(
-        c.id,
-        cli::DiagnoseJob{
-            .recordings = {(dir / "recordings").string()}, .library = clump_file, .clump_name = clump_name},
-        dir / "report.json");
-  };
-  const bool ran = existing_only ||
-                   run_missing(
-                       *team, ids, [&](std::size_t i) { return !fs::exists(fs::path(out) / ids[i] / "report.json"); },
-                       make_and_diagnose);
-  if (!team->leader()) return ran ? 0 : 1;
-  if (!ran) return 1;
+  }
+  std::ofstream(dir / "answer.json") << answer_json(c.options, *made);
+  return diagnose_case(c.id, job, dir / "report.json");
+}
+
+/// The leader's score of the cases diagnosed in --out: a line per case, then the summary.
+int score_generated(const std::vector<Case>& cases, const std::string& out) {
+  const auto library = effect_library();
+  std::vector<CaseScore> outcomes;
   for (const auto& c : cases) {
     const fs::path report = fs::path(out) / c.id / "report.json";
     const std::string truth = c.effect ? effect_spec(library, *c.effect).name : "none";
@@ -559,7 +538,40 @@ int main(int argc, char** argv) {
               << std::flush;
     outcomes.push_back(*o);
   }
-
   write_generated_summary(outcomes, library, out);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Blind benchmark of clumpforge diagnose on concealed-effect recordings"};
+  BenchOptions o;
+  add_options(app, o);
+  CLI11_PARSE(app, argc, argv);
+  // Under mpirun the ranks share the cases; on its own, one process.
+  auto team = Team::join({.threads_per_rank = o.threads});
+  if (!team) {
+    std::cerr << team.error().message << "\n";
+    return 1;
+  }
+  if (!o.recordings_set.empty())
+    return run_recordings_set(o.recordings_set, o.out, cli::DiagnoseJob{.spheres = o.spheres}, o.existing_only, *team);
+  const MaterialTable table = default_material_table();
+  auto generator = generator_clump(o);
+  auto cases = generator ? generated_cases(o, table) : Result<std::vector<Case>>(std::unexpected(generator.error()));
+  if (!cases) {
+    std::cerr << cases.error().message << "\n";
+    return 1;
+  }
+  fs::create_directories(o.out);
+  std::vector<std::string> ids;
+  for (const auto& c : *cases) ids.push_back(c.id);
+  const bool ran = o.existing_only ||
+                   run_missing(
+                       *team, ids, [&](std::size_t i) { return !fs::exists(fs::path(o.out) / ids[i] / "report.json"); },
+                       [&](std::size_t i) { return make_and_diagnose((*cases)[i], *generator, table, o); });
+  if (!team->leader()) return ran ? 0 : 1;
+  if (!ran) return 1;
+  return score_generated(*cases, o.out);
 }

@@ -285,7 +285,9 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                                {"worsened_phases", h.worsened_phases},
                                {"passes", h.passes},
                                {"evaluations", h.evaluations},
-                               {"smallest_detectable", finite_or_null(h.smallest_detectable)}});
+                               {"smallest_detectable", finite_or_null(h.smallest_detectable)},
+                               {"strong_delta_chi2", finite_or_null(h.strong_delta_chi2)},
+                               {"strong_resolution_chi2", finite_or_null(h.strong_resolution_chi2)}});
   }
   auto phases_of = [](const std::vector<PhaseOf>& list) {
     nlohmann::json out = nlohmann::json::array();

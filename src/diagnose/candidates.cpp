@@ -1,3 +1,6 @@
+#include <array>
+#include <cstdio>
+#include <map>
 /// The candidates frame by frame: each effect fitted on the training trials, then on every trial
 /// against the second null; the detection limits; the particle-model check; the plotted tracks.
 
@@ -253,41 +256,103 @@ double largest_signal_misfit(const Context& c, const std::vector<std::pair<Group
   return largest;
 }
 
+/// How many times the move to the next finer clump a strong effect's rejection must exceed
+/// (besides the delta-BIC margin) to count: the diagnosed clump's distance from the recorded
+/// body is larger than its distance from the next rung, so this is an allowance, not a bound.
+constexpr double kResolutionAllowance = 2.0;
+
+/// The training trials' cells (residuals) under one model, and how many belong to each trial.
+struct TrialCells {
+  Eigen::VectorXd values;
+  std::vector<std::size_t> extent;
+};
+
+/// The recordings' rejection of a strong effect (chi^2 with it minus the null's, the part the
+/// coefficients could absorb projected out) with each trial released at the orientation, of
+/// those tried, that favours the effect most (the least chi^2 with it against the null's
+/// there): the release is a nuisance, and a rejection must hold at the release the trial may
+/// have had. Entry 0 of `probes` and `bases` is the release the diagnosis replays; an entry
+/// whose trial has other extents is not used for that trial.
+double rejection_over_releases(const Eigen::MatrixXd& keep, const std::vector<TrialCells>& probes,
+                               const std::vector<TrialCells>& bases) {
+  const TrialCells& own = bases.front();
+  const std::size_t trials = own.extent.size();
+  Eigen::VectorXd probe(own.values.size()), base(own.values.size());
+  Eigen::Index at = 0;
+  std::vector<Eigen::Index> at_probe(probes.size(), 0), at_base(bases.size(), 0);
+  auto aligned = [&](std::size_t k) {
+    return k < bases.size() && probes[k].extent.size() == trials && bases[k].extent.size() == trials;
+  };
+  for (std::size_t j = 0; j < trials; ++j) {
+    const std::size_t n = own.extent[j];
+    const auto len = static_cast<Eigen::Index>(n);
+    std::optional<std::size_t> best;
+    double least = kNever;
+    for (std::size_t k = 0; k < probes.size(); ++k) {
+      if (!aligned(k) || probes[k].extent[j] != n || bases[k].extent[j] != n) continue;
+      const double d = probes[k].values.segment(at_probe[k], len).squaredNorm() -
+                       bases[k].values.segment(at_base[k], len).squaredNorm();
+      if (d < least) {
+        least = d;
+        best = k;
+      }
+    }
+    if (!best) return NAN;  // no release replays this trial's cells as the diagnosis does
+    probe.segment(at, len) = probes[*best].values.segment(at_probe[*best], len);
+    base.segment(at, len) = bases[*best].values.segment(at_base[*best], len);
+    for (std::size_t k = 0; k < probes.size(); ++k) {
+      if (!aligned(k)) continue;
+      at_probe[k] += static_cast<Eigen::Index>(probes[k].extent[j]);
+      at_base[k] += static_cast<Eigen::Index>(bases[k].extent[j]);
+    }
+    at += len;
+  }
+  return (keep * probe).squaredNorm() - (keep * base).squaredNorm();
+}
+
 }  // namespace
 
-/// For a `none`: the smallest effect of each candidate the data could have shown (its
-/// signal at a fifth of its realistic magnitude, the part the coefficients could absorb
-/// projected out, scaled quadratically to the delta-BIC margin and to a large misfit in one
-/// phase, whichever needs more; a lower bound), in each
-/// hypothesis report; returns the statements and the candidates not testable even at
-/// their strong magnitude.
+/// For a `none`: each candidate replayed at its strong magnitude. Its signal there (its
+/// replays minus the baseline's, the part the coefficients could absorb projected out) gives
+/// the smallest effect the data could have shown, scaled quadratically down (or up) to the
+/// delta-BIC margin and to a large misfit in one phase, whichever needs more (first order, in
+/// each hypothesis report). An effect counts as decided (absent) only when it would show and
+/// the recordings themselves reject its strong magnitude by the margin: with each trial
+/// released at the most favourable of the orientations its prior allows that were tried
+/// (rejection_over_releases), with the coefficients refitted at the strong magnitude, and by
+/// more than twice how far the next finer clump's response to it lies from the diagnosed
+/// clump's. A first-order signal alone is not a test: the diagnosed clump responds to an
+/// effect as it does, not as the recorded body does, and an effect that makes the path hang
+/// on the unknown release cannot be judged by one replay. Returns the statements and the
+/// candidates not decided.
 Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_limits(Context& c,
                                                                                        DiagnoseResult& result,
                                                                                        const Model& baseline,
                                                                                        const std::vector<Fitted>& fits,
                                                                                        const DiagnoseOptions& options) {
   const auto library = effect_library();
-  // The smallest effect the data could have shown: an effect's signal (its replays minus
-  // the baseline's at a fifth of its realistic magnitude) with the part the coefficients
-  // could absorb projected out (their own finite-difference directions), scaled
-  // quadratically to the delta-BIC margin.
   // The baseline's cells' groups (recording, phase) and axes, for the large-misfit rule.
   std::vector<std::pair<GroupKey, Axis>> keys;
-  auto cells = [&](const Model& m) -> Result<Eigen::VectorXd> {
+  auto cells = [&](const Model& m, const Evaluator* ev = nullptr) -> Result<TrialCells> {
     // Cells' phases only once, with the baseline (the probes' cells are the same cells).
-    auto scores = evaluate(c.ev, m, c.training, false, keys.empty() ? Residuals::ValuesAndCells : Residuals::Values);
+    auto scores =
+        evaluate(ev ? *ev : c.ev, m, c.training, false, keys.empty() ? Residuals::ValuesAndCells : Residuals::Values);
     c.evaluations += static_cast<int>(c.training.size());
     if (!scores) return std::unexpected(scores.error());
     std::vector<double> all_cells;
+    TrialCells out;
     for (std::size_t k = 0; k < scores->size(); ++k) {
       const TrialScore& sc = (*scores)[k];
       all_cells.insert(all_cells.end(), sc.residuals.begin(), sc.residuals.end());
+      out.extent.push_back(sc.residuals.size());
       for (const auto& [phase, axis] : sc.cells) keys.push_back({{c.ev.trials[c.training[k]].recording, phase}, axis});
     }
-    return Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));
+    out.values = Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));
+    return out;
   };
-  auto base_cells = cells(baseline);
-  if (!base_cells) return std::unexpected(base_cells.error());
+  auto base = cells(baseline);
+  if (!base) return std::unexpected(base.error());
+  const Eigen::VectorXd& base_cells = base->values;
   std::vector<Eigen::VectorXd> directions;
   for (std::size_t b = 0; b < baseline.base.size(); ++b) {
     for (Coefficient k : {Coefficient::Restitution, Coefficient::StaticFriction, Coefficient::RollingFriction}) {
@@ -296,27 +361,43 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
       v = k == Coefficient::RollingFriction && v < 1e-3 ? v + 1e-5 : v * 1.002;
       auto moved_cells = cells(moved);
       if (!moved_cells) return std::unexpected(moved_cells.error());
-      if (moved_cells->size() == base_cells->size()) directions.push_back(*moved_cells - *base_cells);
+      if (moved_cells->values.size() == base_cells.size()) directions.push_back(moved_cells->values - base_cells);
     }
   }
-  Eigen::MatrixXd absorb(base_cells->size(), static_cast<Eigen::Index>(directions.size()));
+  Eigen::MatrixXd absorb(base_cells.size(), static_cast<Eigen::Index>(directions.size()));
   for (std::size_t k = 0; k < directions.size(); ++k) absorb.col(static_cast<Eigen::Index>(k)) = directions[k];
   const Eigen::MatrixXd keep = residual_projection(absorb, absorb.rows());
+  // The same trials released at the other orientations their priors allow, and the
+  // baseline's cells there (when first asked).
+  std::vector<Evaluator> releases;
+  for (std::size_t k = 0; k < kAlternativeReleases; ++k) {
+    Evaluator released = c.ev;
+    for (auto& t : released.trials) {
+      if (!t.alternatives.empty()) t.orientation = t.alternatives[k % t.alternatives.size()];
+    }
+    releases.push_back(std::move(released));
+  }
+  std::vector<TrialCells> bases{*base};
+  std::optional<Eigen::VectorXd> fine_base;  // the baseline's cells with the next finer clump, when asked
   std::vector<std::string> limits, untestable;
   for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
     auto& report = result.hypotheses[h];
     const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
     Model probe = baseline;
     probe.effect = spec.effect;
-    for (const auto& p : spec.parameters) probe.values.push_back(p.log_scale ? p.realistic : 0.2 * p.realistic);
-    auto probe_cells = cells(probe);
-    if (!probe_cells) return std::unexpected(probe_cells.error());
+    for (const auto& p : spec.parameters) probe.values.push_back(p.strong);
+    auto probed = cells(probe);
+    if (!probed) return std::unexpected(probed.error());
+    const Eigen::VectorXd& probe_cells = probed->values;
     double signal = 0.0, misfit = 0.0;
-    if (probe_cells->size() == base_cells->size()) {
-      const Eigen::VectorXd d = *base_cells - *probe_cells;
-      const Eigen::VectorXd kept = keep * d;
+    report.strong_delta_chi2 = NAN;
+    if (probe_cells.size() == base_cells.size()) {
+      const Eigen::VectorXd kept = keep * (base_cells - probe_cells);
       signal = kept.squaredNorm();
       misfit = largest_signal_misfit(c, keys, kept);
+      // The recordings' own answer (cells are residuals): chi^2 at the strong magnitude minus
+      // the null's, each after the coefficients absorb what they can.
+      report.strong_delta_chi2 = (keep * probe_cells).squaredNorm() - (keep * base_cells).squaredNorm();
     }
     const double needed =
         options.min_delta_bic + static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
@@ -324,24 +405,66 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
     // kLargeMisfit, of which the noise gives one.
     const double needed_misfit = kLargeMisfit - 1.0;
     const auto& first = spec.parameters[0];
+    const bool shows = signal >= needed && misfit >= needed_misfit;
     if (first.log_scale) {
-      const bool shows = signal >= needed && misfit >= needed_misfit;
-      report.smallest_detectable = shows ? first.realistic : NAN;
-      limits.push_back(shows ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.realistic)
-                             : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.realistic));
+      report.smallest_detectable = shows ? first.strong : NAN;
+      limits.push_back(shows ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.strong)
+                             : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.strong));
     } else {
       const double null_value = effect_off(spec)[0];
-      const double probed = 0.2 * first.realistic;
       // Both grow as the magnitude's square while the response is linear.
       const double scale = std::max(std::sqrt(needed / signal), std::sqrt(needed_misfit / misfit));
-      report.smallest_detectable = signal > 0.0 && misfit > 0.0 ? null_value + (probed - null_value) * scale : kNever;
+      report.smallest_detectable =
+          signal > 0.0 && misfit > 0.0 ? null_value + (first.strong - null_value) * scale : kNever;
       limits.push_back(fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable));
     }
-    // Beyond its strong magnitude (or never): the predictable parts of these tracks cannot
-    // decide it; said, not counted as absent.
-    const bool testable = first.log_scale
-                              ? std::isfinite(report.smallest_detectable)
-                              : std::isfinite(report.smallest_detectable) && report.smallest_detectable <= first.strong;
+    // Decided only where it would show at its strong magnitude and the recordings reject that
+    // magnitude, asked each way in turn (the cheapest first); otherwise said, not counted as
+    // absent.
+    bool testable = shows && report.strong_delta_chi2 >= needed;
+    if (testable) {
+      // At each trial's most favourable release of those tried.
+      std::vector<TrialCells> probes{*probed};
+      for (std::size_t k = 0; k < releases.size(); ++k) {
+        if (bases.size() <= k + 1) {
+          auto released = cells(baseline, &releases[k]);
+          if (!released) return std::unexpected(released.error());
+          bases.push_back(std::move(*released));
+        }
+        auto released = cells(probe, &releases[k]);
+        if (!released) return std::unexpected(released.error());
+        probes.push_back(std::move(*released));
+      }
+      const double released = rejection_over_releases(keep, probes, bases);
+      report.strong_delta_chi2 = std::isfinite(released) ? std::min(report.strong_delta_chi2, released) : NAN;
+      testable = report.strong_delta_chi2 >= needed;
+    }
+    if (testable) {
+      // With the coefficients refitted at the strong magnitude (they may have absorbed the
+      // effect farther than a first order undoes).
+      auto profile = refit(c, probe, nullptr, c.training, options.max_evaluations);
+      if (!profile) return std::unexpected(profile.error());
+      report.strong_delta_chi2 = std::min(report.strong_delta_chi2, profile->chi2 - base_cells.squaredNorm());
+      testable = report.strong_delta_chi2 >= needed;
+    }
+    if (testable && !c.finer.empty()) {
+      // Is the diagnosed clump's response to the effect converged? The next finer clump's (its
+      // probe minus its own baseline) against it; a rejection within twice that move may be the
+      // clump's, not the recordings'.
+      const ClumpSwap swap(c, c.finer.front());
+      if (!fine_base) {
+        auto cells_fine = cells(baseline);
+        if (!cells_fine) return std::unexpected(cells_fine.error());
+        fine_base = std::move(cells_fine->values);
+      }
+      auto fine_probe = cells(probe);
+      if (!fine_probe) return std::unexpected(fine_probe.error());
+      report.strong_resolution_chi2 =
+          fine_probe->values.size() == probe_cells.size() && fine_base->size() == base_cells.size()
+              ? (keep * ((fine_probe->values - *fine_base) - (probe_cells - base_cells))).squaredNorm()
+              : kNever;
+      testable = report.strong_delta_chi2 >= needed + kResolutionAllowance * report.strong_resolution_chi2;
+    }
     if (!testable) untestable.push_back(spec.name);
   }
   return std::pair{std::move(limits), std::move(untestable)};

@@ -140,6 +140,16 @@ struct HypothesisReport {
       worsened_phases;  ///< flagged phases it makes worse (training trials), with chi^2 per value before -> after
   int evaluations = 0;
   double smallest_detectable = 0.0;  ///< of its first parameter (reported with verdict "none")
+  /// With verdict "none": the recordings' chi^2 with the effect at its strong magnitude minus
+  /// the null's, the coefficients absorbing what they can (first order, then refitted) and each
+  /// trial released at the most favourable orientation tried; the effect is decided absent only
+  /// when this reaches the delta-BIC margin (and the resolution allowance). NaN when not probed.
+  double strong_delta_chi2 = NAN;
+  /// With verdict "none", for an effect the recordings reject: how far (chi^2, as above) the
+  /// next finer clump's response to the effect at its strong magnitude lies from the diagnosed
+  /// clump's. The rejection must also exceed twice this (it may be the clump's). NaN when not
+  /// asked (no finer clump, or not rejected).
+  double strong_resolution_chi2 = NAN;
 };
 
 struct FitQuality {

@@ -75,6 +75,8 @@ Result<std::vector<std::string>> settle_release_state(Context& c, const Model& m
       const double horizon = release_horizon(replays, 0.5 * c.ev.sigma[r]);
       for (std::size_t i : members) {
         c.ev.trials[i].orientation = candidates.front();
+        c.ev.trials[i].alternatives.assign(candidates.begin() + 1,
+                                           candidates.begin() + std::min(candidates.size(), kAlternativeReleases + 1));
         c.ev.trials[i].release_horizon = horizon;
       }
       horizons.push_back(horizon);

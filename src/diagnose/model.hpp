@@ -16,15 +16,22 @@
 
 namespace clumpforge {
 
+/// How many other release orientations a trial keeps (TrackedTrial::alternatives).
+inline constexpr std::size_t kAlternativeReleases = 4;
+
 struct TrackedTrial {
   std::size_t recording = 0, trial = 0;  ///< indices into the recordings
   Eigen::Quaterniond orientation =
       Eigen::Quaterniond::Identity();  ///< release orientation replayed (one the prior allows)
-  OriginFit origins;                   ///< camera-frame origins fitted besides the time origin
-  bool training = true;                ///< false: held out of every fit
-  double shift_guess = 0.0;            ///< [s] from the data alone
-  double duration = 0.0;               ///< [s] replayed after release
-  double record_from = 0.0;            ///< [s] first replay time the camera saw (tilt)
+  /// Other release orientations the prior allows (the next ones drawn, up to
+  /// kAlternativeReleases): a strong effect is only called absent when the recordings reject it
+  /// at each trial's most favourable one (detection_limits).
+  std::vector<Eigen::Quaterniond> alternatives;
+  OriginFit origins;         ///< camera-frame origins fitted besides the time origin
+  bool training = true;      ///< false: held out of every fit
+  double shift_guess = 0.0;  ///< [s] from the data alone
+  double duration = 0.0;     ///< [s] replayed after release
+  double record_from = 0.0;  ///< [s] first replay time the camera saw (tilt)
   /// [s] replay time up to which the trajectory is predictable: replays from release
   /// orientations 0.1 mrad apart stay within the noise level until then. An irregular
   /// body's later bounces and tumbles depend on its release state beyond what any lab

@@ -152,8 +152,8 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
     // horizon of an irregular body (its contacts) need more than these tracks.
     result.undecidable = untestable;
     result.statement += fmt::format(
-        " Not decidable from the predictable parts of these tracks (even at their strong magnitude): {}; they act "
-        "where the unknown release orientation decides the path.",
+        " Not decided by the predictable parts of these tracks: {} (at its strong magnitude each would not show, "
+        "or the recordings do not reject it); they act where the unknown release orientation decides the path.",
         fmt::join(untestable, ", "));
     result.experiment =
         "record each trial's release orientation to a few degrees (a marked particle, a release jig), or repeat the "
