@@ -261,6 +261,9 @@ double largest_signal_misfit(const Context& c, const std::vector<std::pair<Group
 /// body is larger than its distance from the next rung, so this is an allowance, not a bound.
 constexpr double kResolutionAllowance = 2.0;
 
+/// The fit budget of the refit at a strong magnitude (refit: a fifth of it are iterations).
+constexpr int kProfileEvaluations = 10;
+
 /// The training trials' cells (residuals) under one model, and how many belong to each trial.
 struct TrialCells {
   Eigen::VectorXd values;
@@ -310,6 +313,94 @@ double rejection_over_releases(const Eigen::MatrixXd& keep, const std::vector<Tr
   return (keep * probe).squaredNorm() - (keep * base).squaredNorm();
 }
 
+/// The training trials' cells under a model, as detection_limits asks for them; the first
+/// call (the baseline) also records each cell's group and axis in `keys`.
+class CellProbe {
+ public:
+  explicit CellProbe(Context& c) : c_(c) {}
+  Result<TrialCells> operator()(const Model& m, const Evaluator* ev = nullptr) {
+    auto scores =
+        evaluate(ev ? *ev : c_.ev, m, c_.training, false, keys.empty() ? Residuals::ValuesAndCells : Residuals::Values);
+    c_.evaluations += static_cast<int>(c_.training.size());
+    if (!scores) return std::unexpected(scores.error());
+    std::vector<double> all_cells;
+    TrialCells out;
+    for (std::size_t k = 0; k < scores->size(); ++k) {
+      const TrialScore& sc = (*scores)[k];
+      all_cells.insert(all_cells.end(), sc.residuals.begin(), sc.residuals.end());
+      out.extent.push_back(sc.residuals.size());
+      for (const auto& [phase, axis] : sc.cells)
+        keys.push_back({{c_.ev.trials[c_.training[k]].recording, phase}, axis});
+    }
+    out.values = Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));
+    return out;
+  }
+  std::vector<std::pair<GroupKey, Axis>> keys;  ///< the baseline's cells' groups and axes
+
+ private:
+  Context& c_;
+};
+
+/// What detection_limits shares among the candidates it asks about: the projection that takes
+/// off what the coefficients absorb, the trials released at the other orientations their
+/// priors allow, and the baseline's cells at each release and with the next finer clump
+/// (computed when first asked).
+struct AbsenceCheck {
+  Eigen::MatrixXd keep;
+  std::vector<Evaluator> releases;
+  std::vector<TrialCells> bases;  ///< [0] the baseline as replayed, then at each release
+  std::optional<Eigen::VectorXd> fine_base;
+};
+
+/// Whether the recordings reject `probe` (an effect at its strong magnitude, `probed` its
+/// cells) by `needed`, asked each way in turn, the cheapest first: to first order (already in
+/// report.strong_delta_chi2), at each trial's most favourable release of those tried, with the
+/// coefficients refitted, and beyond twice the next finer clump's move
+/// (report.strong_resolution_chi2). report.strong_delta_chi2 keeps the least rejection found.
+Result<bool> rejected(Context& c, CellProbe& cells, AbsenceCheck& check, const Model& baseline, const Model& probe,
+                      const TrialCells& probed, double needed, HypothesisReport& report) {
+  if (!(report.strong_delta_chi2 >= needed)) return false;
+  std::vector<TrialCells> probes{probed};
+  for (std::size_t k = 0; k < check.releases.size(); ++k) {
+    if (check.bases.size() <= k + 1) {
+      auto released = cells(baseline, &check.releases[k]);
+      if (!released) return std::unexpected(released.error());
+      check.bases.push_back(std::move(*released));
+    }
+    auto released = cells(probe, &check.releases[k]);
+    if (!released) return std::unexpected(released.error());
+    probes.push_back(std::move(*released));
+  }
+  const double released = rejection_over_releases(check.keep, probes, check.bases);
+  report.strong_delta_chi2 = std::isfinite(released) ? std::min(report.strong_delta_chi2, released) : NAN;
+  if (!(report.strong_delta_chi2 >= needed)) return false;
+  // With the coefficients refitted at the strong magnitude (they may have absorbed the effect
+  // farther than a first order undoes): two Levenberg-Marquardt iterations from the null's
+  // coefficients, past the first-order step already taken.
+  const Eigen::VectorXd& base_cells = check.bases.front().values;
+  auto profile = refit(c, probe, nullptr, c.training, kProfileEvaluations);
+  if (!profile) return std::unexpected(profile.error());
+  report.strong_delta_chi2 = std::min(report.strong_delta_chi2, profile->chi2 - base_cells.squaredNorm());
+  if (!(report.strong_delta_chi2 >= needed)) return false;
+  if (c.finer.empty()) return true;
+  // Is the diagnosed clump's response to the effect converged? The next finer clump's (its
+  // probe minus its own baseline) against it; a rejection within twice that move may be the
+  // clump's, not the recordings'.
+  const ClumpSwap swap(c, c.finer.front());
+  if (!check.fine_base) {
+    auto cells_fine = cells(baseline);
+    if (!cells_fine) return std::unexpected(cells_fine.error());
+    check.fine_base = std::move(cells_fine->values);
+  }
+  auto fine_probe = cells(probe);
+  if (!fine_probe) return std::unexpected(fine_probe.error());
+  report.strong_resolution_chi2 =
+      fine_probe->values.size() == probed.values.size() && check.fine_base->size() == base_cells.size()
+          ? (check.keep * ((fine_probe->values - *check.fine_base) - (probed.values - base_cells))).squaredNorm()
+          : kNever;
+  return report.strong_delta_chi2 >= needed + kResolutionAllowance * report.strong_resolution_chi2;
+}
+
 }  // namespace
 
 /// For a `none`: each candidate replayed at its strong magnitude. Its signal there (its
@@ -331,25 +422,7 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
                                                                                        const std::vector<Fitted>& fits,
                                                                                        const DiagnoseOptions& options) {
   const auto library = effect_library();
-  // The baseline's cells' groups (recording, phase) and axes, for the large-misfit rule.
-  std::vector<std::pair<GroupKey, Axis>> keys;
-  auto cells = [&](const Model& m, const Evaluator* ev = nullptr) -> Result<TrialCells> {
-    // Cells' phases only once, with the baseline (the probes' cells are the same cells).
-    auto scores =
-        evaluate(ev ? *ev : c.ev, m, c.training, false, keys.empty() ? Residuals::ValuesAndCells : Residuals::Values);
-    c.evaluations += static_cast<int>(c.training.size());
-    if (!scores) return std::unexpected(scores.error());
-    std::vector<double> all_cells;
-    TrialCells out;
-    for (std::size_t k = 0; k < scores->size(); ++k) {
-      const TrialScore& sc = (*scores)[k];
-      all_cells.insert(all_cells.end(), sc.residuals.begin(), sc.residuals.end());
-      out.extent.push_back(sc.residuals.size());
-      for (const auto& [phase, axis] : sc.cells) keys.push_back({{c.ev.trials[c.training[k]].recording, phase}, axis});
-    }
-    out.values = Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));
-    return out;
-  };
+  CellProbe cells(c);
   auto base = cells(baseline);
   if (!base) return std::unexpected(base.error());
   const Eigen::VectorXd& base_cells = base->values;
@@ -366,19 +439,15 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
   }
   Eigen::MatrixXd absorb(base_cells.size(), static_cast<Eigen::Index>(directions.size()));
   for (std::size_t k = 0; k < directions.size(); ++k) absorb.col(static_cast<Eigen::Index>(k)) = directions[k];
-  const Eigen::MatrixXd keep = residual_projection(absorb, absorb.rows());
-  // The same trials released at the other orientations their priors allow, and the
-  // baseline's cells there (when first asked).
-  std::vector<Evaluator> releases;
+  AbsenceCheck check{.keep = residual_projection(absorb, absorb.rows()), .bases = {*base}};
+  const Eigen::MatrixXd& keep = check.keep;
   for (std::size_t k = 0; k < kAlternativeReleases; ++k) {
     Evaluator released = c.ev;
     for (auto& t : released.trials) {
       if (!t.alternatives.empty()) t.orientation = t.alternatives[k % t.alternatives.size()];
     }
-    releases.push_back(std::move(released));
+    check.releases.push_back(std::move(released));
   }
-  std::vector<TrialCells> bases{*base};
-  std::optional<Eigen::VectorXd> fine_base;  // the baseline's cells with the next finer clump, when asked
   std::vector<std::string> limits, untestable;
   for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
     auto& report = result.hypotheses[h];
@@ -394,7 +463,7 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
     if (probe_cells.size() == base_cells.size()) {
       const Eigen::VectorXd kept = keep * (base_cells - probe_cells);
       signal = kept.squaredNorm();
-      misfit = largest_signal_misfit(c, keys, kept);
+      misfit = largest_signal_misfit(c, cells.keys, kept);
       // The recordings' own answer (cells are residuals): chi^2 at the strong magnitude minus
       // the null's, each after the coefficients absorb what they can.
       report.strong_delta_chi2 = (keep * probe_cells).squaredNorm() - (keep * base_cells).squaredNorm();
@@ -419,52 +488,10 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
       limits.push_back(fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable));
     }
     // Decided only where it would show at its strong magnitude and the recordings reject that
-    // magnitude, asked each way in turn (the cheapest first); otherwise said, not counted as
-    // absent.
-    bool testable = shows && report.strong_delta_chi2 >= needed;
-    if (testable) {
-      // At each trial's most favourable release of those tried.
-      std::vector<TrialCells> probes{*probed};
-      for (std::size_t k = 0; k < releases.size(); ++k) {
-        if (bases.size() <= k + 1) {
-          auto released = cells(baseline, &releases[k]);
-          if (!released) return std::unexpected(released.error());
-          bases.push_back(std::move(*released));
-        }
-        auto released = cells(probe, &releases[k]);
-        if (!released) return std::unexpected(released.error());
-        probes.push_back(std::move(*released));
-      }
-      const double released = rejection_over_releases(keep, probes, bases);
-      report.strong_delta_chi2 = std::isfinite(released) ? std::min(report.strong_delta_chi2, released) : NAN;
-      testable = report.strong_delta_chi2 >= needed;
-    }
-    if (testable) {
-      // With the coefficients refitted at the strong magnitude (they may have absorbed the
-      // effect farther than a first order undoes).
-      auto profile = refit(c, probe, nullptr, c.training, options.max_evaluations);
-      if (!profile) return std::unexpected(profile.error());
-      report.strong_delta_chi2 = std::min(report.strong_delta_chi2, profile->chi2 - base_cells.squaredNorm());
-      testable = report.strong_delta_chi2 >= needed;
-    }
-    if (testable && !c.finer.empty()) {
-      // Is the diagnosed clump's response to the effect converged? The next finer clump's (its
-      // probe minus its own baseline) against it; a rejection within twice that move may be the
-      // clump's, not the recordings'.
-      const ClumpSwap swap(c, c.finer.front());
-      if (!fine_base) {
-        auto cells_fine = cells(baseline);
-        if (!cells_fine) return std::unexpected(cells_fine.error());
-        fine_base = std::move(cells_fine->values);
-      }
-      auto fine_probe = cells(probe);
-      if (!fine_probe) return std::unexpected(fine_probe.error());
-      report.strong_resolution_chi2 =
-          fine_probe->values.size() == probe_cells.size() && fine_base->size() == base_cells.size()
-              ? (keep * ((fine_probe->values - *fine_base) - (probe_cells - base_cells))).squaredNorm()
-              : kNever;
-      testable = report.strong_delta_chi2 >= needed + kResolutionAllowance * report.strong_resolution_chi2;
-    }
+    // magnitude; otherwise said, not counted as absent.
+    auto absent = shows ? rejected(c, cells, check, baseline, probe, *probed, needed, report) : Result<bool>(false);
+    if (!absent) return std::unexpected(absent.error());
+    const bool testable = *absent;
     if (!testable) untestable.push_back(spec.name);
   }
   return std::pair{std::move(limits), std::move(untestable)};
