@@ -423,7 +423,8 @@ void add_options(CLI::App& app, BenchOptions& o) {
 
 /// The clump the recordings are made with: a finer (or other) clump than the one diagnosed,
 /// as real data never comes from the diagnoser's own model; the diagnosed one when no
-/// generator library is given.
+/// generator library is given. The diagnosed clump is read first, so a wrong --library or
+/// --clump fails before any case is made.
 Result<Clump> generator_clump(const BenchOptions& o) {
   auto library = read_clump_library(o.clump_file);
   if (!library) return std::unexpected(library.error());

@@ -174,10 +174,10 @@ ResponseSignal response_signal(const Eigen::VectorXd& response, const Eigen::Vec
                                const Eigen::VectorXd& inverse_se, const Eigen::MatrixXd& jacobian) {
   const Eigen::Index n = response.size();
   const Eigen::VectorXd weighted = inverse_se.cwiseProduct(response);
-  const Eigen::MatrixXd keep = residual_projection(inverse_se.asDiagonal() * jacobian, n);
+  const ResidualProjection keep(inverse_se.asDiagonal() * jacobian);
   ResponseSignal out;
-  out.raw = (keep * weighted).squaredNorm();
-  for (Eigen::Index j = 0; j < n; ++j) out.noise += inverse_se(j) * inverse_se(j) * variance(j) * keep(j, j);
+  out.raw = keep(weighted).squaredNorm();
+  for (Eigen::Index j = 0; j < n; ++j) out.noise += inverse_se(j) * inverse_se(j) * variance(j) * keep.diagonal(j);
   return out;
 }
 

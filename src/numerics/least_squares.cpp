@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 namespace clumpforge {
@@ -92,10 +93,19 @@ Result<LeastSquaresResult> levenberg_marquardt(const ResidualFunction& residuals
   return out;
 }
 
-Eigen::MatrixXd residual_projection(const Eigen::MatrixXd& a, Eigen::Index n) {
-  Eigen::MatrixXd keep = Eigen::MatrixXd::Identity(n, n);
-  if (a.cols() > 0) keep -= a * a.colPivHouseholderQr().solve(Eigen::MatrixXd::Identity(n, n));
-  return keep;
+ResidualProjection::ResidualProjection(Eigen::MatrixXd a) : a_(std::move(a)) {
+  if (a_.cols() > 0) qr_.compute(a_);
+}
+
+Eigen::VectorXd ResidualProjection::operator()(const Eigen::VectorXd& v) const {
+  if (a_.cols() == 0) return v;
+  return v - a_ * qr_.solve(v);
+}
+
+double ResidualProjection::diagonal(Eigen::Index j) const {
+  if (a_.cols() == 0) return 1.0;
+  const Eigen::VectorXd unit = Eigen::VectorXd::Unit(a_.rows(), j);
+  return 1.0 - a_.row(j).dot(qr_.solve(unit));
 }
 
 }  // namespace clumpforge

@@ -4,6 +4,7 @@
 /// and rises on failure, and projected steps at the bounds. Used by the joint calibration and
 /// the diagnosis's fits.
 #include <Eigen/Core>
+#include <Eigen/QR>
 #include <functional>
 
 #include "core/error.hpp"
@@ -41,9 +42,20 @@ struct LeastSquaresResult {
 Result<LeastSquaresResult> levenberg_marquardt(const ResidualFunction& residuals, Eigen::VectorXd start,
                                                const LeastSquaresOptions& options);
 
-/// I - P, P the least-squares projection on the columns of `a` (n rows): (I - P) v is what of v
-/// a fit on those columns leaves; the identity when `a` has no columns. What free coefficients
-/// absorb of an effect's response is projected out so (the diagnosis's detectability).
-Eigen::MatrixXd residual_projection(const Eigen::MatrixXd& a, Eigen::Index n);
+/// I - P, P the least-squares projection on the columns of `a` (n rows, few columns): (I - P) v
+/// is what of v a fit on those columns leaves; the identity when `a` has no columns. What free
+/// coefficients absorb of an effect's response is projected out so (the diagnosis's
+/// detectability). Applied through the columns' QR (O(n k) per vector), never as an n x n matrix:
+/// a tuber's fitted cells number thousands.
+class ResidualProjection {
+ public:
+  explicit ResidualProjection(Eigen::MatrixXd a);
+  Eigen::VectorXd operator()(const Eigen::VectorXd& v) const;  ///< (I - P) v
+  double diagonal(Eigen::Index j) const;                       ///< (I - P)_jj
+
+ private:
+  Eigen::MatrixXd a_;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr_;
+};
 
 }  // namespace clumpforge

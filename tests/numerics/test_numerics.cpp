@@ -67,6 +67,33 @@ TEST(LevenbergMarquardt, PassesTheResidualFunctionsErrorOn) {
   EXPECT_EQ(fit.error().code, ErrorCode::InvalidArgument);
 }
 
+TEST(ResidualProjection, LeavesWhatAFitOnTheColumnsCannotExplain) {
+  // Columns 1 and t over t = 0..9 (a straight-line fit): a line is projected out entirely, a
+  // parabola leaves its residual from the least-squares line, orthogonal to both columns; the
+  // diagonal is 1 minus the hat matrix's leverage, which for a line is 1/n + (t - mean)^2 / Sxx.
+  const int n = 10;
+  Eigen::MatrixXd a(n, 2);
+  Eigen::VectorXd line(n), parabola(n);
+  for (int i = 0; i < n; ++i) {
+    a(i, 0) = 1.0;
+    a(i, 1) = i;
+    line(i) = 3.0 - 2.0 * i;
+    parabola(i) = i * i;
+  }
+  const ResidualProjection keep(a);
+  EXPECT_LT(keep(line).norm(), 1e-10);
+  const Eigen::VectorXd left = keep(parabola);
+  EXPECT_LT(std::abs(left.sum()), 1e-9);
+  EXPECT_LT(std::abs(a.col(1).dot(left)), 1e-8);
+  EXPECT_GT(left.norm(), 1.0);
+  const double mean = 4.5, sxx = 82.5;
+  for (int i = 0; i < n; ++i) EXPECT_NEAR(keep.diagonal(i), 1.0 - (1.0 / n + (i - mean) * (i - mean) / sxx), 1e-12);
+  // No columns: the identity.
+  const ResidualProjection none(Eigen::MatrixXd(n, 0));
+  EXPECT_EQ(none(parabola), parabola);
+  EXPECT_EQ(none.diagonal(3), 1.0);
+}
+
 TEST(Statistics, MedianStandardErrorAndChiSquaredTail) {
   EXPECT_EQ(median({3.0, 1.0, 2.0}), 2.0);
   EXPECT_EQ(median({4.0, 1.0, 3.0, 2.0}), 3.0);
