@@ -17,10 +17,14 @@ Eigen::Quaterniond random_orientation(Rng& rng) {
   return q.normalized();
 }
 
-// Lowest point of the body along `normal` relative to its centre of mass.
+// Lowest point of the body along `normal` relative to its centre of mass. The normal is
+// turned into the body frame once ((q c) . n = c . (q^-1 n)) instead of turning every sphere:
+// replays sample it every 0.1 ms, about as often as they step, and a per-sphere rotation made
+// it a fifth of a diagnosis's time.
 double lowest_offset(const RigidBody& body, const Eigen::Quaterniond& q, const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d n = q.conjugate() * normal;
   double lowest = std::numeric_limits<double>::infinity();
-  for (const auto& s : body.spheres) lowest = std::min(lowest, (q * s.centre).dot(normal) - s.radius);
+  for (const auto& s : body.spheres) lowest = std::min(lowest, s.centre.dot(n) - s.radius);
   return lowest;
 }
 

@@ -35,6 +35,7 @@ void refresh_candidates(World& world, std::size_t b, double skin) {
     }
   }
   world.candidate_travel[b] = 0.0;
+  world.candidate_skin[b] = skin;
 }
 
 double candidate_skin(const RigidBody& body) {
@@ -50,27 +51,31 @@ void adjust_by_terms(const World& world, ContactInput& in, ContactState& state) 
   state.max_overlap = std::max(state.max_overlap, in.overlap);
   in.rolling = world.contact.rolling;
   for (const auto& term : world.terms) {
-    std::visit([&](const auto& t) {
-      if constexpr (ContactTerm<std::decay_t<decltype(t)>>) adjust_contact(t, in, state);
-    }, term);
+    std::visit(
+        [&](const auto& t) {
+          if constexpr (ContactTerm<std::decay_t<decltype(t)>>) adjust_contact(t, in, state);
+        },
+        term);
   }
 }
 
-// E*, G* and beta of every material pair, once per force evaluation.
-struct PairConstants {
-  double youngs = 0.0, shear = 0.0, beta = 0.0;
-};
-std::vector<std::vector<PairConstants>> pair_constants(const World& world) {
+// E*, G* and beta of one material pair, kept in the world while the two materials' E and nu
+// and the pair's restitution stay as they were: computed afresh every step (a logarithm per
+// pair and two allocations) they were about a tenth of a replay's time.
+const PairConstants& pair_constants(World& world, int a, int b) {
   const std::size_t n = world.materials.size();
-  std::vector<std::vector<PairConstants>> table(n, std::vector<PairConstants>(n));
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = 0; j < n; ++j) {
-      table[i][j] = {effective_youngs_modulus(world.materials[i], world.materials[j]),
-                     effective_shear_modulus(world.materials[i], world.materials[j]),
-                     damping_beta(world.interactions[i][j].restitution)};
-    }
+  world.pair_constants.resize(n * n);
+  world.pair_inputs.resize(n * n, {std::numeric_limits<double>::quiet_NaN()});
+  const std::size_t k = static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b);
+  const Material &ma = world.materials[a], &mb = world.materials[b];
+  const std::array<double, 5> inputs{ma.youngs_modulus, ma.poisson_ratio, mb.youngs_modulus, mb.poisson_ratio,
+                                     world.interactions[a][b].restitution};
+  if (world.pair_inputs[k] != inputs) {
+    world.pair_constants[k] = {effective_youngs_modulus(ma, mb), effective_shear_modulus(ma, mb),
+                               damping_beta(inputs[4])};
+    world.pair_inputs[k] = inputs;
   }
-  return table;
+  return world.pair_constants[k];
 }
 
 // The body's rotation and spin, computed once per force evaluation.
@@ -79,8 +84,7 @@ struct BodyFrame {
   Eigen::Vector3d omega;
 };
 
-void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, double dt, const BodyFrame& frame,
-                  const std::vector<std::vector<PairConstants>>& constants) {
+void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, double dt, const BodyFrame& frame) {
   RigidBody& body = world.bodies[b];
   const Wall& wall = world.walls[w];
   const Sphere& sphere = body.spheres[k];
@@ -94,7 +98,7 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
   const Eigen::Vector3d point = centre - (sphere.radius - 0.5 * overlap) * wall.normal;
   const Eigen::Vector3d arm = point - body.position;
   const Eigen::Vector3d& omega = frame.omega;
-  const PairConstants& pair = constants[body.material][wall.material];
+  const PairConstants pair = pair_constants(world, body.material, wall.material);
   ContactInput in;
   in.normal = wall.normal;
   in.overlap = overlap;
@@ -123,12 +127,12 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
   world.torque[b] += arm.cross(out.force) + out.rolling_torque;
 }
 
-void sphere_contacts(World& world, std::size_t bi, std::size_t bj, double dt, const std::vector<std::vector<PairConstants>>& constants) {
+void sphere_contacts(World& world, std::size_t bi, std::size_t bj, double dt) {
   RigidBody& a = world.bodies[bi];
   RigidBody& c = world.bodies[bj];
   if ((a.position - c.position).norm() > a.bounding_radius + c.bounding_radius) return;
   const Eigen::Vector3d wa = a.angular_velocity(), wc = c.angular_velocity();
-  const PairConstants& pair = constants[a.material][c.material];
+  const PairConstants pair = pair_constants(world, a.material, c.material);
   for (std::size_t si = 0; si < a.spheres.size(); ++si) {
     const Eigen::Vector3d pi = a.sphere_position(si);
     if ((pi - c.position).norm() > c.bounding_radius + a.spheres[si].radius) continue;
@@ -199,39 +203,45 @@ void compute_forces(World& world, double dt) {
   const std::size_t n = world.bodies.size();
   world.force.assign(n, Eigen::Vector3d::Zero());
   world.torque.assign(n, Eigen::Vector3d::Zero());
-  if (world.wall_candidates.size() != n) {
+  if (world.wall_candidates.size() != n || world.candidate_skin.size() != n) {
     world.wall_candidates.assign(n, {});
     world.candidate_travel.assign(n, std::numeric_limits<double>::infinity());
+    world.candidate_skin.assign(n, 0.0);
   }
-  const auto constants = pair_constants(world);
   for (std::size_t b = 0; b < n; ++b) {
     RigidBody& body = world.bodies[b];
     world.force[b] += body.mass * world.gravity;
     const Eigen::Matrix3d rotation = body.orientation.toRotationMatrix();
-    const BodyFrame frame{rotation, rotation * (rotation.transpose() * body.angular_momentum).cwiseQuotient(body.inertia)};
+    const BodyFrame frame{rotation,
+                          rotation * (rotation.transpose() * body.angular_momentum).cwiseQuotient(body.inertia)};
     for (const auto& term : world.terms) {
-      std::visit([&](const auto& t) {
-        if constexpr (BodyTerm<std::decay_t<decltype(t)>>) {
-          const TermLoad load = apply(t, body.velocity, body.mass, world.materials[body.material].density);
-          world.force[b] += load.force;
-          world.torque[b] += load.torque;
-        }
-      }, term);
+      std::visit(
+          [&](const auto& t) {
+            if constexpr (BodyTerm<std::decay_t<decltype(t)>>) {
+              const TermLoad load = apply(t, body.velocity, body.mass, world.materials[body.material].density);
+              world.force[b] += load.force;
+              world.torque[b] += load.torque;
+            }
+          },
+          term);
     }
-    const double skin = candidate_skin(body);
-    if (world.candidate_travel[b] > 0.5 * skin) refresh_candidates(world, b, skin);
+    // The skin the candidates were listed with (the smallest sphere's half radius, listed again
+    // once the body may have moved by half of it).
+    if (world.candidate_travel[b] > 0.5 * world.candidate_skin[b]) refresh_candidates(world, b, candidate_skin(body));
     for (std::size_t w = 0; w < world.walls.size(); ++w) {
-      for (int k : world.wall_candidates[b][w]) wall_contact(world, b, static_cast<std::size_t>(k), w, dt, frame, constants);
+      for (int k : world.wall_candidates[b][w]) wall_contact(world, b, static_cast<std::size_t>(k), w, dt, frame);
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = i + 1; j < n; ++j) sphere_contacts(world, i, j, dt, constants);
+    for (std::size_t j = i + 1; j < n; ++j) sphere_contacts(world, i, j, dt);
   }
   // Contacts that ended this step lose their history, except, on a plastic substrate, the
   // dent a sphere left in the plate (its largest overlap), which later contacts unload into.
-  const bool plastic = std::any_of(world.terms.begin(), world.terms.end(), [](const PhysicsTerm& t) { return std::holds_alternative<PlasticSubstrate>(t); });
+  const bool plastic = std::any_of(world.terms.begin(), world.terms.end(),
+                                   [](const PhysicsTerm& t) { return std::holds_alternative<PlasticSubstrate>(t); });
   std::erase_if(world.history, [&](const auto& entry) {
-    return entry.second.last_step != world.steps && !(plastic && (entry.first >> 63) == 0 && entry.second.max_overlap > 0.0);
+    return entry.second.last_step != world.steps &&
+           !(plastic && (entry.first >> 63) == 0 && entry.second.max_overlap > 0.0);
   });
   world.forces_current = true;
 }
@@ -246,7 +256,8 @@ void step(World& world, double dt) {
     rotate(body, dt);
     // How far any point of the body, or of a moving wall near it, may have gone.
     double travel = (body.velocity.norm() + body.angular_velocity().norm() * body.bounding_radius) * dt;
-    for (const auto& wall : world.walls) travel += wall.spin.norm() * ((body.position - wall.pivot).norm() + body.bounding_radius) * dt;
+    for (const auto& wall : world.walls)
+      travel += wall.spin.norm() * ((body.position - wall.pivot).norm() + body.bounding_radius) * dt;
     world.candidate_travel[b] += travel;
   }
   for (auto& wall : world.walls) rotate_wall(wall, dt);
@@ -268,29 +279,36 @@ TimeStepEstimate estimate_time_step(const World& world, double impact_speed, int
     const Material& m = world.materials[body.material];
     double smallest = std::numeric_limits<double>::infinity();
     for (const auto& s : body.spheres) smallest = std::min(smallest, s.radius);
-    estimate.rayleigh = std::min(estimate.rayleigh, std::numbers::pi * smallest * std::sqrt(m.density / m.shear_modulus()) /
-                                                        (0.1631 * m.poisson_ratio + 0.8766));
+    estimate.rayleigh =
+        std::min(estimate.rayleigh, std::numbers::pi * smallest * std::sqrt(m.density / m.shear_modulus()) /
+                                        (0.1631 * m.poisson_ratio + 0.8766));
     // The stiffest partner: walls and the other bodies' materials.
     double stiffest = effective_youngs_modulus(m, m);
-    for (const auto& wall : world.walls) stiffest = std::max(stiffest, effective_youngs_modulus(m, world.materials[wall.material]));
+    for (const auto& wall : world.walls)
+      stiffest = std::max(stiffest, effective_youngs_modulus(m, world.materials[wall.material]));
     const double m_star = body.mass;  // a clump's sphere carries the whole mass against a wall
-    estimate.hertz = std::min(estimate.hertz, 2.868 * std::pow(m_star * m_star / (smallest * stiffest * stiffest * std::max(impact_speed, 1e-3)), 0.2));
+    estimate.hertz = std::min(
+        estimate.hertz,
+        2.868 * std::pow(m_star * m_star / (smallest * stiffest * stiffest * std::max(impact_speed, 1e-3)), 0.2));
   }
   // EDEM's guidance: 20 % of the Rayleigh time for coordination numbers of 4 or more, 40 %
   // below; one body on walls (the lab tests) is the sparse case.
   estimate.rayleigh_fraction = world.bodies.size() <= 1 ? 0.4 : 0.2;
-  estimate.chosen = std::min(estimate.rayleigh_fraction * estimate.rayleigh, estimate.hertz / std::max(20, steps_per_contact));
+  estimate.chosen =
+      std::min(estimate.rayleigh_fraction * estimate.rayleigh, estimate.hertz / std::max(20, steps_per_contact));
   estimate.largest_allowed = std::min(0.4 * estimate.rayleigh, estimate.hertz / 20.0);
   return estimate;
 }
 
 Result<void> check_time_step(double dt, const TimeStepEstimate& estimate) {
-  if (!(dt > 0.0) || !std::isfinite(dt)) return fail(ErrorCode::InvalidArgument, fmt::format("time step {} s must be positive", dt));
+  if (!(dt > 0.0) || !std::isfinite(dt))
+    return fail(ErrorCode::InvalidArgument, fmt::format("time step {} s must be positive", dt));
   if (dt > estimate.largest_allowed) {
-    return fail(ErrorCode::InvalidArgument,
-                fmt::format("time step {:.3g} s is above the stable limit {:.3g} s (0.4 of the Rayleigh time {:.3g} s, or 1/20 "
-                            "of the Hertz contact time {:.3g} s)",
-                            dt, estimate.largest_allowed, estimate.rayleigh, estimate.hertz));
+    return fail(
+        ErrorCode::InvalidArgument,
+        fmt::format("time step {:.3g} s is above the stable limit {:.3g} s (0.4 of the Rayleigh time {:.3g} s, or 1/20 "
+                    "of the Hertz contact time {:.3g} s)",
+                    dt, estimate.largest_allowed, estimate.rayleigh, estimate.hertz));
   }
   return {};
 }

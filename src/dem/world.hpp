@@ -2,6 +2,7 @@
 /// The DEM's plain data: rigid multi-sphere bodies, walls, contact history, settings.
 /// Free functions in step.hpp advance it.
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -37,6 +38,12 @@ RigidBody make_body(const Clump& clump, int material);
 void update_bounding_radius(RigidBody& body);
 /// A one-sphere body (for analytic benchmarks): solid sphere of `radius` and `density`.
 RigidBody make_sphere_body(double radius, double density, int material);
+
+/// A material pair's contact constants: effective Young's and shear moduli [Pa] and the
+/// damping factor of its restitution.
+struct PairConstants {
+  double youngs = 0.0, shear = 0.0, beta = 0.0;
+};
 
 /// A wall: an infinite plane, or a rectangle on it (|u|, |v| within the half sizes), that
 /// may rotate at a constant rate about an axis through its `pivot`.
@@ -103,7 +110,11 @@ struct World {
   /// Per (body, wall): spheres that may touch the wall before the next refresh.
   std::vector<std::vector<std::vector<int>>> wall_candidates;
   std::vector<double> candidate_travel;        ///< per body: motion since its candidates were refreshed [m]
+  std::vector<double> candidate_skin;          ///< per body: the skin they were listed with [m]
   std::vector<Eigen::Vector3d> force, torque;  ///< per body, at the current state (world frame)
+  /// Per material pair (row-major): E*, G* and beta, and the E, nu (both) and e they came from.
+  std::vector<PairConstants> pair_constants;
+  std::vector<std::array<double, 5>> pair_inputs;
   bool forces_current = false;
 };
 
