@@ -3,13 +3,17 @@
 // and the impact-accuracy weights.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "core/rng.hpp"
 #include "diagnose/ensemble.hpp"
 #include "diagnose/release.hpp"
+#include "diagnose/stages.hpp"
 #include "diagnose/tracks.hpp"
 
 using namespace clumpforge;
@@ -409,4 +413,31 @@ TEST(EnsembleConvergence, AnOutcomeShiftCountsWhenItIsRealAndMatters) {
   const OutcomeShift noise = outcome_shift(coarse, comparisons(0.104, 0.01));
   EXPECT_GT(noise.p, 0.1);
   EXPECT_TRUE(noise.converged());
+}
+
+// A candidate tried on the outcomes and not named decides its absence only where its strong
+// magnitude would have shown (its strong signal reaches the margin): the generated 8-trial
+// plastic substrate was tried at a fitted level in its own strong case, failed the margin with
+// a strong signal of 0.1 against 13 needed, and was called absent until 4e3e08b.
+TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow) {
+  for (const double strong_signal : {0.1, 30.0}) {
+    DiagnoseResult result;
+    result.verdict = Verdict::None;
+    result.undecidable = {"plastic_substrate", "viscous_rolling"};
+    EnsembleResult ens;
+    ens.trials = 8.0;
+    ens.detectability.push_back({Effect::PlasticSubstrate, strong_signal, 1.0, 13.0, 8.0 * 13.0 / strong_signal});
+    ens.detectability.push_back({Effect::ViscousRolling, 0.0, 0.0, 13.0, std::numeric_limits<double>::infinity()});
+    EnsembleHypothesis tried;
+    tried.effect = Effect::PlasticSubstrate;
+    tried.delta_bic = -1.7;
+    ens.hypotheses.push_back(tried);
+    diagnosis::say_what_outcomes_decide(result, ens);
+    const bool undecided = std::count(result.undecidable.begin(), result.undecidable.end(), "plastic_substrate") == 1;
+    EXPECT_EQ(undecided, strong_signal < 13.0) << strong_signal;
+    // Never tried, it stays undecidable, and the experiment says the outcomes do not respond.
+    EXPECT_EQ(std::count(result.undecidable.begin(), result.undecidable.end(), "viscous_rolling"), 1);
+    EXPECT_NE(result.experiment.find("viscous_rolling (the outcomes do not respond to it)"), std::string::npos)
+        << result.experiment;
+  }
 }
