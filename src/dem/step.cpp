@@ -65,7 +65,9 @@ void adjust_by_terms(const World& world, ContactInput& in, ContactState& state) 
 const PairConstants& pair_constants(World& world, int a, int b) {
   const std::size_t n = world.materials.size();
   world.pair_constants.resize(n * n);
-  world.pair_inputs.resize(n * n, {std::numeric_limits<double>::quiet_NaN()});
+  std::array<double, 5> unset;
+  unset.fill(std::numeric_limits<double>::quiet_NaN());  // never equal to any inputs
+  world.pair_inputs.resize(n * n, unset);
   const std::size_t k = static_cast<std::size_t>(a) * n + static_cast<std::size_t>(b);
   const Material &ma = world.materials[a], &mb = world.materials[b];
   const std::array<double, 5> inputs{ma.youngs_modulus, ma.poisson_ratio, mb.youngs_modulus, mb.poisson_ratio,

@@ -253,10 +253,11 @@ bool particle_model_unconverged(const Context& c, DiagnoseResult& result) {
       recording_label((*c.ev.recordings)[shift.recording], c.names[shift.recording]), shift.from * as.scale,
       shift.to * as.scale, as.unit, shift.largest);
   supersede(result, Verdict::Undecidable, Basis::UnconvergedParticleModel);
-  // Nothing is decided while the particle model is not: every effect is undecidable, present or
-  // absent (the frame-by-frame and first-order claims of absence included).
+  // Nothing is decided while the particle model is not: every candidate asked about (one
+  // hypothesis each) is undecidable, present or absent (the frame-by-frame and first-order
+  // claims of absence included).
   result.undecidable.clear();
-  for (const auto& spec : effect_library()) result.undecidable.push_back(spec.name);
+  for (const auto& h : result.hypotheses) result.undecidable.push_back(h.name);
   result.statement = fmt::format(
       "Not decidable with these clumps: the recorded outcomes differ from replays over the unknown release "
       "orientation (chi^2 {:.1f} over {} recorded means and spreads with {}, {:.1f} with {}), but the particle "

@@ -341,10 +341,24 @@ class CellProbe {
 /// (computed when first asked).
 struct AbsenceCheck {
   ResidualProjection keep;
-  std::vector<Evaluator> releases;
-  std::vector<TrialCells> bases;  ///< [0] the baseline as replayed, then at each release
+  std::vector<Evaluator> releases;  ///< made when first asked (released_evaluators)
+  std::vector<TrialCells> bases;    ///< [0] the baseline as replayed, then at each release
   std::optional<Eigen::VectorXd> fine_base;
 };
+
+/// The diagnosis's evaluator with each trial released at its k-th other orientation, for k
+/// below kAlternativeReleases (made once, when a candidate first reaches that check).
+const std::vector<Evaluator>& released_evaluators(const Context& c, AbsenceCheck& check) {
+  if (!check.releases.empty()) return check.releases;
+  for (std::size_t k = 0; k < kAlternativeReleases; ++k) {
+    Evaluator released = c.ev;
+    for (auto& t : released.trials) {
+      if (!t.alternatives.empty()) t.orientation = t.alternatives[k % t.alternatives.size()];
+    }
+    check.releases.push_back(std::move(released));
+  }
+  return check.releases;
+}
 
 /// Whether the recordings reject `probe` (an effect at its strong magnitude, `probed` its
 /// cells) by `needed`, asked each way in turn, the cheapest first: to first order (already in
@@ -356,13 +370,14 @@ Result<bool> rejected(Context& c, CellProbe& cells, AbsenceCheck& check, const M
                       const DiagnoseOptions& options) {
   if (!(report.strong_delta_chi2 >= needed)) return false;
   std::vector<TrialCells> probes{probed};
-  for (std::size_t k = 0; k < check.releases.size(); ++k) {
+  const std::vector<Evaluator>& releases = released_evaluators(c, check);
+  for (std::size_t k = 0; k < releases.size(); ++k) {
     if (check.bases.size() <= k + 1) {
-      auto released = cells(baseline, &check.releases[k]);
+      auto released = cells(baseline, &releases[k]);
       if (!released) return std::unexpected(released.error());
       check.bases.push_back(std::move(*released));
     }
-    auto released = cells(probe, &check.releases[k]);
+    auto released = cells(probe, &releases[k]);
     if (!released) return std::unexpected(released.error());
     probes.push_back(std::move(*released));
   }
@@ -437,13 +452,6 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
   for (std::size_t k = 0; k < directions.size(); ++k) absorb.col(static_cast<Eigen::Index>(k)) = directions[k];
   AbsenceCheck check{.keep = ResidualProjection(std::move(absorb)), .bases = {*base}};
   const ResidualProjection& keep = check.keep;
-  for (std::size_t k = 0; k < kAlternativeReleases; ++k) {
-    Evaluator released = c.ev;
-    for (auto& t : released.trials) {
-      if (!t.alternatives.empty()) t.orientation = t.alternatives[k % t.alternatives.size()];
-    }
-    check.releases.push_back(std::move(released));
-  }
   std::vector<std::string> limits, untestable;
   for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
     auto& report = result.hypotheses[h];
