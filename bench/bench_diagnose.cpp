@@ -380,6 +380,7 @@ struct BenchOptions {
                               generator_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default.h5",
                               generator_name = "adaptive-340";
   int spheres = 0, threads = 0;
+  int finer_clumps = 2;  ///< finer clumps of the particle-model check (DiagnoseJob::finer_clumps)
   double fps = 1000.0, noise = 1e-4;
   bool no_pre_roll = false;
   std::string camera_target = "silhouette";
@@ -419,6 +420,10 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "With --recordings-set: spheres of the adaptive clump each case's mesh is filled with (0: by "
                  "convergence to the scan, as diagnose does)");
   app.add_option("--threads", o.threads, "Threads per process (0: the cores shared among the MPI ranks on a node)");
+  app.add_option("--finer-clumps", o.finer_clumps,
+                 "Finer clumps of the particle-model check (default 2): the library's next ones with more spheres "
+                 "than --clump; with --recordings-set, fills of the mesh with 2, 4, ... times the spheres")
+      ->check(CLI::Range(0, 4));
 }
 
 /// The clump the recordings are made with: a finer (or other) clump than the one diagnosed,
@@ -499,8 +504,10 @@ Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialT
 /// (the diagnosis sees the recordings directory and the clump, nothing else).
 bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTable& table, const BenchOptions& o) {
   const fs::path dir = fs::path(o.out) / c.id;
-  const cli::DiagnoseJob job{
-      .recordings = {(dir / "recordings").string()}, .library = o.clump_file, .clump_name = o.clump_name};
+  const cli::DiagnoseJob job{.recordings = {(dir / "recordings").string()},
+                             .library = o.clump_file,
+                             .clump_name = o.clump_name,
+                             .finer_clumps = o.finer_clumps};
   // Recordings already made (their answer is written last) are diagnosed as they are: delete a
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
@@ -557,7 +564,9 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (!o.recordings_set.empty())
-    return run_recordings_set(o.recordings_set, o.out, cli::DiagnoseJob{.spheres = o.spheres}, o.existing_only, *team);
+    return run_recordings_set(o.recordings_set, o.out,
+                              cli::DiagnoseJob{.spheres = o.spheres, .finer_clumps = o.finer_clumps}, o.existing_only,
+                              *team);
   const MaterialTable table = default_material_table();
   auto generator = generator_clump(o);
   auto cases = generator ? generated_cases(o, table) : Result<std::vector<Case>>(std::unexpected(generator.error()));

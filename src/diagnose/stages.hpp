@@ -297,6 +297,10 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
                                            const std::vector<Effect>& candidates, const EnsembleOptions& eo,
                                            int max_evaluations, std::optional<LetThrough> let_through);
 bool particle_model_unconverged(const Context& c, DiagnoseResult& result);
+/// The ladder converged on its finest clump, which still leaves the outcomes inconsistent: the
+/// candidates are judged on that clump's comparison; named there when one passes.
+bool judge_on_converged_clump(DiagnoseResult& result, const ParticleModelCheck& check, const EnsembleResult& finest,
+                              double min_delta_bic);
 Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Model& baseline,
                                   const std::vector<FreeCoefficient>& free, const std::vector<Effect>& candidates,
                                   const EnsembleOptions& eo, int max_evaluations);

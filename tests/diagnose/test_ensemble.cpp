@@ -441,3 +441,56 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
         << result.experiment;
   }
 }
+
+// A ladder of clumps whose finest one leaves the recorded outcomes inconsistent: the candidates
+// are judged on it only when its outcomes agree with the previous clump's (converged); before
+// that the mismatch may still be the particle model's, and nothing is named. A candidate that
+// does not reach the margin names nothing either.
+TEST(EnsembleConvergedLadder, CandidatesAreJudgedOnTheFinestClumpOnlyOnceItHasConverged) {
+  const auto library = effect_library();
+  const std::size_t parameters = effect_spec(library, Effect::ViscoelasticRestitution).parameters.size();
+  struct Case {
+    double shift_p, delta_bic;
+    bool named;
+  };
+  for (const Case& k : {Case{1e-4, 25.0, false}, Case{0.4, 25.0, true}, Case{0.4, 4.0, false}}) {
+    DiagnoseResult result;
+    result.verdict = Verdict::None;
+    result.ensemble = EnsembleReport{};
+    ParticleModelCheck check;
+    check.rungs.resize(3);
+    for (int r = 0; r < 3; ++r) {
+      check.rungs[r].name = "adaptive-" + std::to_string(64 << r);
+      check.rungs[r].spheres = 64 << r;
+      check.rungs[r].refitted = r > 0;
+    }
+    OutcomeShift shift;
+    shift.means = 10;
+    shift.p = k.shift_p;
+    shift.largest = 2.4;  // recorded standard errors: a move that matters, if real
+    check.rungs[2].outcome_shift = shift;
+    EnsembleResult finest;
+    finest.outcomes = 20;
+    finest.null_chi2 = 73.0;
+    EnsembleHypothesis h;
+    h.effect = Effect::ViscoelasticRestitution;
+    h.values.assign(parameters, 0.1);
+    h.plausible = true;
+    h.delta_bic = k.delta_bic;
+    for (int o = 0; o < 20; ++o)
+      h.comparisons.push_back({.statistic = o < 10 ? Statistic::Mean : Statistic::Spread, .z = 0.5});
+    h.chi2 = 5.0;
+    finest.hypotheses.push_back(h);
+    const bool decided = diagnosis::judge_on_converged_clump(result, check, finest, 10.0);
+    EXPECT_EQ(decided, k.named) << k.shift_p << " " << k.delta_bic;
+    if (k.named) {
+      EXPECT_EQ(result.verdict, Verdict::Named);
+      EXPECT_EQ(result.basis, Basis::Ensemble);
+      EXPECT_EQ(result.effect, Effect::ViscoelasticRestitution);
+      EXPECT_EQ(result.ensemble->null_chi2, 73.0);  // the report's comparison is the finest clump's
+    } else {
+      EXPECT_EQ(result.verdict, Verdict::None);
+      EXPECT_FALSE(result.effect.has_value());
+    }
+  }
+}
