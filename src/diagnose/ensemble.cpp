@@ -714,6 +714,7 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
       margin_over_null(result.null_chi2, h.chi2, result.outcomes, free.size(), spec.parameters.size());
   h.dispersion = margin.dispersion;
   h.delta_bic = margin.delta_bic;
+  h.first_delta_bic = margin.delta_bic;
   h.comparisons = std::move(fitted->comparisons);
   h.plausible = spec.plausible(h.values);
   return h;

@@ -15,6 +15,7 @@
 /// and new replays at that point decide (delta-BIC against the calibrated null, computed from
 /// replays, never from the surrogate).
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -145,6 +146,12 @@ struct EnsembleHypothesis {
   /// replayed: only a candidate that reaches the margin on the first draw is). delta_bic is the
   /// lower of the two: chaotic replays move chi^2 by tens between draws.
   double fresh_delta_bic = std::numeric_limits<double>::quiet_NaN();
+  double first_delta_bic = 0.0;  ///< its delta-BIC on the first draw of orientations
+  /// The higher of its two draws' delta-BICs: how well it can explain the outcomes (a rival to a
+  /// named candidate, whose lower draw is what names it).
+  double best_delta_bic() const {
+    return std::isfinite(fresh_delta_bic) ? std::max(first_delta_bic, fresh_delta_bic) : first_delta_bic;
+  }
   bool plausible = false;
   std::vector<OutcomeComparison> comparisons;  ///< its replays against the recordings
 };

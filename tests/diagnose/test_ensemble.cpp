@@ -494,3 +494,49 @@ TEST(EnsembleConvergedLadder, CandidatesAreJudgedOnTheFinestClumpOnlyOnceItHasCo
     }
   }
 }
+
+// Two candidates that explain the outcomes about equally well are ambiguous even when one draw
+// of release orientations favoured one: the rival's better draw counts. The generated 8-trial
+// realistic elastic-plastic case: delta-BIC 14.6 and 15.3 on the first draw, 10.2 and 2.4 on
+// the second; named viscoelastic before, a guess.
+TEST(EnsembleRival, ACandidateWithinTheMarginOnEitherDrawMakesTheVerdictAmbiguous) {
+  struct Case {
+    double rival_first, rival_fresh;
+    bool rival_plausible;
+    Verdict verdict;
+  };
+  for (const Case& k : {Case{15.3, 2.4, true, Verdict::Ambiguous}, Case{9.0, 2.4, true, Verdict::Named},
+                        Case{15.3, 2.4, false, Verdict::Named}, Case{0.5, 21.0, true, Verdict::Ambiguous}}) {
+    EnsembleResult ens;
+    ens.outcomes = 20;
+    ens.null_chi2 = 91.3;
+    auto hypothesis = [](Effect effect, double first, double fresh, bool plausible) {
+      EnsembleHypothesis h;
+      h.effect = effect;
+      h.values = {0.3};
+      h.plausible = plausible;
+      h.first_delta_bic = first;
+      h.fresh_delta_bic = fresh;
+      h.delta_bic = std::min(first, fresh);
+      for (int o = 0; o < 20; ++o)
+        h.comparisons.push_back({.statistic = o < 10 ? Statistic::Mean : Statistic::Spread, .z = 0.5});
+      return h;
+    };
+    ens.hypotheses.push_back(hypothesis(Effect::ViscoelasticRestitution, 14.6, 10.2, true));
+    ens.hypotheses.push_back(
+        hypothesis(Effect::ElasticPlasticRestitution, k.rival_first, k.rival_fresh, k.rival_plausible));
+    DiagnoseResult result;
+    result.ensemble = EnsembleReport{};
+    std::vector<std::string> notes;
+    const auto passing = diagnosis::passing_hypotheses(ens, 10.0, notes);
+    ASSERT_FALSE(passing.empty());
+    diagnosis::name_beyond_horizon(result, ens, passing, 10.0);
+    EXPECT_EQ(result.verdict, k.verdict) << k.rival_first << " " << k.rival_fresh << " " << k.rival_plausible;
+    if (k.verdict == Verdict::Ambiguous) {
+      EXPECT_FALSE(result.effect.has_value());
+      EXPECT_EQ(result.candidates.size(), 2u);
+    } else {
+      EXPECT_EQ(result.effect, Effect::ViscoelasticRestitution);
+    }
+  }
+}
