@@ -366,7 +366,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
 
 /// The benchmark's command line.
 struct BenchOptions {
-  // The diagnosed clump (adaptive-32) with finer fills of the same scan (64, 128), against
+  // The diagnosed clump (adaptive-32) with finer fills of the same scan (64, 128, 256), against
   // which the diagnosis checks its particle model before it blames missing physics.
   std::string clump_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default-ladder.h5",
               clump_name = "adaptive-32", out = "bench-out/diagnose";
@@ -380,7 +380,10 @@ struct BenchOptions {
                               generator_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default.h5",
                               generator_name = "adaptive-340";
   int spheres = 0, threads = 0;
-  int finer_clumps = 2;  ///< finer clumps of the particle-model check (DiagnoseJob::finer_clumps)
+  /// Finer clumps of the particle-model check (DiagnoseJob::finer_clumps); unset: 3 for the
+  /// generated set (its ladder's 64, 128 and 256 spheres: from 64 to 128 the tuber's outcomes
+  /// still move), 2 with --recordings-set (as diagnose: fills with 2 and 4 times the spheres).
+  std::optional<int> finer_clumps;
   double fps = 1000.0, noise = 1e-4;
   bool no_pre_roll = false;
   std::string camera_target = "silhouette";
@@ -421,8 +424,9 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "convergence to the scan, as diagnose does)");
   app.add_option("--threads", o.threads, "Threads per process (0: the cores shared among the MPI ranks on a node)");
   app.add_option("--finer-clumps", o.finer_clumps,
-                 "Finer clumps of the particle-model check (default 2): the library's next ones with more spheres "
-                 "than --clump; with --recordings-set, fills of the mesh with 2, 4, ... times the spheres")
+                 "Finer clumps of the particle-model check: the library's next ones with more spheres than --clump "
+                 "(default 3: 64, 128, 256); with --recordings-set, fills of the mesh with 2, 4, ... times the "
+                 "spheres (default 2, as diagnose)")
       ->check(CLI::Range(0, 4));
 }
 
@@ -507,7 +511,7 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
   const cli::DiagnoseJob job{.recordings = {(dir / "recordings").string()},
                              .library = o.clump_file,
                              .clump_name = o.clump_name,
-                             .finer_clumps = o.finer_clumps};
+                             .finer_clumps = o.finer_clumps.value_or(3)};
   // Recordings already made (their answer is written last) are diagnosed as they are: delete a
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
@@ -565,8 +569,8 @@ int main(int argc, char** argv) {
   }
   if (!o.recordings_set.empty())
     return run_recordings_set(o.recordings_set, o.out,
-                              cli::DiagnoseJob{.spheres = o.spheres, .finer_clumps = o.finer_clumps}, o.existing_only,
-                              *team);
+                              cli::DiagnoseJob{.spheres = o.spheres, .finer_clumps = o.finer_clumps.value_or(2)},
+                              o.existing_only, *team);
   const MaterialTable table = default_material_table();
   auto generator = generator_clump(o);
   auto cases = generator ? generated_cases(o, table) : Result<std::vector<Case>>(std::unexpected(generator.error()));

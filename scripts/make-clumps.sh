@@ -39,10 +39,10 @@ done
 # every tracked trial a few thousand times), and the bundled concealed-effect recordings.
 $cf repair meshes/tuber-default.stl -o "$work/diagnosis.stl" > /dev/null
 $cf fill "$work/diagnosis.stl" -o clumps/tuber-default-diagnosis.h5 --method adaptive --max-spheres 32 > /dev/null
-# The same 32-sphere clump with finer fills of the scan (64, 128; not the generator's 340):
+# The same 32-sphere clump with finer fills of the scan (64, 128, 256; not the generator's 340):
 # the generated benchmark's diagnosis checks its particle model against them.
 $cf fill "$work/diagnosis.stl" -o clumps/tuber-default-ladder.h5 --method adaptive --max-spheres 32 > /dev/null
-for n in 64 128; do
+for n in 64 128 256; do
   $cf fill "$work/diagnosis.stl" -o clumps/tuber-default-ladder.h5 --append --method adaptive --max-spheres $n > /dev/null
 done
 # Made from a finer clump of the same scan (adaptive-340) with the generator's finer time step,
@@ -50,4 +50,4 @@ done
 build/tools/clumpforge-conceal clumps/tuber-default.h5 --clump adaptive-340 --effect air_drag --magnitude realistic --small --trials 4 --seed 7 \
   --output clumps/tuber-default-diagnosis/recordings --answer clumps/tuber-default-diagnosis/answer.json
 echo "clumps/tuber-default-diagnosis.h5: adaptive-32; concealed-effect recordings (from adaptive-340) in clumps/tuber-default-diagnosis/"
-echo "clumps/tuber-default-ladder.h5: adaptive-32, -64, -128"
+echo "clumps/tuber-default-ladder.h5: adaptive-32, -64, -128, -256"
