@@ -218,7 +218,7 @@ TEST(DiagnoseCli, AnotherSimulatorsSpeedDependentRestitutionIsFoundByCalibrating
   // restitution must be named, on both draws of orientations (delta-BIC and fresh delta-BIC at
   // least the margin of 10), and confirmed on the finer clump whose null is consistent (the
   // candidate the 64-sphere clump let through is calibrated there whatever its detectability:
-  // from 7a3816a to b949cde it was not tried there, and the verdict was `none` on the particle
+  // at 8e0421d (probably from 7a3816a on) it was not tried there, and the verdict was `none` on the particle
   // model's basis). Before 7d84481 the verdict was the particle model's or `unexplained`.
   test::ScratchDir dir("diagnose-lab-like-speed-restitution");
   const auto j = diagnose_lab_like_tuber("case-08", dir / "out", 2);
