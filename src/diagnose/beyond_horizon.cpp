@@ -79,7 +79,7 @@ const EnsembleHypothesis* closest_rival(const EnsembleResult& ens, const Ensembl
                                         double min_delta_bic) {
   const EnsembleHypothesis* rival = nullptr;
   for (const auto& h : ens.hypotheses) {
-    if (&h == &best || h.effect == best.effect || !h.plausible || h.best_delta_bic() < min_delta_bic) continue;
+    if (h.effect == best.effect || !h.plausible || h.best_delta_bic() < min_delta_bic) continue;
     if (best.delta_bic - h.best_delta_bic() >= min_delta_bic) continue;
     if (!outcomes_consistent(h.comparisons, h.values.size())) continue;
     if (!rival || h.best_delta_bic() > rival->best_delta_bic()) rival = &h;
@@ -168,8 +168,9 @@ std::string hypotheses_tried(const EnsembleResult& ens) {
 /// 20), and the verdict was `unexplained` with the candidates never judged on it.
 bool judge_on_converged_clump(DiagnoseResult& result, const ParticleModelCheck& check, const EnsembleResult& finest,
                               double min_delta_bic) {
+  if (check.rungs.size() < 2) return false;
   const ParticleModelRung& last = check.rungs.back();
-  if (!last.outcome_shift || !last.outcome_shift->converged() || check.rungs.size() < 2) return false;
+  if (!last.outcome_shift || !last.outcome_shift->converged()) return false;
   const ParticleModelRung& before = check.rungs[check.rungs.size() - 2];
   const auto passing = passing_hypotheses(finest, min_delta_bic, result.notes);
   if (passing.empty()) {
