@@ -222,7 +222,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                        {"values", values},
                        {"chi2", h.chi2},
                        {"dispersion", h.dispersion},
-                       {"delta_bic", h.delta_bic},
+                       {"delta_bic", h.delta_bic()},
                        {"fresh_delta_bic", finite_or_null(h.fresh_delta_bic)},
                        {"first_delta_bic", finite_or_null(h.first_delta_bic)},
                        {"plausible", h.plausible},

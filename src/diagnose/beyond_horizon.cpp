@@ -55,14 +55,14 @@ std::vector<const EnsembleHypothesis*> passing_hypotheses(const EnsembleResult& 
                                                           std::vector<std::string>& notes) {
   std::vector<const EnsembleHypothesis*> passing;
   for (const auto& h : ens.hypotheses) {
-    if (!h.plausible || h.delta_bic < min_delta_bic) continue;
+    if (!h.plausible || h.delta_bic() < min_delta_bic) continue;
     if (outcomes_consistent(h.comparisons, h.values.size())) {
       passing.push_back(&h);
     } else {
       notes.push_back(fmt::format(
           "beyond the release horizon {} improves the outcomes by delta-BIC {:.1f} but leaves chi^2 {:.1f} over {} "
           "recorded means and spreads: not an explanation",
-          effect_name(h.effect), h.delta_bic, h.chi2, ens.outcomes));
+          effect_name(h.effect), h.delta_bic(), h.chi2, ens.outcomes));
     }
   }
   return passing;
@@ -80,7 +80,7 @@ const EnsembleHypothesis* closest_rival(const EnsembleResult& ens, const Ensembl
   const EnsembleHypothesis* rival = nullptr;
   for (const auto& h : ens.hypotheses) {
     if (h.effect == best.effect || !h.plausible || h.best_delta_bic() < min_delta_bic) continue;
-    if (best.delta_bic - h.best_delta_bic() >= min_delta_bic) continue;
+    if (best.delta_bic() - h.best_delta_bic() >= min_delta_bic) continue;
     if (!outcomes_consistent(h.comparisons, h.values.size())) continue;
     if (!rival || h.best_delta_bic() > rival->best_delta_bic()) rival = &h;
   }
@@ -106,7 +106,7 @@ void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
         "to rest) differ from replays over the unknown release orientation, and {} and {} explain that about equally "
         "well (delta-BIC {:.1f} vs {:.1f} on the lower of two draws of release orientations, {:.1f} vs {:.1f} on the "
         "higher). To separate them: {}.",
-        result.candidates[0], result.candidates[1], best.delta_bic, rival->delta_bic, best.best_delta_bic(),
+        result.candidates[0], result.candidates[1], best.delta_bic(), rival->delta_bic(), best.best_delta_bic(),
         rival->best_delta_bic(), result.experiment);
   } else {
     result.verdict = Verdict::Named;
@@ -126,9 +126,9 @@ void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
                     return fmt::format("{} = {:.4g}", p.name, p.value);
                   }),
                   ", "),
-        ens.null_chi2, best.chi2, ens.outcomes, best.delta_bic,
+        ens.null_chi2, best.chi2, ens.outcomes, best.delta_bic(),
         passing.size() > 1 ? fmt::format("; next: {} at delta-BIC {:.1f}",
-                                         effect_spec(library, passing[1]->effect).name, passing[1]->delta_bic)
+                                         effect_spec(library, passing[1]->effect).name, passing[1]->delta_bic())
                            : std::string());
     result.experiment.clear();
   }
@@ -151,7 +151,7 @@ namespace {
 /// The candidates tried in a comparison, each with its delta-BIC, for a note.
 std::string hypotheses_tried(const EnsembleResult& ens) {
   return fmt::format("{}", fmt::join(ens.hypotheses | std::views::transform([](const EnsembleHypothesis& h) {
-                                       return fmt::format("{} delta-BIC {:.1f}{}", effect_name(h.effect), h.delta_bic,
+                                       return fmt::format("{} delta-BIC {:.1f}{}", effect_name(h.effect), h.delta_bic(),
                                                           h.plausible ? "" : " (implausible value)");
                                      }),
                                      ", "));
@@ -516,7 +516,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   // whether or not the coarse null is consistent: a candidate that beats a consistent null by
   // the margin may still only absorb the coarse clump's bias (generated control-05 at 240 fps
   // was named viscous_rolling so).
-  const LetThrough best{passing.front()->effect, passing.front()->delta_bic};
+  const LetThrough best{passing.front()->effect, passing.front()->delta_bic()};
   auto explained =
       finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, options.max_evaluations, best);
   if (!explained) return std::unexpected(explained.error());

@@ -723,7 +723,6 @@ Result<EnsembleHypothesis> confirm(const Evaluator& ev, const std::vector<Plan>&
   const Margin margin =
       margin_over_null(result.null_chi2, h.chi2, result.outcomes, free.size(), spec.parameters.size());
   h.dispersion = margin.dispersion;
-  h.delta_bic = margin.delta_bic;
   h.first_delta_bic = margin.delta_bic;
   h.comparisons = std::move(fitted->comparisons);
   h.plausible = spec.plausible(h.values);
@@ -739,7 +738,7 @@ Result<void> replay_afresh(const Evaluator& ev, const std::vector<TrialScore>& s
   std::vector<Plan> fresh;
   std::optional<double> null_chi2;
   for (EnsembleHypothesis& h : result.hypotheses) {
-    if (!h.plausible || h.delta_bic < options.min_delta_bic) continue;
+    if (!h.plausible || h.delta_bic() < options.min_delta_bic) continue;
     if (!null_chi2) {
       fresh = make_plans(ev, scores, options, stream);
       auto out = replay_outcomes(ev, null_model, fresh, std::vector<bool>(fresh.size(), true), nullptr, result.replays);
@@ -754,7 +753,6 @@ Result<void> replay_afresh(const Evaluator& ev, const std::vector<TrialScore>& s
     if (!out) return std::unexpected(out.error());
     const double chi2 = chi2_of(compare_all(fresh, *out, options.impact_accuracy));
     h.fresh_delta_bic = margin_over_null(*null_chi2, chi2, result.outcomes, free, h.values.size()).delta_bic;
-    h.delta_bic = std::min(h.delta_bic, h.fresh_delta_bic);
   }
   return {};
 }
@@ -869,7 +867,7 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   if (auto ok = replay_afresh(ev, scores, null_model, free.size(), options, 190000, result); !ok)
     return std::unexpected(ok.error());
   std::sort(result.hypotheses.begin(), result.hypotheses.end(),
-            [](const EnsembleHypothesis& a, const EnsembleHypothesis& b) { return a.delta_bic > b.delta_bic; });
+            [](const EnsembleHypothesis& a, const EnsembleHypothesis& b) { return a.delta_bic() > b.delta_bic(); });
   return result;
 }
 

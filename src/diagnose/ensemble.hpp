@@ -141,12 +141,16 @@ struct EnsembleHypothesis {
   std::vector<SurfaceParameters> base;  ///< with the free coefficients refitted
   double chi2 = 0.0;                    ///< from replays at that point
   double dispersion = 1.0;  ///< its chi^2 per degree of freedom when above 1: the margin is judged in these units
-  double delta_bic = 0.0;   ///< against the calibrated null: delta-chi^2 / dispersion - k ln n (the lower draw)
+  /// Against the calibrated null, on the first draw of orientations: delta-chi^2 / dispersion - k ln n.
+  double first_delta_bic = 0.0;
   /// Its delta-BIC with the null and it replayed from orientations drawn afresh (NaN when not
-  /// replayed: only a candidate that reaches the margin on the first draw is). delta_bic is the
-  /// lower of the two: chaotic replays move chi^2 by tens between draws.
+  /// replayed: only a candidate that reaches the margin on the first draw is).
   double fresh_delta_bic = std::numeric_limits<double>::quiet_NaN();
-  double first_delta_bic = 0.0;  ///< its delta-BIC on the first draw of orientations
+  /// The lower of its two draws' delta-BICs, what it is judged by: chaotic replays move chi^2 by
+  /// tens between draws.
+  double delta_bic() const {
+    return std::isfinite(fresh_delta_bic) ? std::min(first_delta_bic, fresh_delta_bic) : first_delta_bic;
+  }
   /// The higher of its two draws' delta-BICs: how well it can explain the outcomes (a rival to a
   /// named candidate, whose lower draw is what names it).
   double best_delta_bic() const {

@@ -430,7 +430,7 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
     ens.detectability.push_back({Effect::ViscousRolling, 0.0, 0.0, 13.0, std::numeric_limits<double>::infinity()});
     EnsembleHypothesis tried;
     tried.effect = Effect::PlasticSubstrate;
-    tried.delta_bic = -1.7;
+    tried.first_delta_bic = -1.7;
     ens.hypotheses.push_back(tried);
     diagnosis::say_what_outcomes_decide(result, ens);
     const bool undecided = std::count(result.undecidable.begin(), result.undecidable.end(), "plastic_substrate") == 1;
@@ -476,7 +476,7 @@ TEST(EnsembleConvergedLadder, CandidatesAreJudgedOnTheFinestClumpOnlyOnceItHasCo
     h.effect = Effect::ViscoelasticRestitution;
     h.values.assign(parameters, 0.1);
     h.plausible = true;
-    h.delta_bic = k.delta_bic;
+    h.first_delta_bic = k.delta_bic;
     for (int o = 0; o < 20; ++o)
       h.comparisons.push_back({.statistic = o < 10 ? Statistic::Mean : Statistic::Spread, .z = 0.5});
     h.chi2 = 5.0;
@@ -517,7 +517,6 @@ TEST(EnsembleRival, ACandidateWithinTheMarginOnEitherDrawMakesTheVerdictAmbiguou
       h.plausible = plausible;
       h.first_delta_bic = first;
       h.fresh_delta_bic = fresh;
-      h.delta_bic = std::min(first, fresh);
       for (int o = 0; o < 20; ++o)
         h.comparisons.push_back({.statistic = o < 10 ? Statistic::Mean : Statistic::Spread, .z = 0.5});
       return h;
