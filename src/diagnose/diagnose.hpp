@@ -78,10 +78,13 @@ struct ParticleModelRung {
   /// The largest misfit it leaves: a phase's chi^2 per value (frames), or a recorded mean's
   /// z^2 (outcomes beyond the release horizon), as chi2_per_value is per value or per mean.
   double worst_phase_chi2_per_value = 0.0;
-  bool explains = false;  ///< it leaves no large misfit: the mismatch was the particle model's
+  /// It leaves no large misfit: the mismatch was the particle model's. Beyond the release horizon
+  /// also that the next clump, when there is one, replays the same outcomes (its outcome_shift
+  /// converged); an agreement that moved on is not an explanation (a note says so).
+  bool explains = false;
   /// Beyond the release horizon: how its replayed outcomes moved from the previous clump's at
   /// that clump's calibrated coefficients (empty when not compared on outcomes, or when it
-  /// explains them).
+  /// explains them and the previous clump did not).
   std::optional<OutcomeShift> outcome_shift;
 };
 
