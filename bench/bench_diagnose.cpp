@@ -223,8 +223,9 @@ struct CaseScore {
   std::string truth, magnitude, verdict;
   double heldout_before = NAN, heldout_after = NAN, seconds = NAN;
   bool detected = false;
-  bool called_decided = false;  ///< the concealed effect is not among the report's undecidable ones
-  int undecidable = 0;          ///< how many effects the report lists as undecidable
+  bool called_decided =
+      false;  ///< the concealed effect is neither among the report's undecidable ones nor its ambiguous candidates
+  int undecidable = 0;                                     ///< how many effects the report lists as undecidable
   std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
 };
 
@@ -244,7 +245,11 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   o.seconds = j.value("seconds", NAN);
   if (j.contains("undecidable") && j["undecidable"].is_array()) {
     const auto& u = j["undecidable"];
-    o.called_decided = std::find(u.begin(), u.end(), truth) == u.end();
+    // An ambiguous pair that holds the truth does not call it absent either.
+    const bool among_candidates =
+        j.contains("candidates") && j["candidates"].is_array() &&
+        std::find(j["candidates"].begin(), j["candidates"].end(), truth) != j["candidates"].end();
+    o.called_decided = std::find(u.begin(), u.end(), truth) == u.end() && !among_candidates;
     o.undecidable = static_cast<int>(u.size());
   }
   if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
@@ -322,8 +327,10 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   md += fmt::format("\nfalse-positive rate on {} controls (any verdict but none): {}/{} = {:.1f} %\n", control_count,
                     false_positives, control_count, 100.0 * fpr);
   md += fmt::format("controls blamed on an effect (named or ambiguous): {}/{}\n", named_controls, control_count);
-  md += fmt::format("strong effects missed that the report called decided (not in its undecidable list): {}/{}\n",
-                    missed_decided, strong_count);
+  md += fmt::format(
+      "strong effects missed that the report called decided (neither in its undecidable list nor an ambiguous "
+      "candidate): {}/{}\n",
+      missed_decided, strong_count);
   md += fmt::format("effects a control's `none` decides absent (not undecidable), median of {}: {:.0f} of {}\n",
                     decided_absent.size(), median(decided_absent), library.size());
   md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
