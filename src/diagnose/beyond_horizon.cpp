@@ -310,12 +310,12 @@ std::string agreement_unconverged(const ParticleModelRung& agreed, const Particl
 }
 
 /// The finest clump agrees with the recorded outcomes and no candidate passes there, but one
-/// passed on the coarser clump `before`, whose agreement the finest clump's outcomes moved away
-/// from (its outcome_shift): whether that candidate is missing physics or the coarser clump's
-/// share hangs on the resolution, and no clump at hand has converged. Undecidable, asking for
-/// finer clumps. Lab-like case-08 (elastic-plastic restitution): named on 128 spheres before
-/// finer_clump_explains_outcomes checked agreements; delta-BIC 5.9 on 256, whose outcomes moved
-/// from 128's by 3.3 recorded standard errors.
+/// passed on a coarser agreeing clump whose agreement the next clump moved away from, and the
+/// finest clump's outcomes moved from those of `before`, the clump before it (its outcome_shift): whether that
+/// candidate is missing physics or the coarser clump's share hangs on the resolution, and no clump at hand has
+/// converged. Undecidable, asking for finer clumps. Lab-like case-08 (elastic-plastic restitution): named on 128
+/// spheres before finer_clump_explains_outcomes checked agreements; delta-BIC 5.9 on 256, whose outcomes moved from
+/// 128's by 3.3 recorded standard errors.
 void undecided_by_resolution(DiagnoseResult& result, const ParticleModelRung& before, const ParticleModelRung& finest,
                              const std::vector<Effect>& passed) {
   const OutcomeShift& s = *finest.outcome_shift;
@@ -325,13 +325,13 @@ void undecided_by_resolution(DiagnoseResult& result, const ParticleModelRung& be
   result.verdict = Verdict::Undecidable;
   result.basis = Basis::UnconvergedParticleModel;
   result.statement = fmt::format(
-      "Not decidable with these clumps: with {} ({} spheres) the recorded outcomes are consistent with the null and "
-      "{} beats it by the margin; with {} ({} spheres) they are consistent too and nothing beats its null, but from "
-      "{} to {} spheres, at the same coefficients and release orientations, the replayed outcomes still moved "
-      "(chi^2 {:.1f} over {} means, p = {:.2g}, up to {:.1f} recorded standard errors). Whether {} is missing physics "
-      "or the coarser clump's share hangs on a particle model that has not converged.",
-      before.name, before.spheres, names, finest.name, finest.spheres, before.spheres, finest.spheres, s.chi2, s.means,
-      s.p, s.largest, names);
+      "Not decidable with these clumps: on a coarser clump whose null agrees with the recorded outcomes, {} beat "
+      "that null by the margin, and the next clump's outcomes moved away from it; with {} ({} spheres), the finest, "
+      "the outcomes are consistent with the null and nothing beats it, but from {} to {} spheres, at the same "
+      "coefficients and release orientations, the replayed outcomes still moved (chi^2 {:.1f} over {} means, p = "
+      "{:.2g}, up to {:.1f} recorded standard errors). Whether {} is missing physics or the coarser clump's share "
+      "hangs on a particle model that has not converged.",
+      names, finest.name, finest.spheres, before.spheres, finest.spheres, s.chi2, s.means, s.p, s.largest, names);
   result.experiment = finer_clumps_experiment(finest.spheres);
 }
 
@@ -406,7 +406,10 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     if (rung.explains && k + 1 == c.finer.size()) {
       // The finest clump at hand: nothing finer to check its agreement against.
       settle_on_explaining_clump(result, check, rung, *fine, eo, coarse, let_through, passed_unconverged);
-      if (result.verdict == Verdict::None && !passed_unconverged.empty())
+      // (Its move from the clump before is known when that clump agreed too; after a clump that
+      // did not, the candidate stays listed undecidable under the particle model's `none`.)
+      if (result.verdict == Verdict::None && !passed_unconverged.empty() && rung.outcome_shift &&
+          !rung.outcome_shift->converged())
         undecided_by_resolution(result, check.rungs.at(k), rung, passed_unconverged);
       return true;
     }
