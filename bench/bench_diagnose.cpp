@@ -223,8 +223,8 @@ struct CaseScore {
   std::string truth, magnitude, verdict;
   double heldout_before = NAN, heldout_after = NAN, seconds = NAN;
   bool detected = false;
-  bool called_decided =
-      false;  ///< the concealed effect is neither among the report's undecidable ones nor its ambiguous candidates
+  /// The concealed effect is neither among the report's undecidable ones nor its ambiguous candidates.
+  bool called_decided = false;
   int undecidable = 0;                                     ///< how many effects the report lists as undecidable
   std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
 };

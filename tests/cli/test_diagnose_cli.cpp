@@ -175,7 +175,8 @@ TEST(DiagnoseCli, SummariesOnlySayWhatTheyCanDecide) {
 }
 
 // One tuber case of ../shared/data/lab-like (a simulator that shares no code with this project)
-// diagnosed from its mesh with no finer clump, as the JSON report; empty when the command failed.
+// diagnosed from its mesh with `finer_clumps` finer fills (none by default), as the JSON report;
+// empty when the command failed.
 nlohmann::json diagnose_lab_like_tuber(const std::string& case_id, const std::filesystem::path& out,
                                        int finer_clumps = 0) {
   const auto set = test::shared_dir() / "data" / "lab-like";

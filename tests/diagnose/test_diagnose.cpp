@@ -502,7 +502,7 @@ TEST(DiagnoseParticleModel, AControlMadeFromAFinerBodyIsTheClumpsNotMissingPhysi
 struct Control09 {
   Clump coarse;  ///< the 4 mm lattice of the same scan: 55 equal spheres
   std::vector<Clump> ladder;
-  MaterialTable table = default_material_table();
+  MaterialTable table;
   ConcealResult made;
 };
 std::optional<Control09> control_09(const std::vector<std::string>& rungs) {
@@ -536,6 +536,15 @@ std::optional<Control09> control_09(const std::vector<std::string>& rungs) {
   return set;
 }
 
+// Control-09 diagnosed with the 4 mm lattice, its rolls replayed from any orientation, given
+// `finer` clumps of the same scan.
+Result<DiagnoseResult> diagnose_control_09(const Control09& set, std::vector<Clump> finer) {
+  DiagnoseOptions options;
+  options.roll_release = RollPosture::Any;
+  options.finer_clumps = std::move(finer);
+  return diagnose(set.coarse, set.table, set.made.recordings, set.made.names, options);
+}
+
 TEST(DiagnoseParticleModel, BeyondTheHorizonACoarseClumpIsCheckedBeforeAnEffectIsNamed) {
   // Control-09 diagnosed with a clump built otherwise and coarser in its contacts (the 4 mm
   // lattice): frame by frame nothing misfits, and beyond the release horizon no coefficient
@@ -546,14 +555,11 @@ TEST(DiagnoseParticleModel, BeyondTheHorizonACoarseClumpIsCheckedBeforeAnEffectI
   // here; its calibrated null now reproduces these outcomes, as the finer body's should.)
   auto set = control_09({"adaptive-64"});
   ASSERT_TRUE(set);
-  DiagnoseOptions options;
-  options.roll_release = RollPosture::Any;
-  auto alone = diagnose(set->coarse, set->table, set->made.recordings, set->made.names, options);
+  auto alone = diagnose_control_09(*set, {});
   ASSERT_TRUE(alone) << alone.error().message;
   EXPECT_EQ(alone->verdict, Verdict::Unexplained) << alone->statement;
   EXPECT_EQ(alone->basis, Basis::UnexplainedOutcomes) << alone->statement;
-  options.finer_clumps = set->ladder;
-  auto checked = diagnose(set->coarse, set->table, set->made.recordings, set->made.names, options);
+  auto checked = diagnose_control_09(*set, set->ladder);
   ASSERT_TRUE(checked) << checked.error().message;
   EXPECT_EQ(checked->verdict, Verdict::None) << checked->statement;
   EXPECT_EQ(checked->basis, Basis::ParticleModel) << checked->statement;
@@ -571,10 +577,7 @@ TEST(DiagnoseParticleModel, AClumpThatAgreesExplainsOnlyOnceTheNextReplaysTheSam
   // never blamed on an effect.
   auto set = control_09({"adaptive-64", "adaptive-128"});
   ASSERT_TRUE(set);
-  DiagnoseOptions options;
-  options.roll_release = RollPosture::Any;
-  options.finer_clumps = set->ladder;
-  auto checked = diagnose(set->coarse, set->table, set->made.recordings, set->made.names, options);
+  auto checked = diagnose_control_09(*set, set->ladder);
   ASSERT_TRUE(checked) << checked.error().message;
   EXPECT_NE(checked->verdict, Verdict::Named) << checked->statement;
   EXPECT_NE(checked->verdict, Verdict::Ambiguous) << checked->statement;
