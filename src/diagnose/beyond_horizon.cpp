@@ -247,8 +247,8 @@ struct Coarse {
 
 /// The verdict once the finer clump `rung` explains the outcomes (`fine` its comparison, its null
 /// consistent with them): the candidates are tried there; one that passes is named on its
-/// outcomes, else the mismatch is the particle model's.
-void settle_on_explaining_clump(DiagnoseResult& result, ParticleModelCheck& check, const ParticleModelRung& rung,
+/// outcomes, else the mismatch is the particle model's. Returns whether a candidate was named.
+bool settle_on_explaining_clump(DiagnoseResult& result, ParticleModelCheck& check, const ParticleModelRung& rung,
                                 const EnsembleResult& fine, const EnsembleOptions& eo, const Coarse& coarse,
                                 std::optional<LetThrough> let_through, const std::vector<Effect>& passed_unconverged) {
   check.resolution_needed = rung.spheres;
@@ -280,7 +280,7 @@ void settle_on_explaining_clump(DiagnoseResult& result, ParticleModelCheck& chec
           rung.spheres, effect_name(let_through->effect), rung.spheres);
     }
     result.improved = fine.calibrated;  // the finer clump's coefficients, calibrated on the outcomes
-    return;
+    return false;
   }
   // Named on the clump the body needs: the report's ensemble is that clump's.
   report_ensemble(*result.ensemble, fine);
@@ -295,6 +295,7 @@ void settle_on_explaining_clump(DiagnoseResult& result, ParticleModelCheck& chec
                               "from the replays beyond the noise (chi^2 {:.1f} over {}), with this one they do not "
                               "(chi^2 {:.1f}) until the effect is tried.",
                               rung.name, rung.spheres, coarse.chi2, coarse.outcomes, fine.null_chi2);
+  return true;
 }
 
 /// The note when a clump's null agreed with the recorded outcomes but the next clump's outcomes,
@@ -405,11 +406,11 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     rung.explains = fine->outcomes == coarse.outcomes && outcomes_consistent(fine->null_comparisons, free.size());
     if (rung.explains && k + 1 == c.finer.size()) {
       // The finest clump at hand: nothing finer to check its agreement against.
-      settle_on_explaining_clump(result, check, rung, *fine, eo, coarse, let_through, passed_unconverged);
+      const bool named =
+          settle_on_explaining_clump(result, check, rung, *fine, eo, coarse, let_through, passed_unconverged);
       // (Its move from the clump before is known when that clump agreed too; after a clump that
       // did not, the candidate stays listed undecidable under the particle model's `none`.)
-      if (result.verdict == Verdict::None && !passed_unconverged.empty() && rung.outcome_shift &&
-          !rung.outcome_shift->converged())
+      if (!named && !passed_unconverged.empty() && rung.outcome_shift && !rung.outcome_shift->converged())
         undecided_by_resolution(result, check.rungs.at(k), rung, passed_unconverged);
       return true;
     }
