@@ -412,15 +412,100 @@ Result<bool> rejected(Context& c, CellProbe& cells, AbsenceCheck& check, const M
   return report.strong_delta_chi2 >= needed + kResolutionAllowance * report.strong_resolution_chi2;
 }
 
+/// A candidate at a fraction `t` of its strong magnitude: each parameter moved from its null value
+/// t times the way to its strong one.
+Model effect_at(const Model& baseline, const EffectSpec& spec, double t) {
+  Model probe = baseline;
+  probe.effect = spec.effect;
+  const std::vector<double> off = effect_off(spec);
+  for (std::size_t i = 0; i < spec.parameters.size(); ++i)
+    probe.values.push_back(off[i] + t * (spec.parameters[i].strong - off[i]));
+  return probe;
+}
+
+/// The largest fraction of its strong magnitude a candidate may take within its parameters'
+/// search ranges.
+double largest_fraction(const EffectSpec& spec) {
+  const std::vector<double> off = effect_off(spec);
+  double t = kNever;
+  for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
+    const EffectParameter& p = spec.parameters[i];
+    const double way = p.strong - off[i];
+    if (way != 0.0) t = std::min(t, ((way > 0.0 ? p.upper : p.lower) - off[i]) / way);
+  }
+  return t;
+}
+
+/// What a candidate's replays show against the baseline's: the squared norm of their move once
+/// the coefficients absorb what they can (noise units), and the largest misfit it would leave in
+/// a phase. Each is scaled to its margin: `shown()` is the smaller ratio (1 or more: it shows).
+struct Shown {
+  double signal = 0.0, misfit = 0.0;
+  double needed = 1.0, needed_misfit = 1.0;
+  double shown() const { return std::min(signal / needed, misfit / needed_misfit); }
+  /// The fraction of `t` at which both would reach their margins were the response linear in
+  /// the magnitude (both grow as its square).
+  double linear_scale() const { return std::max(std::sqrt(needed / signal), std::sqrt(needed_misfit / misfit)); }
+};
+
+/// How many replays check a candidate's first-order smallest detectable magnitude.
+constexpr int kDetectableReplays = 3;
+
+/// The fractions of its strong magnitude a candidate's replays were tried at: the smallest that
+/// showed (both margins; NaN when none did) and the largest below it that did not.
+struct Bracket {
+  double shown = NAN, missed = 0.0;
+  double first_order = NAN;                    ///< the first guess (quadratic scaling from the strong magnitude)
+  std::vector<std::pair<double, bool>> tried;  ///< each fraction replayed, and whether it showed
+};
+
+/// The smallest fraction of its strong magnitude at which a replay of the candidate shows. The first-order figure (what
+/// shows at the strong magnitude, scaled quadratically) is only a first guess: a response that is not linear in the
+/// magnitude scales wrongly (lab-like case-21, a sphere: adhesion "would show" from a work of adhesion of 0.0096 J/m^2
+/// scaled down from its strong 0.4, where a pull-off of half the weight captures the last bounces; recorded with about
+/// 0.08, the coefficients absorbed it to the noise). Each guess is replayed and the next taken from that replay's
+/// scale, kept between the largest fraction that did not show and the smallest that did (their geometric mean when a
+/// guess leaves that bracket).
+Result<Bracket> smallest_shown_fraction(CellProbe& cells, const Model& baseline, const EffectSpec& spec,
+                                        const Eigen::VectorXd& base_cells, const ResidualProjection& keep,
+                                        const Shown& strong, const Context& c) {
+  const bool strong_shows = strong.shown() >= 1.0;
+  double shown = strong_shows ? 1.0 : NAN, missed = strong_shows ? 0.0 : 1.0;
+  const double top = largest_fraction(spec);
+  double t = strong.linear_scale();
+  Bracket out{.first_order = t};
+  if (strong_shows && !(t < 1.0)) return out;  // nothing below the strong magnitude to try
+  for (int k = 0; k < kDetectableReplays; ++k) {
+    const bool bracketed = std::isfinite(shown);
+    if (bracketed ? !(t > missed && t < shown) : !(t > missed))
+      t = bracketed ? std::sqrt(std::max(missed, shown / 16.0) * shown) : 2.0 * missed;
+    t = std::min(t, top);
+    if (!(t > missed)) break;
+    auto probed = cells(effect_at(baseline, spec, t));
+    if (!probed) return std::unexpected(probed.error());
+    if (probed->values.size() != base_cells.size()) break;
+    const Eigen::VectorXd kept = keep(base_cells - probed->values);
+    const Shown at{kept.squaredNorm(), largest_signal_misfit(c, cells.keys, kept), strong.needed, strong.needed_misfit};
+    (at.shown() >= 1.0 ? shown : missed) = t;
+    out.tried.emplace_back(t, at.shown() >= 1.0);
+    if (std::isfinite(shown) && shown < 1.15 * missed) break;
+    t = at.signal > 0.0 && at.misfit > 0.0 ? t * at.linear_scale() : 2.0 * t;
+  }
+  out.shown = shown;
+  out.missed = missed;
+  return out;
+}
+
 }  // namespace
 
 /// For a `none`: each candidate replayed at its strong magnitude. Its signal there (its
-/// replays minus the baseline's, the part the coefficients could absorb projected out) gives
-/// the smallest effect the data could have shown, scaled quadratically down (or up) to the
-/// delta-BIC margin and to a large misfit in one phase, whichever needs more (first order, in
-/// each hypothesis report). An effect counts as decided (absent) only when it would show and
-/// the recordings themselves reject its strong magnitude by the margin: with each trial
-/// released at the most favourable of the orientations its prior allows that were tried
+/// replays minus the baseline's, the part the coefficients could absorb projected out),
+/// scaled quadratically down (or up) to the delta-BIC margin and to a large misfit in one
+/// phase, whichever needs more, is a first guess of the smallest effect the data could have
+/// shown; the figure reported (in each hypothesis report) is the smallest magnitude a replay
+/// showed, the guess refined by up to kDetectableReplays replays (smallest_shown_fraction). An effect counts as decided
+/// (absent) only when it would show and the recordings themselves reject its strong magnitude by the margin: with each
+/// trial released at the most favourable of the orientations its prior allows that were tried
 /// (rejection_over_releases), with the coefficients refitted at the strong magnitude, and by
 /// more than twice how far the next finer clump's response to it lies from the diagnosed
 /// clump's. A first-order signal alone is not a test: the diagnosed clump responds to an
@@ -456,9 +541,7 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
   for (std::size_t h = 0; h < result.hypotheses.size(); ++h) {
     auto& report = result.hypotheses[h];
     const EffectSpec& spec = effect_spec(library, *fits[h].model.effect);
-    Model probe = baseline;
-    probe.effect = spec.effect;
-    for (const auto& p : spec.parameters) probe.values.push_back(p.strong);
+    const Model probe = effect_at(baseline, spec, 1.0);
     auto probed = cells(probe);
     if (!probed) return std::unexpected(probed.error());
     const Eigen::VectorXd& probe_cells = probed->values;
@@ -484,12 +567,29 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
       limits.push_back(shows ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.strong)
                              : fmt::format("{} would not show with {} {:.3g}", spec.name, first.name, first.strong));
     } else {
+      // The first-order figure checked by replays (smallest_shown_fraction).
+      Bracket tried{.shown = NAN, .missed = 0.0};
+      if (signal > 0.0 && misfit > 0.0) {
+        auto bracket = smallest_shown_fraction(cells, baseline, spec, base_cells, keep,
+                                               Shown{signal, misfit, needed, needed_misfit}, c);
+        if (!bracket) return std::unexpected(bracket.error());
+        tried = *bracket;
+      }
       const double null_value = effect_off(spec)[0];
-      // Both grow as the magnitude's square while the response is linear.
-      const double scale = std::max(std::sqrt(needed / signal), std::sqrt(needed_misfit / misfit));
-      report.smallest_detectable =
-          signal > 0.0 && misfit > 0.0 ? null_value + (first.strong - null_value) * scale : kNever;
-      limits.push_back(fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable));
+      const auto magnitude = [&](double t) { return null_value + (first.strong - null_value) * t; };
+      report.smallest_detectable = std::isfinite(tried.shown) ? magnitude(tried.shown) : kNever;
+      limits.push_back(std::isfinite(tried.shown)
+                           ? fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable)
+                           : fmt::format("{} not shown by a replay with {} up to {:.3g}", spec.name, first.name,
+                                         magnitude(std::max(1.0, tried.missed))));
+      if (!tried.tried.empty())
+        result.notes.push_back(fmt::format(
+            "{}'s smallest detectable {}: {:.3g} to first order (scaled from its strong {:.3g}); replayed at {}",
+            spec.name, first.name, magnitude(tried.first_order), first.strong,
+            fmt::join(tried.tried | std::views::transform([&](const std::pair<double, bool>& r) {
+                        return fmt::format("{:.3g} ({})", magnitude(r.first), r.second ? "shows" : "does not show");
+                      }),
+                      ", ")));
     }
     // Decided only where it would show at its strong magnitude and the recordings reject that
     // magnitude; otherwise said, not counted as absent.

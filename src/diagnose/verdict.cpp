@@ -145,7 +145,7 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
   result.statement = fmt::format(
       "No missing physics found: no candidate passes every check and {}. Smallest effects these recordings would "
       "have revealed (at delta-BIC {:g} and a phase misfit of three times hypot(noise, model accuracy), after the "
-      "coefficients absorb what they can, to first order): {}.",
+      "coefficients absorb what they can to first order; each a magnitude a replay showed): {}.",
       residual_state, options.min_delta_bic, fmt::join(limits, "; "));
   if (!untestable.empty()) {
     // What the frame-by-frame fit cannot reach: the effects that act after the release
