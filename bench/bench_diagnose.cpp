@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -225,7 +226,11 @@ struct CaseScore {
   bool detected = false;
   /// The concealed effect is neither among the report's undecidable ones nor its ambiguous candidates.
   bool called_decided = false;
-  int undecidable = 0;                                     ///< how many effects the report lists as undecidable
+  int undecidable = 0;  ///< how many effects the report lists as undecidable
+  /// The smallest detectable magnitude the report gives for the concealed effect (NaN: none given).
+  double smallest_detectable = NAN;
+  /// Missed, yet the report says a magnitude at or below the concealed one would have shown.
+  bool overclaimed = false;
   std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
 };
 
@@ -251,6 +256,11 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
         std::find(j["candidates"].begin(), j["candidates"].end(), truth) != j["candidates"].end();
     o.called_decided = std::find(u.begin(), u.end(), truth) == u.end() && !among_candidates;
     o.undecidable = static_cast<int>(u.size());
+  }
+  if (j.contains("hypotheses") && j["hypotheses"].is_array()) {
+    for (const auto& h : j["hypotheses"])
+      if (h.value("name", "") == truth && h.contains("smallest_detectable") && h["smallest_detectable"].is_number())
+        o.smallest_detectable = h["smallest_detectable"].get<double>();
   }
   if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
     for (const auto& cmp : j["ensemble"]["comparisons"])
@@ -288,6 +298,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
     md += "\n";
   }
   int control_count = 0, false_positives = 0, named_controls = 0, strong_count = 0, missed_decided = 0;
+  int missed = 0, overclaimed = 0;
   std::vector<double> improvements, seconds, decided_absent;
   nlohmann::json summary;
   for (const auto& o : outcomes) {
@@ -305,6 +316,8 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
       strong_count += o.magnitude == "strong";
       // The decidable list speaks of the strong magnitude: a missed realistic one may lie below it.
       missed_decided += o.magnitude == "strong" && !o.detected && o.called_decided;
+      missed += !o.detected;
+      overclaimed += o.overclaimed;
     }
   }
   md += "\n| effect | realistic | strong |\n|---|---:|---:|\n";
@@ -331,6 +344,9 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
       "strong effects missed that the report called decided (neither in its undecidable list nor an ambiguous "
       "candidate): {}/{}\n",
       missed_decided, strong_count);
+  md += fmt::format(
+      "effects missed whose report gives a smallest detectable magnitude at or below the concealed one: {}/{}\n",
+      overclaimed, missed);
   md += fmt::format("effects a control's `none` decides absent (not undecidable), median of {}: {:.0f} of {}\n",
                     decided_absent.size(), median(decided_absent), library.size());
   md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
@@ -363,6 +379,8 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   summary["controls_blamed_on_an_effect"] = named_controls;
   summary["controls"] = control_count;
   summary["strong_effects_missed_yet_called_decided"] = missed_decided;
+  summary["effects_missed"] = missed;
+  summary["missed_yet_claimed_detectable"] = overclaimed;
   summary["median_effects_decided_absent_on_controls"] = median(decided_absent);
   summary["median_heldout_improvement"] = median(improvements);
   summary["median_seconds"] = median(seconds);
@@ -551,6 +569,14 @@ int score_generated(const std::vector<Case>& cases, const std::string& out) {
     if (!o) {
       std::cerr << c.id << ": unreadable report\n";
       return 1;
+    }
+    if (c.effect && !o->detected && std::isfinite(o->smallest_detectable)) {
+      // The first parameter's way from the effect's null value: the figure claims the concealed
+      // magnitude would have shown when it lies no farther along it.
+      const EffectSpec& spec = effect_spec(library, *c.effect);
+      const double off = effect_off(spec)[0], hidden = c.options.values.at(0) - off;
+      const double claimed = o->smallest_detectable - off;
+      o->overclaimed = hidden * claimed > 0.0 && std::abs(claimed) <= std::abs(hidden);
     }
     std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id,
                              truth, o->verdict, o->heldout_before, o->heldout_after, o->seconds)
