@@ -58,6 +58,27 @@ ConcealOptions one_metre_drops(std::optional<Effect> effect = std::nullopt, std:
   return conceal;
 }
 
+// Recordings of the finer 340-sphere body made with `conceal`, diagnosed against the 32-sphere
+// clump with `effect` the only candidate and no replay ensembles (the frame-by-frame figures are
+// the ones asserted), and `finer` for the particle-model check.
+Result<DiagnoseResult> diagnose_frame_by_frame(const ConcealOptions& conceal, Effect effect,
+                                               std::vector<Clump> finer = {}) {
+  auto made = make_concealed_recordings(test::generator_tuber(), default_material_table(), conceal);
+  if (!made) return std::unexpected(made.error());
+  DiagnoseOptions options;
+  options.effects = {effect};
+  options.ensemble_replays = 0;
+  options.finer_clumps = std::move(finer);
+  return diagnose(diagnosis_clump(), default_material_table(), made->recordings, made->names, options);
+}
+
+// The report of the candidate `name`, or null.
+const HypothesisReport* hypothesis_named(const DiagnoseResult& result, std::string_view name) {
+  for (const auto& h : result.hypotheses)
+    if (h.name == name) return &h;
+  return nullptr;
+}
+
 }  // namespace
 
 TEST(DiagnoseMeasurement, NoiseLevelFromThirdDifferences) {
@@ -291,9 +312,6 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
 // the verdict is `none`; the smallest detectable drag reported must then lie above 0.45. At
 // b88cdad it said 0.078 (the delta-BIC alone, generated air_drag-realistic at 240 fps).
 TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) {
-  const Clump clump = diagnosis_clump();
-  const Clump finer = test::generator_tuber();
-  const MaterialTable table = default_material_table();
   // The benchmark's small set (drops from 0.2 and 1 m, a 100 mm roll, a tilt; 4 trials), its
   // air_drag-realistic case's seed.
   ConcealOptions conceal = one_metre_drops(Effect::AirDrag, {0.45});
@@ -303,17 +321,11 @@ TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) 
   conceal.seed = 1001;
   conceal.frame_rate_hz = 240.0;
   conceal.noise_m = 5e-4;
-  auto made = make_concealed_recordings(finer, table, conceal);
-  ASSERT_TRUE(made) << made.error().message;
-  DiagnoseOptions options;
-  options.effects = {Effect::AirDrag};
-  options.ensemble_replays = 0;  // the frame-by-frame figure is the one asserted
-  auto result = diagnose(clump, table, made->recordings, made->names, options);
+  auto result = diagnose_frame_by_frame(conceal, Effect::AirDrag);
   ASSERT_TRUE(result) << result.error().message;
   ASSERT_EQ(result->verdict, Verdict::None) << result->statement;
-  const auto drag = std::find_if(result->hypotheses.begin(), result->hypotheses.end(),
-                                 [](const HypothesisReport& h) { return h.name == "air_drag"; });
-  ASSERT_NE(drag, result->hypotheses.end());
+  const HypothesisReport* drag = hypothesis_named(*result, "air_drag");
+  ASSERT_NE(drag, nullptr);
   EXPECT_GT(drag->smallest_detectable, 0.45) << result->statement;
 }
 
@@ -325,25 +337,16 @@ TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) 
 // misfits these recordings by delta-chi^2 about 3600 (the tilt's): the release is a nuisance,
 // and at other releases the trials allow, the strong offset is not rejected.
 TEST(DiagnoseBlind, AStrongEffectWhosePathHangsOnTheReleaseIsNotCalledAbsent) {
-  const Clump clump = diagnosis_clump();
-  const Clump finer = test::generator_tuber();
-  const MaterialTable table = default_material_table();
   ConcealOptions conceal = one_metre_drops(Effect::ComOffset, {2.5e-3, 1.2e-3});
   conceal.drop_heights = {};
   conceal.roll_starts = {0.10};
   conceal.tilt = true;
-  auto made = make_concealed_recordings(finer, table, conceal);
-  ASSERT_TRUE(made) << made.error().message;
-  DiagnoseOptions options;
-  options.effects = {Effect::ComOffset};
-  options.ensemble_replays = 0;  // the frame-by-frame claim is the one asserted
   // The finer clump the command line checks its particle model with (the ladder's next rung).
   auto ladder = read_clump_library(test::source_dir() / "clumps" / "tuber-default-ladder.h5");
   ASSERT_TRUE(ladder) << ladder.error().message;
   auto next = select_clump(*ladder, "adaptive-64", "tuber-default-ladder.h5");
   ASSERT_TRUE(next) << next.error().message;
-  options.finer_clumps = {*next};
-  auto result = diagnose(clump, table, made->recordings, made->names, options);
+  auto result = diagnose_frame_by_frame(conceal, Effect::ComOffset, {*next});
   ASSERT_TRUE(result) << result.error().message;
   if (result->verdict == Verdict::Named) {
     EXPECT_EQ(result->effect, Effect::ComOffset) << result->statement;
@@ -352,9 +355,8 @@ TEST(DiagnoseBlind, AStrongEffectWhosePathHangsOnTheReleaseIsNotCalledAbsent) {
   ASSERT_EQ(result->verdict, Verdict::None) << result->statement;
   const auto& undecided = result->undecidable;
   EXPECT_EQ(std::count(undecided.begin(), undecided.end(), "com_offset"), 1) << result->statement;
-  const auto offset = std::find_if(result->hypotheses.begin(), result->hypotheses.end(),
-                                   [](const HypothesisReport& h) { return h.name == "com_offset"; });
-  ASSERT_NE(offset, result->hypotheses.end());
+  const HypothesisReport* offset = hypothesis_named(*result, "com_offset");
+  ASSERT_NE(offset, nullptr);
   // A replay of the offset shows at its strong magnitude (the first-order guess of a smaller one is
   // replayed before it is claimed, and here none smaller showed).
   EXPECT_LE(offset->smallest_detectable, 2.5e-3) << result->statement;
@@ -374,27 +376,18 @@ TEST(DiagnoseBlind, AStrongEffectWhosePathHangsOnTheReleaseIsNotCalledAbsent) {
 // at 6ac3aa3 claimed 0.0009 and 0.0006 with 0.1 and 0.25 hidden, and lab-like case-21, a sphere
 // with adhesion of about 0.08 J/m^2 left unnamed, 0.0096 (0.079 replay-checked).
 TEST(DiagnoseBlind, TheSmallestDetectableEffectIsOneAReplayShowed) {
-  const Clump clump = diagnosis_clump();
-  const Clump finer = test::generator_tuber();
-  const MaterialTable table = default_material_table();
   ConcealOptions conceal = one_metre_drops(Effect::StaticKineticFriction, {0.1});
   conceal.drop_heights = {};
   conceal.tilt = true;
-  auto made = make_concealed_recordings(finer, table, conceal);
-  ASSERT_TRUE(made) << made.error().message;
-  DiagnoseOptions options;
-  options.effects = {Effect::StaticKineticFriction};
-  options.ensemble_replays = 0;  // the frame-by-frame figure is the one asserted
-  auto result = diagnose(clump, table, made->recordings, made->names, options);
+  auto result = diagnose_frame_by_frame(conceal, Effect::StaticKineticFriction);
   ASSERT_TRUE(result) << result.error().message;
   if (result->verdict == Verdict::Named) {
     EXPECT_EQ(result->effect, Effect::StaticKineticFriction) << result->statement;
     return;
   }
   ASSERT_EQ(result->verdict, Verdict::None) << result->statement;
-  const auto drop = std::find_if(result->hypotheses.begin(), result->hypotheses.end(),
-                                 [](const HypothesisReport& h) { return h.name == "static_kinetic_friction"; });
-  ASSERT_NE(drop, result->hypotheses.end());
+  const HypothesisReport* drop = hypothesis_named(*result, "static_kinetic_friction");
+  ASSERT_NE(drop, nullptr);
   RecordProperty("smallest_detectable", std::to_string(drop->smallest_detectable));
   EXPECT_GT(drop->smallest_detectable, 0.5 * 0.1) << result->statement;
 }
