@@ -448,8 +448,10 @@ struct Shown {
   double linear_scale() const { return std::max(std::sqrt(needed / signal), std::sqrt(needed_misfit / misfit)); }
 };
 
-/// How many replays check a candidate's first-order smallest detectable magnitude.
+/// How many replays check a candidate's first-order smallest detectable magnitude, and the
+/// ratio of magnitudes (that showed / that did not) at which the search stops.
 constexpr int kDetectableReplays = 3;
+constexpr double kBracketRatio = 1.15;
 
 /// The fractions of its strong magnitude a candidate's replays were tried at: the smallest that
 /// showed (both margins; NaN when none did) and the largest below it that did not.
@@ -464,8 +466,8 @@ struct Bracket {
 /// magnitude scales wrongly (lab-like case-21, a sphere: adhesion "would show" from a work of adhesion of 0.0096 J/m^2
 /// scaled down from its strong 0.4, where a pull-off of half the weight captures the last bounces; recorded with about
 /// 0.08, the coefficients absorbed it to the noise). Each guess is replayed and the next taken from that replay's
-/// scale, kept between the largest fraction that did not show and the smallest that did (their geometric mean when a
-/// guess leaves that bracket).
+/// scale, kept within the inner half (in log) of the bracket between the largest fraction that did not show and the
+/// smallest that did.
 Result<Bracket> smallest_shown_fraction(CellProbe& cells, const Model& baseline, const EffectSpec& spec,
                                         const Eigen::VectorXd& base_cells, const ResidualProjection& keep,
                                         const Shown& strong, const Context& c) {
@@ -476,9 +478,15 @@ Result<Bracket> smallest_shown_fraction(CellProbe& cells, const Model& baseline,
   Bracket out{.first_order = t};
   if (strong_shows && !(t < 1.0)) return out;  // nothing below the strong magnitude to try
   for (int k = 0; k < kDetectableReplays; ++k) {
-    const bool bracketed = std::isfinite(shown);
-    if (bracketed ? !(t > missed && t < shown) : !(t > missed))
-      t = bracketed ? std::sqrt(std::max(missed, shown / 16.0) * shown) : 2.0 * missed;
+    if (std::isfinite(shown) && missed > 0.0) {
+      // Within the inner half of the bracket (in log), so that each replay narrows it.
+      const double lo = std::log(missed), hi = std::log(shown);
+      t = std::clamp(t, std::exp(0.75 * lo + 0.25 * hi), std::exp(0.25 * lo + 0.75 * hi));
+    } else if (std::isfinite(shown)) {
+      if (!(t < shown)) t = shown / 4.0;
+    } else if (!(t > missed)) {
+      t = 2.0 * missed;
+    }
     t = std::min(t, top);
     if (!(t > missed)) break;
     auto probed = cells(effect_at(baseline, spec, t));
@@ -488,8 +496,10 @@ Result<Bracket> smallest_shown_fraction(CellProbe& cells, const Model& baseline,
     const Shown at{kept.squaredNorm(), largest_signal_misfit(c, cells.keys, kept), strong.needed, strong.needed_misfit};
     (at.shown() >= 1.0 ? shown : missed) = t;
     out.tried.emplace_back(t, at.shown() >= 1.0);
-    if (std::isfinite(shown) && shown < 1.15 * missed) break;
+    if (std::isfinite(shown) && shown < kBracketRatio * missed) break;
     t = at.signal > 0.0 && at.misfit > 0.0 ? t * at.linear_scale() : 2.0 * t;
+    // A replay that showed and a next guess within the bracket's ratio of it: close enough.
+    if (at.shown() >= 1.0 && t * kBracketRatio > shown && t < shown) break;
   }
   out.shown = shown;
   out.missed = missed;
