@@ -448,6 +448,14 @@ struct Shown {
   double linear_scale() const { return std::max(std::sqrt(needed / signal), std::sqrt(needed_misfit / misfit)); }
 };
 
+/// What a probe's cells show against the baseline's once the coefficients absorb what they can.
+Shown measure(const Context& c, const std::vector<std::pair<GroupKey, Axis>>& keys, const ResidualProjection& keep,
+              const Eigen::VectorXd& base_cells, const Eigen::VectorXd& probe_cells, double needed,
+              double needed_misfit) {
+  const Eigen::VectorXd kept = keep(base_cells - probe_cells);
+  return Shown{kept.squaredNorm(), largest_signal_misfit(c, keys, kept), needed, needed_misfit};
+}
+
 /// How many replays check a candidate's first-order smallest detectable magnitude, and the
 /// ratio of magnitudes (that showed / that did not) at which the search stops.
 constexpr int kDetectableReplays = 3;
@@ -492,8 +500,7 @@ Result<Bracket> smallest_shown_fraction(CellProbe& cells, const Model& baseline,
     auto probed = cells(effect_at(baseline, spec, t));
     if (!probed) return std::unexpected(probed.error());
     if (probed->values.size() != base_cells.size()) break;
-    const Eigen::VectorXd kept = keep(base_cells - probed->values);
-    const Shown at{kept.squaredNorm(), largest_signal_misfit(c, cells.keys, kept), strong.needed, strong.needed_misfit};
+    const Shown at = measure(c, cells.keys, keep, base_cells, probed->values, strong.needed, strong.needed_misfit);
     (at.shown() >= 1.0 ? shown : missed) = t;
     out.tried.emplace_back(t, at.shown() >= 1.0);
     if (std::isfinite(shown) && shown < kBracketRatio * missed) break;
@@ -558,9 +565,9 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
     double signal = 0.0, misfit = 0.0;
     report.strong_delta_chi2 = NAN;
     if (probe_cells.size() == base_cells.size()) {
-      const Eigen::VectorXd kept = keep(base_cells - probe_cells);
-      signal = kept.squaredNorm();
-      misfit = largest_signal_misfit(c, cells.keys, kept);
+      const Shown strong = measure(c, cells.keys, keep, base_cells, probe_cells, 1.0, 1.0);
+      signal = strong.signal;
+      misfit = strong.misfit;
       // The recordings' own answer (cells are residuals): chi^2 at the strong magnitude minus
       // the null's, each after the coefficients absorb what they can.
       report.strong_delta_chi2 = keep(probe_cells).squaredNorm() - keep(base_cells).squaredNorm();
