@@ -229,8 +229,14 @@ struct CaseScore {
   int undecidable = 0;  ///< how many effects the report lists as undecidable
   /// The smallest detectable magnitude the report gives for the concealed effect (NaN: none given).
   double smallest_detectable = NAN;
-  /// Missed, yet the report says a magnitude at or below the concealed one would have shown.
-  bool overclaimed = false;
+  /// The concealed effect's first parameter and its null value (NaN: not known to the scorer).
+  double concealed = NAN, null_value = NAN;
+  /// Missed, yet the report says a magnitude at or below the concealed one would have shown: the
+  /// figure lies no farther from the effect's null value, the same way, than the concealed one.
+  bool overclaimed() const {
+    const double hidden = concealed - null_value, claimed = smallest_detectable - null_value;
+    return !detected && hidden * claimed > 0.0 && std::abs(claimed) <= std::abs(hidden);
+  }
   std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
 };
 
@@ -317,7 +323,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
       // The decidable list speaks of the strong magnitude: a missed realistic one may lie below it.
       missed_decided += o.magnitude == "strong" && !o.detected && o.called_decided;
       missed += !o.detected;
-      overclaimed += o.overclaimed;
+      overclaimed += o.overclaimed();
     }
   }
   md += "\n| effect | realistic | strong |\n|---|---:|---:|\n";
@@ -570,13 +576,9 @@ int score_generated(const std::vector<Case>& cases, const std::string& out) {
       std::cerr << c.id << ": unreadable report\n";
       return 1;
     }
-    if (c.effect && !o->detected && std::isfinite(o->smallest_detectable)) {
-      // The first parameter's way from the effect's null value: the figure claims the concealed
-      // magnitude would have shown when it lies no farther along it.
-      const EffectSpec& spec = effect_spec(library, *c.effect);
-      const double off = effect_off(spec)[0], hidden = c.options.values.at(0) - off;
-      const double claimed = o->smallest_detectable - off;
-      o->overclaimed = hidden * claimed > 0.0 && std::abs(claimed) <= std::abs(hidden);
+    if (c.effect) {
+      o->concealed = c.options.values.at(0);
+      o->null_value = effect_off(effect_spec(library, *c.effect))[0];
     }
     std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id,
                              truth, o->verdict, o->heldout_before, o->heldout_after, o->seconds)

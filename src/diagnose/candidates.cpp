@@ -412,14 +412,18 @@ Result<bool> rejected(Context& c, CellProbe& cells, AbsenceCheck& check, const M
   return report.strong_delta_chi2 >= needed + kResolutionAllowance * report.strong_resolution_chi2;
 }
 
-/// A candidate at a fraction `t` of its strong magnitude: each parameter moved from its null value
-/// t times the way to its strong one.
+/// A candidate's i-th parameter at a fraction `t` of its strong magnitude: moved from its null
+/// value t times the way to its strong one.
+double magnitude_at(const EffectSpec& spec, std::size_t i, double t) {
+  const double off = effect_off(spec)[i];
+  return off + t * (spec.parameters[i].strong - off);
+}
+
+/// A candidate at a fraction `t` of its strong magnitude (each parameter at magnitude_at).
 Model effect_at(const Model& baseline, const EffectSpec& spec, double t) {
   Model probe = baseline;
   probe.effect = spec.effect;
-  const std::vector<double> off = effect_off(spec);
-  for (std::size_t i = 0; i < spec.parameters.size(); ++i)
-    probe.values.push_back(off[i] + t * (spec.parameters[i].strong - off[i]));
+  for (std::size_t i = 0; i < spec.parameters.size(); ++i) probe.values.push_back(magnitude_at(spec, i, t));
   return probe;
 }
 
@@ -592,8 +596,7 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
         if (!bracket) return std::unexpected(bracket.error());
         tried = *bracket;
       }
-      const double null_value = effect_off(spec)[0];
-      const auto magnitude = [&](double t) { return null_value + (first.strong - null_value) * t; };
+      const auto magnitude = [&](double t) { return magnitude_at(spec, 0, t); };
       report.smallest_detectable = std::isfinite(tried.shown) ? magnitude(tried.shown) : kNever;
       limits.push_back(std::isfinite(tried.shown)
                            ? fmt::format("{} {} {:.3g}", spec.name, first.name, report.smallest_detectable)
