@@ -234,7 +234,8 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                         {"strong_signal", d.strong_signal},
                         {"replay_noise", d.replay_noise},
                         {"needed", d.needed},
-                        {"trials_needed", finite_or_null(d.trials_needed)}});
+                        {"trials_needed", finite_or_null(d.trials_needed)},
+                        {"strong_rejection", d.strong_rejection}});
     }
     j["ensemble"] = {{"replays", e.replays},
                      {"trials", e.trials},

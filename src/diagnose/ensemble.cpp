@@ -479,7 +479,9 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     result.detectability.push_back(d);
   }
   Proposal best{spec.effect, 0.0, result.null_chi2, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()))};
-  for (int step = 1; step <= 60; ++step) {
+  constexpr int kStrongStep = 40;  // u = 2: the strong magnitude
+  double chi2_null = NAN;          // the same means' chi^2 with no effect (u = 0)
+  for (int step = 0; step <= 60; ++step) {
     const double u = 0.05 * step;
     const Eigen::VectorXd shift = u <= 1.0 ? Eigen::VectorXd(u * response[0])
                                            : Eigen::VectorXd(response[0] + (u - 1.0) * (response[1] - response[0]));
@@ -487,6 +489,11 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     const Eigen::VectorXd delta = solve_coefficients(jacobian, residual, inverse_se);
     const Eigen::VectorXd left = free.empty() ? residual : Eigen::VectorXd(residual - jacobian * delta);
     const double chi2 = (inverse_se.asDiagonal() * left).squaredNorm();
+    if (step == 0) {
+      chi2_null = chi2;
+      continue;
+    }
+    if (step == kStrongStep) result.detectability.back().strong_rejection = chi2 - chi2_null;
     if (chi2 < best.predicted) best = {spec.effect, u, chi2, free.empty() ? Eigen::VectorXd() : delta};
   }
   if (best.level > 0.0 && result.null_chi2 - best.predicted - penalty >= options.min_delta_bic) return best;

@@ -169,6 +169,9 @@ struct Detectability {
   double replay_noise = 0.0;   ///< ResponseSignal::noise: what that noise alone adds to the raw signal
   double needed = 0.0;         ///< delta-chi^2 the margin asks for (margin + k ln n)
   double trials_needed = 0.0;  ///< per recording; infinity when the outcomes do not respond
+  /// How far the recorded outcomes reject its strong magnitude: their chi^2 there (the free
+  /// coefficients absorbing what they can, to first order) less the calibrated null's.
+  double strong_rejection = 0.0;
 };
 
 /// A candidate's response (its replays' statistics less the null's, from the same orientations),

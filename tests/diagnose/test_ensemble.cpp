@@ -416,17 +416,20 @@ TEST(EnsembleConvergence, AnOutcomeShiftCountsWhenItIsRealAndMatters) {
 }
 
 // A candidate tried on the outcomes and not named decides its absence only where its strong
-// magnitude would have shown (its strong signal reaches the margin): the generated 8-trial
-// plastic substrate was tried at a fitted level in its own strong case, failed the margin with
-// a strong signal of 0.1 against 13 needed, and was called absent until 4e3e08b.
+// magnitude would have shown (its strong signal reaches the margin) and the recorded outcomes
+// reject that magnitude by the margin: the generated 8-trial plastic substrate was tried at a
+// fitted level in its own strong case, failed the margin with a strong signal of 0.1 against 13
+// needed, and was called absent until 4e3e08b; the generated noisy:15 strong centre-of-mass
+// offset (strong signal 45 against 15) was called absent at 0674a71 while present.
 TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow) {
-  for (const double strong_signal : {0.1, 30.0}) {
+  for (const auto [strong_signal, rejection] : {std::pair{0.1, 30.0}, std::pair{30.0, 30.0}, std::pair{30.0, 2.0}}) {
     DiagnoseResult result;
     result.verdict = Verdict::None;
     result.undecidable = {"plastic_substrate", "viscous_rolling"};
     EnsembleResult ens;
     ens.trials = 8.0;
-    ens.detectability.push_back({Effect::PlasticSubstrate, strong_signal, 1.0, 13.0, 8.0 * 13.0 / strong_signal});
+    ens.detectability.push_back(
+        {Effect::PlasticSubstrate, strong_signal, 1.0, 13.0, 8.0 * 13.0 / strong_signal, rejection});
     ens.detectability.push_back({Effect::ViscousRolling, 0.0, 0.0, 13.0, std::numeric_limits<double>::infinity()});
     EnsembleHypothesis tried;
     tried.effect = Effect::PlasticSubstrate;
@@ -434,7 +437,7 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
     ens.hypotheses.push_back(tried);
     diagnosis::say_what_outcomes_decide(result, ens);
     const bool undecided = std::count(result.undecidable.begin(), result.undecidable.end(), "plastic_substrate") == 1;
-    EXPECT_EQ(undecided, strong_signal < 13.0) << strong_signal;
+    EXPECT_EQ(undecided, strong_signal < 13.0 || rejection < 13.0) << strong_signal << " " << rejection;
     // Never tried, it stays undecidable, and the experiment says the outcomes do not respond.
     EXPECT_EQ(std::count(result.undecidable.begin(), result.undecidable.end(), "viscous_rolling"), 1);
     EXPECT_NE(result.experiment.find("viscous_rolling (the outcomes do not respond to it)"), std::string::npos)
