@@ -493,7 +493,11 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
       chi2_null = chi2;
       continue;
     }
-    if (step == kStrongStep) result.detectability.back().strong_rejection = chi2 - chi2_null;
+    // The strong replays' own sampling noise adds to that chi^2 as it does to the raw signal.
+    if (step == kStrongStep) {
+      Detectability& d = result.detectability.back();
+      d.strong_rejection = chi2 - chi2_null - d.replay_noise;
+    }
     if (chi2 < best.predicted) best = {spec.effect, u, chi2, free.empty() ? Eigen::VectorXd() : delta};
   }
   if (best.level > 0.0 && result.null_chi2 - best.predicted - penalty >= options.min_delta_bic) return best;

@@ -170,7 +170,8 @@ struct Detectability {
   double needed = 0.0;         ///< delta-chi^2 the margin asks for (margin + k ln n)
   double trials_needed = 0.0;  ///< per recording; infinity when the outcomes do not respond
   /// How far the recorded outcomes reject its strong magnitude: their chi^2 there (the free
-  /// coefficients absorbing what they can, to first order) less the calibrated null's.
+  /// coefficients absorbing what they can, to first order) less the same chi^2 with no effect,
+  /// the replays' own noise (replay_noise) taken off.
   double strong_rejection = 0.0;
 };
 
