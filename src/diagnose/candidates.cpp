@@ -566,23 +566,21 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
     auto probed = cells(probe);
     if (!probed) return std::unexpected(probed.error());
     const Eigen::VectorXd& probe_cells = probed->values;
-    double signal = 0.0, misfit = 0.0;
-    report.strong_delta_chi2 = NAN;
-    if (probe_cells.size() == base_cells.size()) {
-      const Shown strong = measure(c, cells.keys, keep, base_cells, probe_cells, 1.0, 1.0);
-      signal = strong.signal;
-      misfit = strong.misfit;
-      // The recordings' own answer (cells are residuals): chi^2 at the strong magnitude minus
-      // the null's, each after the coefficients absorb what they can.
-      report.strong_delta_chi2 = keep(probe_cells).squaredNorm() - keep(base_cells).squaredNorm();
-    }
     const double needed =
         options.min_delta_bic + static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
     // Named frame by frame only over a large misfit too: some phase's chi^2 per value at
     // kLargeMisfit, of which the noise gives one.
     const double needed_misfit = kLargeMisfit - 1.0;
+    Shown strong{.needed = needed, .needed_misfit = needed_misfit};
+    report.strong_delta_chi2 = NAN;
+    if (probe_cells.size() == base_cells.size()) {
+      strong = measure(c, cells.keys, keep, base_cells, probe_cells, needed, needed_misfit);
+      // The recordings' own answer (cells are residuals): chi^2 at the strong magnitude minus
+      // the null's, each after the coefficients absorb what they can.
+      report.strong_delta_chi2 = keep(probe_cells).squaredNorm() - keep(base_cells).squaredNorm();
+    }
     const auto& first = spec.parameters[0];
-    const bool shows = signal >= needed && misfit >= needed_misfit;
+    const bool shows = strong.signal >= needed && strong.misfit >= needed_misfit;
     if (first.log_scale) {
       report.smallest_detectable = shows ? first.strong : NAN;
       limits.push_back(shows ? fmt::format("{} with {} {:.3g} would show", spec.name, first.name, first.strong)
@@ -590,9 +588,8 @@ Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_
     } else {
       // The first-order figure checked by replays (smallest_shown_fraction).
       Bracket tried{.shown = NAN, .missed = 0.0};
-      if (signal > 0.0 && misfit > 0.0) {
-        auto bracket = smallest_shown_fraction(cells, baseline, spec, base_cells, keep,
-                                               Shown{signal, misfit, needed, needed_misfit}, c);
+      if (strong.signal > 0.0 && strong.misfit > 0.0) {
+        auto bracket = smallest_shown_fraction(cells, baseline, spec, base_cells, keep, strong, c);
         if (!bracket) return std::unexpected(bracket.error());
         tried = *bracket;
       }

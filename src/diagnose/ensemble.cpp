@@ -465,6 +465,14 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     response[level - 1] = means_of(compare_all(plans, *out, options.impact_accuracy)) - null_means;
     if (level == 2) strong_variance = difference_variance(plans, null_sample, *out);
   }
+  // The recorded means' chi^2 once the outcomes move by `shift` and the free coefficients
+  // absorb what they can (to first order), and the coefficients' move.
+  const auto absorbed = [&](const Eigen::VectorXd& shift) {
+    const Eigen::VectorXd residual = recorded - null_means - shift;
+    const Eigen::VectorXd delta = solve_coefficients(jacobian, residual, inverse_se);
+    const Eigen::VectorXd left = free.empty() ? residual : Eigen::VectorXd(residual - jacobian * delta);
+    return std::pair{(inverse_se.asDiagonal() * left).squaredNorm(), delta};
+  };
   const double penalty = static_cast<double>(spec.parameters.size()) * std::log(std::max(1, result.outcomes));
   bool detectable = false;
   {
@@ -475,29 +483,19 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     Detectability d{spec.effect, s.signal(), s.noise, options.min_delta_bic + penalty,
                     std::numeric_limits<double>::infinity()};
     if (d.strong_signal > 0.0) d.trials_needed = std::ceil(result.trials * d.needed / d.strong_signal);
+    // How far the recorded means reject the strong magnitude; the strong replays' own sampling
+    // noise adds to that chi^2 as it does to the raw signal.
+    d.strong_rejection =
+        absorbed(response[1]).first - absorbed(Eigen::VectorXd::Zero(response[1].size())).first - d.replay_noise;
     detectable = d.strong_signal >= d.needed;
     result.detectability.push_back(d);
   }
   Proposal best{spec.effect, 0.0, result.null_chi2, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()))};
-  constexpr int kStrongStep = 40;  // u = 2: the strong magnitude
-  double chi2_null = NAN;          // the same means' chi^2 with no effect (u = 0)
-  for (int step = 0; step <= 60; ++step) {
+  for (int step = 1; step <= 60; ++step) {
     const double u = 0.05 * step;
     const Eigen::VectorXd shift = u <= 1.0 ? Eigen::VectorXd(u * response[0])
                                            : Eigen::VectorXd(response[0] + (u - 1.0) * (response[1] - response[0]));
-    const Eigen::VectorXd residual = recorded - null_means - shift;
-    const Eigen::VectorXd delta = solve_coefficients(jacobian, residual, inverse_se);
-    const Eigen::VectorXd left = free.empty() ? residual : Eigen::VectorXd(residual - jacobian * delta);
-    const double chi2 = (inverse_se.asDiagonal() * left).squaredNorm();
-    if (step == 0) {
-      chi2_null = chi2;
-      continue;
-    }
-    // The strong replays' own sampling noise adds to that chi^2 as it does to the raw signal.
-    if (step == kStrongStep) {
-      Detectability& d = result.detectability.back();
-      d.strong_rejection = chi2 - chi2_null - d.replay_noise;
-    }
+    const auto [chi2, delta] = absorbed(shift);
     if (chi2 < best.predicted) best = {spec.effect, u, chi2, free.empty() ? Eigen::VectorXd() : delta};
   }
   if (best.level > 0.0 && result.null_chi2 - best.predicted - penalty >= options.min_delta_bic) return best;
