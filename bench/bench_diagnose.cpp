@@ -509,10 +509,15 @@ Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialT
   std::vector<Case> cases;
   std::uint64_t k = 0;
   for (const auto& spec : effect_library()) {
+    // Each case's seed counts the library's effects whether or not --effects picks them, so a
+    // subset run makes the same recordings as the full run's cases of those effects.
+    const std::uint64_t first = k;
+    k += 2;
     if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), spec.name) == o.only.end()) continue;
+    std::uint64_t m = first;
     for (std::string magnitude : {"realistic", "strong"}) {
       Case c{.id = fmt::format("{}-{}", spec.name, magnitude), .effect = spec.effect, .magnitude = magnitude};
-      c.options = base_options(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", o.seed * 1000 + ++k);
+      c.options = base_options(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", o.seed * 1000 + ++m);
       c.options.effect = spec.effect;
       for (const auto& p : spec.parameters)
         c.options.values.push_back(magnitude == "realistic" ? p.realistic : p.strong);

@@ -397,6 +397,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
       agreement.reset();
     }
     EnsembleOptions pursue = eo;
+    pursue.finer = nullptr;  // its absences are not what the verdict reports
     if (let_through) pursue.pursue = let_through->effect;
     auto fine = compare_ensembles(c.ev, refit->fitted.model, refit->scores, free, candidates, pursue);
     if (!fine) return std::unexpected(fine.error());
@@ -566,12 +567,24 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
     // plastic substrate was tried at a fitted level, failed the margin, and was present (strong
     // signal 0.1 against 13 needed); on the generated noisy:15 set at 0674a71 a strong
     // centre-of-mass offset was present, its strong signal 45 against 15 needed, and called absent.
-    if (tried && d.strong_signal >= d.needed && d.strong_rejection >= d.needed) {
+    // Both in the units of the null's own misfit, as a candidate's margin is judged, and the
+    // rejection beyond twice the next finer clump's move of the strong response, as frame by
+    // frame: on that noisy:15 set the offset (2.5 and 1.2 mm on the 340-sphere body) was rejected
+    // by 20.3 against 15 needed while the null's chi^2 was 3.7 times its degrees of freedom.
+    if (tried && d.decides_absence()) {
       std::erase(result.undecidable, name);
       continue;
     }
     if (std::find(result.undecidable.begin(), result.undecidable.end(), name) == result.undecidable.end()) continue;
-    if (!std::isfinite(d.trials_needed) || d.trials_needed > 1000)
+    if (tried && d.strong_signal >= d.needed && d.strong_rejection >= d.needed)
+      more_trials.push_back(fmt::format(
+          "{} (rejected by {:.1f}, within the null's own misfit ({:.1f} times its degrees of freedom){}: the "
+          "particle model decides it, not more trials)",
+          name, d.strong_rejection, d.dispersion,
+          std::isfinite(d.strong_resolution)
+              ? fmt::format(" or twice the next finer clump's move of its response ({:.1f})", d.strong_resolution)
+              : std::string()));
+    else if (!std::isfinite(d.trials_needed) || d.trials_needed > 1000)
       more_trials.push_back(d.replay_noise > 0.0
                                 ? fmt::format("{} (its response is within the replays' own noise)", name)
                                 : fmt::format("{} (the outcomes do not respond to it)", name));
@@ -622,6 +635,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   eo.impact_accuracy = options.impact_accuracy;
   eo.min_delta_bic = options.min_delta_bic;
   eo.seed = options.seed;
+  eo.finer = c.finer.empty() ? nullptr : c.finer.front();
   auto ens = compare_ensembles(c.ev, baseline, full_scores, free, candidates, eo);
   if (!ens) return std::unexpected(ens.error());
   c.evaluations += ens->replays;

@@ -253,11 +253,6 @@ double largest_signal_misfit(const Context& c, const std::vector<std::pair<Group
   return largest;
 }
 
-/// How many times the move to the next finer clump a strong effect's rejection must exceed
-/// (besides the delta-BIC margin) to count: the diagnosed clump's distance from the recorded
-/// body is larger than its distance from the next rung, so this is an allowance, not a bound.
-constexpr double kResolutionAllowance = 2.0;
-
 /// The training trials' cells (residuals) under one model, and how many belong to each trial.
 struct TrialCells {
   Eigen::VectorXd values;

@@ -170,6 +170,12 @@ OutcomeComparison compare_spread(const std::vector<double>& recorded, const std:
   return c;
 }
 
+bool Detectability::decides_absence() const {
+  const double resolution = std::isfinite(strong_resolution) ? strong_resolution : 0.0;
+  return strong_signal >= dispersion * needed &&
+         strong_rejection >= dispersion * needed + kResolutionAllowance * resolution;
+}
+
 ResponseSignal response_signal(const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
                                const Eigen::VectorXd& inverse_se, const Eigen::MatrixXd& jacobian) {
   const Eigen::Index n = response.size();
@@ -419,6 +425,10 @@ struct Proposal {
   Effect effect = Effect::AirDrag;
   double level = 0.0, predicted = 0.0;
   Eigen::VectorXd delta;
+  /// Its strong magnitude's replays: the plans they ran, their statistics less the null's, and
+  /// those differences' sampling variance (the finer clump's check, weigh_resolution).
+  std::vector<bool> run;
+  Eigen::VectorXd strong_response, strong_variance;
 };
 
 /// Whether a candidate is calibrated with its level whatever the linear surrogate predicts.
@@ -483,6 +493,7 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     Detectability d{spec.effect, s.signal(), s.noise, options.min_delta_bic + penalty,
                     std::numeric_limits<double>::infinity()};
     if (d.strong_signal > 0.0) d.trials_needed = std::ceil(result.trials * d.needed / d.strong_signal);
+    d.dispersion = std::max(1.0, result.null_chi2 / null_dof(result.outcomes, free.size()));
     // How far the recorded means reject the strong magnitude; the strong replays' own sampling
     // noise adds to that chi^2 as it does to the raw signal.
     d.strong_rejection =
@@ -490,18 +501,63 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     detectable = d.strong_signal >= d.needed;
     result.detectability.push_back(d);
   }
-  Proposal best{spec.effect, 0.0, result.null_chi2, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size()))};
+  Proposal best{
+      spec.effect, 0.0,         result.null_chi2, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free.size())),
+      run,         response[1], strong_variance};
   for (int step = 1; step <= 60; ++step) {
     const double u = 0.05 * step;
     const Eigen::VectorXd shift = u <= 1.0 ? Eigen::VectorXd(u * response[0])
                                            : Eigen::VectorXd(response[0] + (u - 1.0) * (response[1] - response[0]));
     const auto [chi2, delta] = absorbed(shift);
-    if (chi2 < best.predicted) best = {spec.effect, u, chi2, free.empty() ? Eigen::VectorXd() : delta};
+    if (chi2 < best.predicted) {
+      best.level = u;
+      best.predicted = chi2;
+      best.delta = free.empty() ? Eigen::VectorXd() : delta;
+    }
   }
   if (best.level > 0.0 && result.null_chi2 - best.predicted - penalty >= options.min_delta_bic) return best;
   if (pursuit == Pursuit::No || (pursuit == Pursuit::IfDetectable && !detectable)) return std::nullopt;
   if (best.level == 0.0) best.level = 2.0;
   return best;
+}
+
+/// The next finer clump's move of each tried candidate's strong response (its
+/// Detectability::strong_resolution), replayed from the same orientations at the calibrated
+/// null's coefficients: only for a candidate whose absence the outcomes would otherwise decide.
+Result<void> weigh_resolution(const Evaluator& ev, const std::vector<Plan>& plans, const Model& null_model,
+                              const Sample& null_sample, const std::vector<Proposal>& tried,
+                              const Eigen::VectorXd& inverse_se, const Eigen::MatrixXd& jacobian,
+                              const EnsembleOptions& options, EnsembleResult& result) {
+  if (options.finer == nullptr) return {};
+  std::vector<std::pair<const Proposal*, Detectability*>> weighed;
+  std::vector<bool> run(plans.size(), false);
+  for (const Proposal& p : tried) {
+    const auto d = std::find_if(result.detectability.begin(), result.detectability.end(),
+                                [&](const Detectability& x) { return x.effect == p.effect; });
+    if (d == result.detectability.end() || !d->decides_absence()) continue;
+    weighed.emplace_back(&p, &*d);
+    for (std::size_t k = 0; k < run.size() && k < p.run.size(); ++k) run[k] = run[k] || p.run[k];
+  }
+  if (weighed.empty()) return {};
+  Evaluator fine = ev;
+  fine.clump = options.finer;
+  // Plans no weighed candidate runs keep the diagnosed clump's null: a response of zero there on
+  // both clumps, as in propose.
+  auto fine_null = replay_outcomes(fine, null_model, plans, run, &null_sample, result.replays);
+  if (!fine_null) return std::unexpected(fine_null.error());
+  const Eigen::VectorXd fine_null_means = means_of(compare_all(plans, *fine_null, options.impact_accuracy));
+  const auto library = effect_library();
+  for (auto [p, d] : weighed) {
+    Model strong = null_model;
+    strong.effect = p->effect;
+    strong.values = effect_values(effect_spec(library, p->effect), 2.0);
+    auto out = replay_outcomes(fine, strong, plans, p->run, &*fine_null, result.replays);
+    if (!out) return std::unexpected(out.error());
+    const Eigen::VectorXd response = means_of(compare_all(plans, *out, options.impact_accuracy)) - fine_null_means;
+    const Eigen::VectorXd variance = p->strong_variance + difference_variance(plans, *fine_null, *out);
+    d->strong_resolution = response_signal(response - p->strong_response, variance, inverse_se, jacobian).signal();
+  }
+  return {};
 }
 
 /// A model's free coefficients as a vector.
@@ -873,6 +929,9 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
     if (!h) return std::unexpected(h.error());
     result.hypotheses.push_back(std::move(*h));
   }
+  if (auto ok = weigh_resolution(ev, plans, null_model, null_sample, proposals, inverse_se, jacobian, options, result);
+      !ok)
+    return std::unexpected(ok.error());
   if (auto ok = replay_afresh(ev, scores, null_model, free.size(), options, 190000, result); !ok)
     return std::unexpected(ok.error());
   std::sort(result.hypotheses.begin(), result.hypotheses.end(),

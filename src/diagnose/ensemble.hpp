@@ -110,6 +110,10 @@ struct EnsembleOptions {
   /// A candidate calibrated with its level even when the null is consistent (a finer clump's
   /// check of the one its coarser clump let through).
   std::optional<Effect> pursue;
+  /// The next finer clump of the same body (none: not asked). A tried candidate whose absence the
+  /// outcomes would decide has its strong magnitude replayed with it too
+  /// (Detectability::strong_resolution).
+  const Clump* finer = nullptr;
 };
 
 /// Recorded outcomes are consistent with replays while their chi^2 tail is at least this (the
@@ -160,6 +164,12 @@ struct EnsembleHypothesis {
   std::vector<OutcomeComparison> comparisons;  ///< its replays against the recordings
 };
 
+/// A rejection decides an effect absent only beyond this many times the next finer clump's
+/// move of the effect's response (chi^2 against chi^2), besides the delta-BIC margin, frame by
+/// frame and on the outcomes: the diagnosed clump's distance from the recorded body is larger
+/// than its distance from the next rung, so this is an allowance, not a bound.
+constexpr double kResolutionAllowance = 2.0;
+
 /// How well the outcomes could show a candidate: its strong magnitude's signal (delta-chi^2
 /// after the free coefficients absorb what they can, to first order) and the trials per
 /// recording at which that signal would reach the delta-BIC margin.
@@ -173,6 +183,20 @@ struct Detectability {
   /// coefficients absorbing what they can, to first order) less the same chi^2 with no effect,
   /// the replays' own noise (replay_noise) taken off.
   double strong_rejection = 0.0;
+  /// How far the next finer clump (EnsembleOptions::finer) moves that strong response, in the
+  /// same chi^2 (projected and weighted alike, both samples' noise taken off): a rejection
+  /// within kResolutionAllowance times it may be the diagnosed clump's, not the recordings'.
+  /// NaN when not replayed (no finer clump, or the candidate was not tried or not rejected).
+  double strong_resolution = std::numeric_limits<double>::quiet_NaN();
+  /// The calibrated null's chi^2 per degree of freedom when above 1 (the particle model's share
+  /// of the misfit): a candidate's margin is judged in these units (EnsembleHypothesis::
+  /// dispersion), and so are the signal and rejection that decide its absence.
+  double dispersion = 1.0;
+  /// Whether the outcomes decide the candidate absent (when it was tried and not named): its
+  /// strong magnitude would show, and the recordings reject it, each by the margin in the null's
+  /// dispersion units, the rejection also beyond kResolutionAllowance times the next finer
+  /// clump's move of the response.
+  bool decides_absence() const;
 };
 
 /// A candidate's response (its replays' statistics less the null's, from the same orientations),
