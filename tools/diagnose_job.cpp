@@ -313,6 +313,9 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["training_trials"] = r.training_trials;
   j["trial_replays"] = r.evaluations;
   j["seconds"] = r.seconds;
+  j["stage_seconds"] = nlohmann::json::array();
+  for (const auto& st : r.stage_seconds)
+    j["stage_seconds"].push_back({{"stage", stage_name(st.stage)}, {"seconds", st.seconds}});
   return j;
 }
 

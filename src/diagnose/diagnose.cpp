@@ -11,6 +11,14 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
                                 const DiagnoseOptions& options, const RunContext& run) {
   using namespace diagnosis;  // the stages (stages.hpp), run here in order
   const auto started = std::chrono::steady_clock::now();
+  auto lap = started;
+  DiagnoseResult result;
+  // Closes a stage: the time since the last one closed.
+  const auto took = [&](Stage stage) {
+    const auto now = std::chrono::steady_clock::now();
+    result.stage_seconds.push_back({stage, std::chrono::duration<double>(now - lap).count()});
+    lap = now;
+  };
   if (auto ok = check_inputs(clump, recordings, names, options); !ok) return std::unexpected(ok.error());
   bool any_track = false;
   for (const auto& r : recordings) {
@@ -18,7 +26,6 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   }
   if (!any_track) return diagnose_summaries(clump, table, recordings, names, options, run);
 
-  DiagnoseResult result;
   Context c;
   c.names = names;
   c.run = &run;
@@ -29,6 +36,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   c.ev.lab = options.lab;
   c.ev.impact_accuracy = options.impact_accuracy;
   const std::vector<double> camera_noise = load_tracks(c, result, recordings, names, options);
+  took(Stage::LoadAndNoise);
   const auto seconds = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   };
@@ -44,12 +52,15 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
                                              : resolution_stage(c, result, *start, options);
       !ok)
     return std::unexpected(ok.error());
+  took(Stage::ReleaseState);
   auto fitted = baseline_stage(c, result, *start, options);
   if (!fitted) return std::unexpected(fitted.error());
+  took(Stage::Baseline);
   const Model baseline = std::move(*fitted);
   run.report("locating", 0.2);
   auto located = locate_stage(c, result, baseline);
   if (!located) return std::unexpected(located.error());
+  took(Stage::Locate);
   // Name: every candidate, on the tests it acts in.
   std::vector<Effect> effects = options.effects;
   if (effects.empty()) {
@@ -57,6 +68,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   }
   auto candidate_fits = candidates_stage(c, result, baseline, *located, effects, options);
   if (!candidate_fits) return std::unexpected(candidate_fits.error());
+  took(Stage::Candidates);
   const std::vector<Fitted>& fits = *candidate_fits;
   SecondNull second(baseline, options.max_evaluations);
   if (auto ok = every_trial_stage(c, result, fits, second, options); !ok) return std::unexpected(ok.error());
@@ -96,9 +108,11 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
       improved.changed = true;
     }
   }
+  took(Stage::EveryTrial);
   // Before the mismatch is blamed on missing physics: is it the particle model?
   auto particle = particle_model_stage(c, result, second, improved, options);
   if (!particle) return std::unexpected(particle.error());
+  took(Stage::ParticleModel);
   const bool named = decision.named() && !*particle;
   if (second.fit()) result.refitted_on_all = second.fit()->model.base;
   result.improved = improved.model.base;
@@ -122,12 +136,14 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
         p.improved_chi2_per_value = g.chi2 / g.values;
     }
   }
+  took(Stage::WholeTracks);
   const bool open = !named && !*particle && result.verdict != Verdict::Ambiguous;
   if (open && !result.unexplained.empty()) {
     say_unexplained_phases(result, options);
   } else if (open) {
     if (auto ok = say_none(c, result, baseline, fits, final_groups, options); !ok) return std::unexpected(ok.error());
   }
+  took(Stage::Limits);
   // The free flights need no replay: when they show the tracked point off the centre of mass,
   // the outcomes over the release are not needed to say so.
   result.flights = flights_of(c, recordings, options);
@@ -139,6 +155,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
       return std::unexpected(ok.error());
   }
   track_plots(c, result, *full_base, *full_improved);
+  took(Stage::Ensemble);
   result.evaluations = c.evaluations;
   result.seconds = seconds();
   run.report("done", 1.0);

@@ -217,6 +217,27 @@ enum class Basis {
 };
 std::string_view basis_name(Basis basis);
 
+/// The stages of a diagnosis, in the order they run (DiagnoseResult::stage_seconds).
+enum class Stage {
+  LoadAndNoise,   ///< the tracks read, checked and their camera noise estimated
+  ReleaseState,   ///< the release state and horizons (and the clump's resolution, with finer clumps)
+  Baseline,       ///< the baseline fit on the training trials
+  Locate,         ///< where the baseline misfits, phase by phase
+  Candidates,     ///< each candidate fitted and judged on the training trials
+  EveryTrial,     ///< the candidates and the null refitted on every trial
+  ParticleModel,  ///< a finer clump checked before a mismatch is blamed on missing physics
+  WholeTracks,    ///< the baseline and the improvement replayed over the whole tracks
+  Limits,         ///< a `none`'s detection limits and absence checks
+  Ensemble,       ///< the outcomes beyond the release horizon against replays over the release
+};
+std::string_view stage_name(Stage stage);
+
+/// How long one stage took (wall clock).
+struct StageTime {
+  Stage stage = Stage::LoadAndNoise;
+  double seconds = 0.0;
+};
+
 /// A recording whose recorded trials part from each other where the model's replays agree for
 /// every release (a sphere with something unrecorded about it): fitted up to `seconds` after
 /// release, compared beyond as a sample.
@@ -253,6 +274,7 @@ struct DiagnoseResult {
   std::optional<FlightWobble> flights;               ///< when drops were tracked
   int tracked_trials = 0, training_trials = 0, evaluations = 0;
   double seconds = 0.0;
+  std::vector<StageTime> stage_seconds;  ///< the stages that ran, in order
 };
 
 /// Which candidate the hypotheses name (indices into them). Nothing is named when the

@@ -166,6 +166,32 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
 
 namespace clumpforge {
 
+std::string_view stage_name(Stage stage) {
+  switch (stage) {
+    case Stage::LoadAndNoise:
+      return "load_and_noise";
+    case Stage::ReleaseState:
+      return "release_state";
+    case Stage::Baseline:
+      return "baseline";
+    case Stage::Locate:
+      return "locate";
+    case Stage::Candidates:
+      return "candidates";
+    case Stage::EveryTrial:
+      return "every_trial";
+    case Stage::ParticleModel:
+      return "particle_model";
+    case Stage::WholeTracks:
+      return "whole_tracks";
+    case Stage::Limits:
+      return "limits";
+    case Stage::Ensemble:
+      return "ensemble";
+  }
+  return "unknown";
+}
+
 std::string_view basis_name(Basis basis) {
   switch (basis) {
     case Basis::Consistent:

@@ -205,6 +205,21 @@ TEST(DiagnoseCli, AnotherSimulatorsTuberControlIsConsistentWithTheDiagnosedClump
   const std::string calibrated = j["ensemble"]["calibrated_here"].dump();
   EXPECT_NE(calibrated.find("soil:restitution"), std::string::npos) << calibrated;
   EXPECT_NE(calibrated.find("Q235:restitution"), std::string::npos) << calibrated;
+  // Where the time went: the stages that ran, in their order, adding up to the whole (within
+  // the report's own bookkeeping, 1 s).
+  const std::vector<std::string> order{"load_and_noise", "release_state",  "baseline",     "locate", "candidates",
+                                       "every_trial",    "particle_model", "whole_tracks", "limits", "ensemble"};
+  ASSERT_TRUE(j["stage_seconds"].is_array());
+  std::vector<std::string> ran;
+  double sum = 0.0;
+  for (const auto& st : j["stage_seconds"]) {
+    ran.push_back(st["stage"].get<std::string>());
+    EXPECT_GE(st["seconds"].get<double>(), 0.0);
+    sum += st["seconds"].get<double>();
+  }
+  EXPECT_EQ(ran, order);
+  EXPECT_NEAR(sum, j["seconds"].get<double>(), 1.0);
+  EXPECT_GT(j["stage_seconds"][9]["seconds"].get<double>(), 0.0);  // its outcomes were calibrated
 }
 
 TEST(DiagnoseCli, AnotherSimulatorsSpeedDependentRestitutionIsFoundByCalibratingItsLevel) {
