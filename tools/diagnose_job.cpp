@@ -237,8 +237,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                         {"trials_needed", finite_or_null(d.trials_needed)},
                         {"strong_rejection", d.strong_rejection},
                         {"strong_resolution", finite_or_null(d.strong_resolution)},
-                        {"dispersion", d.dispersion},
-                        {"decides_absence", d.decides_absence()}});
+                        {"dispersion", d.dispersion}});
     }
     j["ensemble"] = {{"replays", e.replays},
                      {"trials", e.trials},
