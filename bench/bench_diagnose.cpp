@@ -514,10 +514,10 @@ Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialT
     const std::uint64_t first = k;
     k += 2;
     if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), spec.name) == o.only.end()) continue;
-    std::uint64_t m = first;
     for (std::string magnitude : {"realistic", "strong"}) {
       Case c{.id = fmt::format("{}-{}", spec.name, magnitude), .effect = spec.effect, .magnitude = magnitude};
-      c.options = base_options(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", o.seed * 1000 + ++m);
+      const std::uint64_t seed = o.seed * 1000 + first + (magnitude == "realistic" ? 1 : 2);
+      c.options = base_options(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", seed);
       c.options.effect = spec.effect;
       for (const auto& p : spec.parameters)
         c.options.values.push_back(magnitude == "realistic" ? p.realistic : p.strong);

@@ -570,7 +570,7 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
     // Both in the units of the null's own misfit, as a candidate's margin is judged, and the
     // rejection beyond twice the next finer clump's move of the strong response, as frame by
     // frame: on that noisy:15 set the offset (2.5 and 1.2 mm on the 340-sphere body) was rejected
-    // by 20.3 against 15 needed while the null's chi^2 was 3.7 times its degrees of freedom.
+    // by 20.3 against 15 needed while the null's chi^2 was 3.4 times its degrees of freedom.
     if (tried && d.decides_absence()) {
       std::erase(result.undecidable, name);
       continue;

@@ -493,7 +493,7 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     Detectability d{spec.effect, s.signal(), s.noise, options.min_delta_bic + penalty,
                     std::numeric_limits<double>::infinity()};
     if (d.strong_signal > 0.0) d.trials_needed = std::ceil(result.trials * d.needed / d.strong_signal);
-    d.dispersion = std::max(1.0, result.null_chi2 / null_dof(result.outcomes, free.size()));
+    d.dispersion = margin_over_null(result.null_chi2, result.null_chi2, result.outcomes, free.size(), 0).dispersion;
     // How far the recorded means reject the strong magnitude; the strong replays' own sampling
     // noise adds to that chi^2 as it does to the raw signal.
     d.strong_rejection =

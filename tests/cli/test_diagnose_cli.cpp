@@ -295,9 +295,6 @@ TEST(DiagnoseCli, AnAgreementThatMovesWithTheResolutionNamesNothingAndClaimsNoAb
   }
 }
 
-}  // namespace clumpforge
-
-namespace clumpforge {
 TEST(DiagnoseCli, AnAbsenceTheOutcomesDecideIsJudgedInTheUnitsOfTheNullsOwnMisfit) {
   // The generated benchmark's noisy:15 com_offset-strong case (bench_diagnose --orientation
   // noisy:15 makes the same recordings): the default tuber's 340-sphere fill with its centre of
