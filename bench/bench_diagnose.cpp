@@ -44,8 +44,16 @@ struct Case {
   std::string id;
   std::optional<Effect> effect;
   std::string magnitude;  // realistic, strong, control
-  ConcealOptions options;
+  /// One per surface; their recordings share the case's folder.
+  std::vector<ConcealOptions> parts;
 };
+
+/// The part that carries the case's effect (the first part for a control).
+const ConcealOptions& effect_part(const Case& c) {
+  for (const auto& p : c.parts)
+    if (p.effect) return p;
+  return c.parts.front();
+}
 
 double median(std::vector<double> v) {
   if (v.empty()) return NAN;
@@ -404,7 +412,7 @@ struct BenchOptions {
   int controls = 50, trials = 4;
   std::uint64_t seed = 1;
   std::vector<std::string> only;
-  bool full_set = false, existing_only = false;
+  bool full_set = false, nine_set_ups = false, existing_only = false;
   // The recordings come from a finer clump of the same scan than the one diagnosed (340 spheres
   // against the diagnosis's 32), as real data never comes from the diagnoser's own model.
   std::string recordings_set, orientation = "none",
@@ -433,6 +441,10 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--effects", o.only, "Only these effects (default: the library)");
   app.add_flag("--full-set", o.full_set,
                "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
+  app.add_flag("--nine-set-ups", o.nine_set_ups,
+               "Nine recordings per case on two surfaces, a lab's whole programme: drops 0.2/0.5/1 m, rolls "
+               "35/70 mm and a tilt on steel (Q235); drops 0.2/0.5 m and a 35 mm roll on soil")
+      ->excludes("--full-set");
   app.add_flag("--existing-only", o.existing_only,
                "Score only the cases already diagnosed in --out (a partial run's figures), run none");
   app.add_option("--orientation", o.orientation,
@@ -486,8 +498,13 @@ std::vector<Case> interleaved(const std::vector<Case>& cases) {
   return out;
 }
 
+/// Seeds of a case's second surface (--nine-set-ups): its own release orientations and noise.
+constexpr std::uint64_t kSecondSurfaceSeed = 1'000'000;
+
 /// The generated cases: every effect of the library (or --effects) at its realistic and
-/// strong magnitude, then the controls with varied base coefficients, interleaved.
+/// strong magnitude, then the controls with varied base coefficients, interleaved. Each case
+/// records on one surface, or on two with --nine-set-ups (each concealed on its own, as each
+/// surface's coefficients are calibrated on its own).
 Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialTable& table) {
   ConcealOptions camera;
   camera.frame_rate_hz = o.fps;
@@ -495,16 +512,27 @@ Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialT
   camera.pre_roll = !o.no_pre_roll;
   if (auto ok = parse_camera(o.camera_target, o.pixel_mm, camera); !ok) return std::unexpected(ok.error());
   if (auto ok = parse_orientation_record(o.orientation, camera); !ok) return std::unexpected(ok.error());
-  auto base_options = [&](const std::string& surface, std::uint64_t case_seed) {
+  auto parts_of = [&](const std::string& surface, std::uint64_t case_seed) {
     ConcealOptions c = camera;
     c.surface = surface;
     c.trials = o.trials;
     c.seed = case_seed;
-    if (!o.full_set) {
-      c.drop_heights = {0.2, 1.0};
-      c.roll_starts = {0.10};
+    if (!o.nine_set_ups) {
+      if (!o.full_set) {
+        c.drop_heights = {0.2, 1.0};
+        c.roll_starts = {0.10};
+      }
+      return std::vector<ConcealOptions>{c};
     }
-    return c;
+    ConcealOptions steel = c, soil = c;
+    steel.surface = "Q235";
+    steel.roll_starts = {0.035, 0.07};
+    soil.surface = "soil";
+    soil.drop_heights = {0.2, 0.5};
+    soil.roll_starts = {0.035};
+    soil.tilt = false;
+    soil.seed = case_seed + kSecondSurfaceSeed;
+    return std::vector<ConcealOptions>{steel, soil};
   };
   std::vector<Case> cases;
   std::uint64_t k = 0;
@@ -517,26 +545,44 @@ Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialT
     for (std::string magnitude : {"realistic", "strong"}) {
       Case c{.id = fmt::format("{}-{}", spec.name, magnitude), .effect = spec.effect, .magnitude = magnitude};
       const std::uint64_t seed = o.seed * 1000 + first + (magnitude == "realistic" ? 1 : 2);
-      c.options = base_options(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", seed);
-      c.options.effect = spec.effect;
-      for (const auto& p : spec.parameters)
-        c.options.values.push_back(magnitude == "realistic" ? p.realistic : p.strong);
+      c.parts = parts_of(spec.effect == Effect::PlasticSubstrate ? "soil" : "Q235", seed);
+      for (auto& part : c.parts) {
+        // A substrate that keeps dents is soil; steel does not dent.
+        if (spec.effect == Effect::PlasticSubstrate && part.surface != "soil") continue;
+        part.effect = spec.effect;
+        for (const auto& p : spec.parameters) part.values.push_back(magnitude == "realistic" ? p.realistic : p.strong);
+      }
       cases.push_back(std::move(c));
     }
   }
   for (int i = 0; i < o.controls; ++i) {
-    const std::string surface = i % 2 == 0 ? "Q235" : "soil";
     Case c{.id = fmt::format("control-{:02d}", i + 1), .magnitude = "control"};
-    c.options = base_options(surface, o.seed * 1000 + 500 + static_cast<std::uint64_t>(i));
-    Rng rng(o.seed, 9000 + static_cast<std::uint64_t>(i));
-    Interaction base = *table.interaction("tuber", surface);
-    base.restitution = std::min(0.95, base.restitution * rng.uniform(0.85, 1.1));
-    base.static_friction *= rng.uniform(0.85, 1.15);
-    base.rolling_friction *= rng.uniform(0.7, 1.3);
-    c.options.base = base;
+    c.parts = parts_of(i % 2 == 0 ? "Q235" : "soil", o.seed * 1000 + 500 + static_cast<std::uint64_t>(i));
+    for (std::size_t p = 0; p < c.parts.size(); ++p) {
+      Rng rng(o.seed, 9000 + static_cast<std::uint64_t>(i) + kSecondSurfaceSeed * p);
+      Interaction base = *table.interaction("tuber", c.parts[p].surface);
+      base.restitution = std::min(0.95, base.restitution * rng.uniform(0.85, 1.1));
+      base.static_friction *= rng.uniform(0.85, 1.15);
+      base.rolling_friction *= rng.uniform(0.7, 1.3);
+      c.parts[p].base = base;
+    }
     cases.push_back(std::move(c));
   }
   return interleaved(cases);
+}
+
+/// The case's answer for the scorer: one surface's as conceal writes it, or, for two, the
+/// effect and each surface's answer.
+std::string case_answer(const Case& c, const std::vector<ConcealResult>& made) {
+  if (c.parts.size() == 1) return answer_json(c.parts.front(), made.front());
+  nlohmann::json surfaces = nlohmann::json::array();
+  for (std::size_t p = 0; p < c.parts.size(); ++p)
+    surfaces.push_back(nlohmann::json::parse(answer_json(c.parts[p], made[p])));
+  const auto library = effect_library();
+  const nlohmann::json answer{{"format", "clumpforge-concealed-answer/1"},
+                              {"effect", c.effect ? effect_spec(library, *c.effect).name : std::string("none")},
+                              {"surfaces", surfaces}};
+  return answer.dump(2) + "\n";
 }
 
 /// One generated case: its recordings and answer written into `dir` (unless stored there
@@ -552,19 +598,27 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
     return diagnose_case(c.id, job, dir / "report.json");
-  auto made = make_concealed_recordings(generator, table, c.options);
-  if (!made) {
-    std::cerr << c.id << ": " << made.error().message << "\n";
-    return false;
-  }
-  fs::remove_all(dir);
-  for (std::size_t r = 0; r < made->recordings.size(); ++r) {
-    if (auto ok = write_recording(dir / "recordings" / made->names[r], made->recordings[r]); !ok) {
-      std::cerr << ok.error().message << "\n";
+  std::vector<ConcealResult> made;
+  for (const auto& part : c.parts) {
+    auto one = make_concealed_recordings(generator, table, part);
+    if (!one) {
+      std::cerr << c.id << ": " << one.error().message << "\n";
       return false;
     }
+    made.push_back(std::move(*one));
   }
-  std::ofstream(dir / "answer.json") << answer_json(c.options, *made);
+  fs::remove_all(dir);
+  for (std::size_t p = 0; p < c.parts.size(); ++p) {
+    for (std::size_t r = 0; r < made[p].recordings.size(); ++r) {
+      // Two surfaces make the same set-ups' names: the surface tells them apart.
+      const std::string name = c.parts.size() > 1 ? c.parts[p].surface + "-" + made[p].names[r] : made[p].names[r];
+      if (auto ok = write_recording(dir / "recordings" / name, made[p].recordings[r]); !ok) {
+        std::cerr << ok.error().message << "\n";
+        return false;
+      }
+    }
+  }
+  std::ofstream(dir / "answer.json") << case_answer(c, made);
   return diagnose_case(c.id, job, dir / "report.json");
 }
 
@@ -582,7 +636,7 @@ int score_generated(const std::vector<Case>& cases, const std::string& out) {
       return 1;
     }
     if (c.effect) {
-      o->concealed = c.options.values.at(0);
+      o->concealed = effect_part(c).values.at(0);
       o->null_value = effect_off(effect_spec(library, *c.effect))[0];
     }
     std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id,
