@@ -290,6 +290,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                                {"passes", h.passes},
                                {"evaluations", h.evaluations},
                                {"smallest_detectable", finite_or_null(h.smallest_detectable)},
+                               {"replay_shown", finite_or_null(h.replay_shown)},
                                {"strong_delta_chi2", finite_or_null(h.strong_delta_chi2)},
                                {"strong_resolution_chi2", finite_or_null(h.strong_resolution_chi2)}});
   }

@@ -142,7 +142,14 @@ struct HypothesisReport {
   std::vector<std::string>
       worsened_phases;  ///< flagged phases it makes worse (training trials), with chi^2 per value before -> after
   int evaluations = 0;
-  double smallest_detectable = 0.0;  ///< of its first parameter (reported with verdict "none")
+  /// With verdict "none": the smallest magnitude of its first parameter these recordings would
+  /// have revealed. Claimed only for an effect they decide (they reject its strong magnitude, see
+  /// strong_delta_chi2); NaN otherwise, whatever a replay showed.
+  double smallest_detectable = 0.0;
+  /// With verdict "none": the smallest magnitude of its first parameter at which a replay of the
+  /// diagnosed clump showed against the baseline (the coefficients absorbing what they can to
+  /// first order): that clump's response, not a claim about the recordings. NaN when none did.
+  double replay_shown = NAN;
   /// With verdict "none": the recordings' chi^2 with the effect at its strong magnitude minus
   /// the null's, the coefficients absorbing what they can (first order, then refitted) and each
   /// trial released at the most favourable orientation tried; the effect is decided absent only

@@ -261,11 +261,15 @@ std::optional<std::pair<Basis, std::string>> undecidable_tracks(const Context& c
 Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result, const Model& baseline,
                                              const Located& located, const std::vector<Effect>& effects,
                                              const DiagnoseOptions& options);
-Result<std::pair<std::vector<std::string>, std::vector<std::string>>> detection_limits(Context& c,
-                                                                                       DiagnoseResult& result,
-                                                                                       const Model& baseline,
-                                                                                       const std::vector<Fitted>& fits,
-                                                                                       const DiagnoseOptions& options);
+/// What a `none` says of each candidate it fitted (detection_limits): the smallest magnitude the
+/// recordings would have revealed, for those they decide; the rest, each with why not.
+struct DetectionLimits {
+  std::vector<std::string> limits;     ///< "name parameter value", decided candidates
+  std::vector<std::string> undecided;  ///< names
+  std::vector<std::string> why;        ///< per undecided name: what its replays showed
+};
+Result<DetectionLimits> detection_limits(Context& c, DiagnoseResult& result, const Model& baseline,
+                                         const std::vector<Fitted>& fits, const DiagnoseOptions& options);
 Result<void> every_trial_stage(Context& c, DiagnoseResult& result, const std::vector<Fitted>& fits, SecondNull& second,
                                const DiagnoseOptions& options);
 Result<std::optional<std::pair<std::size_t, Fitted>>> particle_model_check(Context& c, ParticleModelCheck& check,

@@ -113,7 +113,7 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
   result.verdict = Verdict::None;
   auto detection = detection_limits(c, result, baseline, fits, options);
   if (!detection) return std::unexpected(detection.error());
-  const auto& [limits, untestable] = *detection;
+  const auto& [limits, untestable, why] = *detection;
   std::vector<std::string> slight, outliers;
   for (const auto& [key, g] : final_groups) {
     if (key.phase == Phase::Hold || g.values < 20 || !beyond_noise(g.chi2, g.values, final_groups.size())) continue;
@@ -142,19 +142,21 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
     result.notes.push_back(fmt::format("outlier trials, not counted as a mismatch: {}", fmt::join(outliers, ", ")));
   }
   result.basis = slight.empty() ? Basis::Consistent : Basis::SlightMisfit;
-  result.statement = fmt::format(
-      "No missing physics found: no candidate passes every check and {}. Smallest effects these recordings would "
-      "have revealed (at delta-BIC {:g} and a phase misfit of three times hypot(noise, model accuracy), after the "
-      "coefficients absorb what they can to first order; each a magnitude a replay showed): {}.",
-      residual_state, options.min_delta_bic, fmt::join(limits, "; "));
+  result.statement = fmt::format("No missing physics found: no candidate passes every check and {}.", residual_state);
+  if (!limits.empty())
+    result.statement += fmt::format(
+        " Smallest effects these recordings would have revealed (at delta-BIC {:g} and a phase misfit of three times "
+        "hypot(noise, model accuracy), after the coefficients absorb what they can to first order; each a magnitude "
+        "a replay showed, of an effect the recordings reject at its strong magnitude): {}.",
+        options.min_delta_bic, fmt::join(limits, "; "));
   if (!untestable.empty()) {
     // What the frame-by-frame fit cannot reach: the effects that act after the release
     // horizon of an irregular body (its contacts) need more than these tracks.
     result.undecidable = untestable;
     result.statement += fmt::format(
-        " Not decided by the predictable parts of these tracks: {} (at its strong magnitude each would not show, "
-        "or the recordings do not reject it); they act where the unknown release orientation decides the path.",
-        fmt::join(untestable, ", "));
+        " Not decided by the predictable parts of these tracks, and no limit claimed: {}; they act where the unknown "
+        "release orientation decides the path.",
+        fmt::join(why, "; "));
     result.experiment =
         "record each trial's release orientation to a few degrees (a marked particle, a release jig), or repeat the "
         "tests with a sphere of the same material, whose path does not depend on it";

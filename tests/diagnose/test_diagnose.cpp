@@ -326,7 +326,9 @@ TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) 
   ASSERT_EQ(result->verdict, Verdict::None) << result->statement;
   const HypothesisReport* drag = hypothesis_named(*result, "air_drag");
   ASSERT_NE(drag, nullptr);
-  EXPECT_GT(drag->smallest_detectable, 0.45) << result->statement;
+  // No replay below the hidden drag showed, and no limit at or below it is claimed (NaN: none).
+  EXPECT_GT(drag->replay_shown, 0.45) << result->statement;
+  EXPECT_FALSE(drag->smallest_detectable <= 0.45) << result->statement;
 }
 
 // A `none` must not call absent an effect it cannot judge. A strong centre-of-mass offset
@@ -358,8 +360,9 @@ TEST(DiagnoseBlind, AStrongEffectWhosePathHangsOnTheReleaseIsNotCalledAbsent) {
   const HypothesisReport* offset = hypothesis_named(*result, "com_offset");
   ASSERT_NE(offset, nullptr);
   // A replay of the offset shows at its strong magnitude (the first-order guess of a smaller one is
-  // replayed before it is claimed, and here none smaller showed).
-  EXPECT_LE(offset->smallest_detectable, 2.5e-3) << result->statement;
+  // replayed before it is claimed, and here none smaller showed); undecided, it claims no limit.
+  EXPECT_LE(offset->replay_shown, 2.5e-3) << result->statement;
+  EXPECT_TRUE(std::isnan(offset->smallest_detectable)) << offset->smallest_detectable;
   // Over the releases tried it is not rejected by the margin (the figure is kept in the test's
   // XML output, --gtest_output=xml).
   RecordProperty("strong_delta_chi2", std::to_string(offset->strong_delta_chi2));
@@ -375,6 +378,10 @@ TEST(DiagnoseBlind, AStrongEffectWhosePathHangsOnTheReleaseIsNotCalledAbsent) {
 // figure claimed 0.0043, 23 times too little; the generated 8-trial set's static-kinetic cases
 // at 6ac3aa3 claimed 0.0009 and 0.0006 with 0.1 and 0.25 hidden, and lab-like case-21, a sphere
 // with adhesion of about 0.08 J/m^2 left unnamed, 0.0096 (0.079 replay-checked).
+// A limit is claimed only for an effect the recordings decide (they reject its strong
+// magnitude); here they reject the strong 0.25, and the replay figure, 0.078, is claimed with
+// 0.1 hidden: the 32-sphere clump responds more than the 340-sphere body. Refitting the
+// coefficients to the replays at 0.078 (tried, not kept) still shows it.
 TEST(DiagnoseBlind, TheSmallestDetectableEffectIsOneAReplayShowed) {
   ConcealOptions conceal = one_metre_drops(Effect::StaticKineticFriction, {0.1});
   conceal.drop_heights = {};
@@ -388,8 +395,11 @@ TEST(DiagnoseBlind, TheSmallestDetectableEffectIsOneAReplayShowed) {
   ASSERT_EQ(result->verdict, Verdict::None) << result->statement;
   const HypothesisReport* drop = hypothesis_named(*result, "static_kinetic_friction");
   ASSERT_NE(drop, nullptr);
-  RecordProperty("smallest_detectable", std::to_string(drop->smallest_detectable));
-  EXPECT_GT(drop->smallest_detectable, 0.5 * 0.1) << result->statement;
+  RecordProperty("replay_shown", std::to_string(drop->replay_shown));
+  EXPECT_GT(drop->replay_shown, 0.5 * 0.1) << result->statement;
+  const bool undecided =
+      std::count(result->undecidable.begin(), result->undecidable.end(), "static_kinetic_friction") == 1;
+  EXPECT_EQ(std::isfinite(drop->smallest_detectable), !undecided) << result->statement;
 }
 
 TEST(DiagnoseBlind, AnEffectOutsideTheCandidatesIsUnexplainedNotNamed) {
