@@ -234,6 +234,9 @@ struct CaseScore {
   bool detected = false;
   /// The concealed effect is neither among the report's undecidable ones nor its ambiguous candidates.
   bool called_decided = false;
+  /// Left `ambiguous` with the concealed effect among the candidates: not named, yet the right one
+  /// is among those the report asks an experiment to separate.
+  bool ambiguous_with_truth = false;
   int undecidable = 0;  ///< how many effects the report lists as undecidable
   /// The smallest detectable magnitude the report gives for the concealed effect (NaN: none given).
   double smallest_detectable = NAN;
@@ -269,6 +272,7 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
         j.contains("candidates") && j["candidates"].is_array() &&
         std::find(j["candidates"].begin(), j["candidates"].end(), truth) != j["candidates"].end();
     o.called_decided = std::find(u.begin(), u.end(), truth) == u.end() && !among_candidates;
+    o.ambiguous_with_truth = o.verdict == "ambiguous" && among_candidates;
     o.undecidable = static_cast<int>(u.size());
   }
   if (j.contains("hypotheses") && j["hypotheses"].is_array()) {
@@ -312,7 +316,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
     md += "\n";
   }
   int control_count = 0, false_positives = 0, named_controls = 0, strong_count = 0, missed_decided = 0;
-  int missed = 0, overclaimed = 0;
+  int missed = 0, overclaimed = 0, ambiguous_right = 0;
   std::vector<double> improvements, seconds, decided_absent;
   nlohmann::json summary;
   for (const auto& o : outcomes) {
@@ -332,6 +336,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
       missed_decided += o.magnitude == "strong" && !o.detected && o.called_decided;
       missed += !o.detected;
       overclaimed += o.overclaimed();
+      ambiguous_right += o.ambiguous_with_truth;
     }
   }
   md += "\n| effect | realistic | strong |\n|---|---:|---:|\n";
@@ -361,6 +366,8 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   md += fmt::format(
       "effects missed whose report gives a smallest detectable magnitude at or below the concealed one: {}/{}\n",
       overclaimed, missed);
+  md += fmt::format("effects missed as `ambiguous` with the concealed one among its candidates: {}/{}\n",
+                    ambiguous_right, missed);
   md += fmt::format("effects a control's `none` decides absent (not undecidable), median of {}: {:.0f} of {}\n",
                     decided_absent.size(), median(decided_absent), library.size());
   md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
@@ -395,6 +402,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   summary["strong_effects_missed_yet_called_decided"] = missed_decided;
   summary["effects_missed"] = missed;
   summary["missed_yet_claimed_detectable"] = overclaimed;
+  summary["missed_as_ambiguous_with_the_truth"] = ambiguous_right;
   summary["median_effects_decided_absent_on_controls"] = median(decided_absent);
   summary["median_heldout_improvement"] = median(improvements);
   summary["median_seconds"] = median(seconds);

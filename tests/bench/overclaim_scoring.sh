@@ -26,4 +26,15 @@ case "$line" in *": 0/1") ;; *) echo "expected 0/1 (0.6 claimed, above the 0.4 h
 case_dir adhesion-strong adhesion none '[{"name":"adhesion","smallest_detectable":null}]'
 line=$(score)
 case "$line" in *": 0/1") ;; *) echo "expected 0/1 (no figure given): $line"; exit 1 ;; esac
+# An `ambiguous` verdict with the concealed effect among its candidates is counted as such (not
+# named right, not an overclaim); one without it is not.
+ambiguous() {  # candidates-json
+  printf '{"verdict":"ambiguous","candidates":%s,"undecidable":[],"hypotheses":[],"seconds":1,"fit":{"before":{"heldout_rms_mm":0.1},"after":{"heldout_rms_mm":0.1}}}\n' \
+    "$1" >"$dir/out/adhesion-strong/report.json"
+  "$bench" -o "$dir/out" --full-set --controls 1 --existing-only 2>&1 | grep "as .ambiguous. with"
+}
+line=$(ambiguous '["adhesion","viscous_rolling"]')
+case "$line" in *": 1/1") ;; *) echo "expected 1/1 (adhesion among the candidates): $line"; exit 1 ;; esac
+line=$(ambiguous '["viscoelastic_restitution","elastic_plastic_restitution"]')
+case "$line" in *": 0/1") ;; *) echo "expected 0/1 (adhesion not among them): $line"; exit 1 ;; esac
 echo ok
