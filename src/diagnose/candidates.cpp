@@ -360,6 +360,7 @@ const std::vector<Evaluator>& released_evaluators(const Context& c, AbsenceCheck
 /// report.strong_delta_chi2), at each trial's most favourable release of those tried, with the
 /// coefficients refitted, and beyond twice the next finer clump's move
 /// (report.strong_resolution_chi2). report.strong_delta_chi2 keeps the least rejection found.
+/// why_undecided words the check that failed: a check added here is added there too.
 Result<bool> rejected(Context& c, CellProbe& cells, AbsenceCheck& check, const Model& baseline, const Model& probe,
                       const TrialCells& probed, double needed, HypothesisReport& report,
                       const DiagnoseOptions& options) {
@@ -553,7 +554,8 @@ Result<ReplayShown> replay_shown(Context& c, CellProbe& cells, const Model& base
 }
 
 /// Why a candidate the recordings do not decide claims no limit, for the statement: what its
-/// replays showed, and which check of `rejected` its strong magnitude did not pass.
+/// replays showed, and which check of `rejected` its strong magnitude did not pass (kept in step
+/// with it: releases and the refit only lower strong_delta_chi2, then the resolution allowance).
 std::string why_undecided(const EffectSpec& spec, const ReplayShown& shown, const HypothesisReport& report, bool shows,
                           double needed) {
   const EffectParameter& first = spec.parameters[0];
