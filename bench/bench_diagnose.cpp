@@ -249,6 +249,7 @@ struct CaseScore {
     return !detected && hidden * claimed > 0.0 && std::abs(claimed) <= std::abs(hidden);
   }
   std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
+  std::vector<std::pair<std::string, double>> stages;      ///< the report's stage_seconds, in order
 };
 
 /// A case's report.json read for the score (nullopt when it is not JSON).
@@ -280,11 +281,40 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
       if (h.value("name", "") == truth && h.contains("smallest_detectable") && h["smallest_detectable"].is_number())
         o.smallest_detectable = h["smallest_detectable"].get<double>();
   }
+  if (j.contains("stage_seconds") && j["stage_seconds"].is_array()) {
+    for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", NAN));
+  }
   if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
     for (const auto& cmp : j["ensemble"]["comparisons"])
       o.ensemble_z.emplace_back(cmp.value("statistic", "mean") + " " + cmp.value("outcome", "?"), cmp.value("z", NAN));
   }
   return o;
+}
+
+/// Where the diagnoses' time went: the median case among the controls and among the effect
+/// cases, and each stage's median share of a case (from each report's stage_seconds).
+std::string time_summary(const std::vector<CaseScore>& outcomes, nlohmann::json& summary) {
+  std::vector<double> controls, effects;
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<double>> shares;
+  for (const auto& o : outcomes) {
+    (o.truth == "none" ? controls : effects).push_back(o.seconds);
+    for (const auto& [stage, seconds] : o.stages) {
+      if (!shares.contains(stage)) order.push_back(stage);
+      if (o.seconds > 0.0) shares[stage].push_back(seconds / o.seconds);
+    }
+  }
+  std::string md = fmt::format("median diagnosis time of the controls: {:.1f} s; of the effect cases: {:.1f} s\n",
+                               median(controls), median(effects));
+  summary["median_seconds_controls"] = median(controls);
+  summary["median_seconds_effects"] = median(effects);
+  if (order.empty()) return md;
+  md += "\n| stage | median share of a case |\n|---|---:|\n";
+  for (const auto& stage : order) {
+    md += fmt::format("| {} | {:.0f} % |\n", stage, 100.0 * median(shares[stage]));
+    summary["median_stage_share"][stage] = median(shares[stage]);
+  }
+  return md;
 }
 
 /// The generated set's score: the confusion matrix, detection per effect and magnitude, the
@@ -373,6 +403,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
                     100.0 * median(improvements));
   md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
+  md += time_summary(outcomes, summary);
   // On the controls the calibrated null's replays should sit on the recorded outcomes within
   // their standard errors (z about 0 +- 1): a mean z away from 0 is a bias of the diagnosed
   // particle model against the generator's, which the ensemble stage may blame on an effect.

@@ -527,7 +527,7 @@ Result<ReplayShown> replay_shown(Context& c, CellProbe& cells, const Model& base
                                  const Eigen::VectorXd& base_cells, const ResidualProjection& keep, const Shown& strong,
                                  DiagnoseResult& result) {
   const auto& first = spec.parameters[0];
-  const bool shows = strong.signal >= strong.needed && strong.misfit >= strong.needed_misfit;
+  const bool shows = strong.shown() >= 1.0;
   if (first.log_scale)
     return ReplayShown{shows ? first.strong : NAN,
                        shows ? fmt::format("with {} {:.3g} would show", first.name, first.strong)
@@ -644,7 +644,7 @@ Result<DetectionLimits> detection_limits(Context& c, DiagnoseResult& result, con
     report.replay_shown = shown->magnitude;
     // Decided only where it would show at its strong magnitude and the recordings reject that
     // magnitude; otherwise said, not counted as absent, and no limit claimed.
-    const bool shows = strong.signal >= needed && strong.misfit >= needed_misfit;
+    const bool shows = strong.shown() >= 1.0;
     auto absent =
         shows ? rejected(c, cells, check, baseline, probe, *probed, needed, report, options) : Result<bool>(false);
     if (!absent) return std::unexpected(absent.error());
