@@ -208,17 +208,17 @@ bool judge_on_converged_clump(DiagnoseResult& result, const ParticleModelCheck& 
 
 namespace {
 
-/// A finer clump (swapped in) refitted: the baseline refitted the baseline's way with it (the
-/// coefficients the frames pin change with the clump: a coarse clump rolls otherwise), and its
-/// whole tracks replayed to put the recordings in its frame.
+/// A finer clump (swapped in) refitted: the baseline's coefficients refitted with it
+/// (fit_coefficients_near: the coefficients the frames pin change with the clump, a coarse clump
+/// rolls otherwise; those the windows leave unpinned stay the table's, unsearched: the windows are
+/// the diagnosed clump's, and whether a coefficient acts in them does not change with the clump),
+/// and its whole tracks replayed to put the recordings in its frame.
 struct Refitted {
   Fitted fitted;
   std::vector<TrialScore> scores;
 };
 Result<Refitted> refit_with_clump(Context& c, const Model& baseline, int max_evaluations) {
-  const auto unpinned = c.unpinned;
-  auto fitted = fit_coefficients(c, baseline, c.training, max_evaluations);
-  c.unpinned = unpinned;
+  auto fitted = fit_coefficients_near(c, baseline, c.training, max_evaluations);
   if (!fitted) return std::unexpected(fitted.error());
   c.ev.full_duration = true;
   auto scores = score(c, fitted->model, c.all, true);
@@ -399,6 +399,9 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     EnsembleOptions pursue = eo;
     pursue.finer = nullptr;  // its absences are not what the verdict reports
     if (let_through) pursue.pursue = let_through->effect;
+    // The candidates of a rung that does not explain the outcomes are read only on the last rung
+    // (judge_on_converged_clump); an explaining one's always (settled on, or its agreement).
+    pursue.candidates_when_inconsistent = k + 1 == c.finer.size();
     auto fine = compare_ensembles(c.ev, refit->fitted.model, refit->scores, free, candidates, pursue);
     if (!fine) return std::unexpected(fine.error());
     c.evaluations += fine->replays;

@@ -400,10 +400,7 @@ Result<std::optional<double>> recalibrated_where_rejected(Context& c, CellProbe&
     if (share != shares.tests.end() && share->second >= needed) which.push_back(i);
   }
   if (which.empty()) return std::optional<double>();
-  // The coefficients the fitted windows pin are the diagnosis's, whatever this fit finds.
-  const auto unpinned = c.unpinned;
-  auto wide = fit_baseline(c, model, false, which);
-  c.unpinned = unpinned;
+  auto wide = fit_baseline(c, model, false, which, Pinning::Keep);
   if (!wide) return std::unexpected(wide.error());
   // Scored on every training trial, the other coefficients where the refit left them (a refit
   // of all of them again, Levenberg-Marquardt over the 36 training trials of a nine-set-up set,

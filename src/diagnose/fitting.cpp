@@ -116,8 +116,42 @@ Result<void> set_horizons(Context& c, const Model& model, double perturbation) {
   return {};
 }
 
+namespace {
+
+constexpr int kNarrowGrid = 7;
+
+/// Where fit_baseline searches a coefficient from `current`: its whole range, or narrowly
+/// +-15 % of it (at least +-0.02, mu_r +-0.006).
+std::pair<double, double> search_range(Coefficient coefficient, double current, bool narrow) {
+  auto [low, high] = coefficient_range(coefficient);
+  if (!narrow) return {low, high};
+  const double half = std::max(0.15 * current, coefficient == Coefficient::RollingFriction ? 0.006 : 0.02);
+  return {std::max(low, current - half), std::min(high, current + half)};
+}
+
+/// Whether a coefficient fit_baseline searched narrowly from `from` (with `pinning` Keep) ended
+/// within half a grid cell of its range's edge, short of the whole range's: its minimum may lie
+/// beyond.
+bool ends_on_narrow_edge(const Context& c, const Model& from, const Model& fitted) {
+  for (std::size_t s = 0; s < from.base.size(); ++s) {
+    for (LabTest test : {LabTest::Tilt, LabTest::Roll, LabTest::Drop}) {
+      const Coefficient coefficient = coefficient_for(test);
+      if (c.unpinned.contains({from.base[s].surface, coefficient})) continue;
+      const auto [low, high] = search_range(coefficient, coefficient_of(from.base[s].interaction, coefficient), true);
+      const auto [lowest, highest] = coefficient_range(coefficient);
+      const double margin = 0.5 * (high - low) / (kNarrowGrid - 1);
+      const double v = coefficient_of(fitted.base[s].interaction, coefficient);
+      if ((v < low + margin && low > lowest) || (v > high - margin && high < highest)) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 /// Block-coordinate fit of the base coefficients: each on its own test's training trials.
-Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vector<std::size_t>& trials) {
+Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vector<std::size_t>& trials,
+                           Pinning pinning) {
   const auto& recs = *c.ev.recordings;
   for (std::size_t s = 0; s < model.base.size(); ++s) {
     // Friction from the tilt, rolling friction from the rolls, then restitution from the
@@ -128,15 +162,11 @@ Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vect
         const Recording& r = recs[c.ev.trials[i].recording];
         if (r.test == test && r.surface == model.base[s].surface) which.push_back(i);
       }
-      if (which.empty()) continue;
       const Coefficient coefficient = coefficient_for(test);
-      auto [low, high] = coefficient_range(coefficient);
+      const bool listed = c.unpinned.contains({model.base[s].surface, coefficient});
+      if (which.empty() || (pinning == Pinning::Keep && listed)) continue;
       const double current = coefficient_of(model.base[s].interaction, coefficient);
-      if (narrow) {
-        const double half = std::max(0.15 * current, coefficient == Coefficient::RollingFriction ? 0.006 : 0.02);
-        low = std::max(low, current - half);
-        high = std::min(high, current + half);
-      }
+      const auto [low, high] = search_range(coefficient, current, narrow);
       std::optional<Error> failure;
       auto chi2 = [&](double v) {
         Model m = model;
@@ -149,7 +179,7 @@ Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vect
         return total_chi_squared(*scores);
       };
       // A coarse grid (the chi^2 of irregular bodies can have several dips), then golden section.
-      const int grid = narrow ? 7 : wide_grid(coefficient);
+      const int grid = narrow ? kNarrowGrid : wide_grid(coefficient);
       double best = current, best_value = chi2(current), worst_value = best_value;
       for (int k = 0; k < grid; ++k) {
         const double v = low + (high - low) * k / (grid - 1);
@@ -164,7 +194,7 @@ Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vect
       // Not pinned: across its whole range the chi^2 moves by less than kUnpinned (the fitted
       // windows end before the coefficient acts, a tuber's e at its first contact). The
       // materials table's value is kept and said to be uncalibrated, not a grid's edge.
-      if (worst_value - best_value < kUnpinned) {
+      if (pinning == Pinning::Decide && worst_value - best_value < kUnpinned) {
         c.unpinned.insert({model.base[s].surface, coefficient});
         for (const auto& b : c.table_values) {
           if (b.surface == model.base[s].surface) {
@@ -173,7 +203,7 @@ Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vect
         }
         continue;
       }
-      c.unpinned.erase({model.base[s].surface, coefficient});
+      if (pinning == Pinning::Decide) c.unpinned.erase({model.base[s].surface, coefficient});
       const double cell = (high - low) / (grid - 1);
       // Tight: within the predictability horizon a 1 % error in mu_r already shows.
       const double tolerance = coefficient == Coefficient::RollingFriction ? 1e-5 : 1e-4;
@@ -298,11 +328,25 @@ Result<Fitted> refit(Context& c, const Model& model, const EffectSpec* spec, con
 /// wide grid, then a narrow one, then all together (each test's coefficient also acts in
 /// the others).
 Result<Fitted> fit_coefficients(Context& c, const Model& start, const std::vector<std::size_t>& trials,
-                                int max_evaluations) {
-  auto wide = fit_baseline(c, start, false, trials);
+                                int max_evaluations, Pinning pinning) {
+  auto wide = fit_baseline(c, start, false, trials, pinning);
   if (!wide) return std::unexpected(wide.error());
-  auto narrow = fit_baseline(c, *wide, true, trials);
+  auto narrow = fit_baseline(c, *wide, true, trials, pinning);
   if (!narrow) return std::unexpected(narrow.error());
+  return refit(c, *narrow, nullptr, trials, max_evaluations);
+}
+
+/// The base coefficients fitted on `trials` from another clump's of the same body (`start`): a
+/// narrow search (the coefficients move little from one clump of a body to the next: the generated
+/// nine-set-up strong adhesion case's friction moved from 0.5837 to 0.5839 between 32 and 256
+/// spheres, and the whole range's grid on the tilt took half the 256-sphere clump's refit), the
+/// whole range only when it ends on its edge, then Levenberg-Marquardt. The coefficients the
+/// windows leave unpinned stay as they are (Pinning::Keep).
+Result<Fitted> fit_coefficients_near(Context& c, const Model& start, const std::vector<std::size_t>& trials,
+                                     int max_evaluations) {
+  auto narrow = fit_baseline(c, start, true, trials, Pinning::Keep);
+  if (!narrow) return std::unexpected(narrow.error());
+  if (ends_on_narrow_edge(c, start, *narrow)) return fit_coefficients(c, start, trials, max_evaluations, Pinning::Keep);
   return refit(c, *narrow, nullptr, trials, max_evaluations);
 }
 

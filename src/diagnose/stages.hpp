@@ -224,7 +224,13 @@ std::pair<double, bool> largest_misfit(const Context& c, const Groups& groups);
 
 Result<std::vector<TrialScore>> score(Context& c, const Model& m, const std::vector<std::size_t>& which, bool keep);
 Result<void> set_horizons(Context& c, const Model& model, double perturbation);
-Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vector<std::size_t>& trials);
+/// What a fit of the base coefficients does with those the fitted windows may not pin:
+/// Decide (each is searched and, when its chi^2 moves by less than kUnpinned over its range,
+/// set to the materials table's value and listed in Context::unpinned) or Keep (the windows are
+/// set: those listed are left as they are and not searched, and the list is not changed).
+enum class Pinning { Decide, Keep };
+Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vector<std::size_t>& trials,
+                           Pinning pinning = Pinning::Decide);
 Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::vector<FitParameter>& parameters,
                                     const std::vector<std::size_t>& which, std::vector<double> unit, int iterations);
 std::pair<Model, std::vector<FitParameter>> fit_parameters(const Context& c, const Model& model, const EffectSpec* spec,
@@ -233,7 +239,9 @@ std::vector<double> unit_point(const Model& start, const std::vector<FitParamete
 Result<Fitted> refit(Context& c, const Model& model, const EffectSpec* spec, const std::vector<std::size_t>& which,
                      int max_evaluations);
 Result<Fitted> fit_coefficients(Context& c, const Model& start, const std::vector<std::size_t>& trials,
-                                int max_evaluations);
+                                int max_evaluations, Pinning pinning = Pinning::Decide);
+Result<Fitted> fit_coefficients_near(Context& c, const Model& start, const std::vector<std::size_t>& trials,
+                                     int max_evaluations);
 Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpec& spec,
                               const std::vector<std::size_t>& which, int max_evaluations);
 
