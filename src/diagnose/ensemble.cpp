@@ -905,7 +905,8 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   const auto library = effect_library();
   const bool unexplained = !outcomes_consistent(result.null_comparisons, free.size());
   std::vector<Proposal> proposals;
-  for (Effect e : unexplained && !options.candidates_when_inconsistent ? std::vector<Effect>{} : candidates) {
+  const bool try_candidates = !unexplained || options.candidates_when_inconsistent;
+  for (Effect e : try_candidates ? candidates : std::vector<Effect>{}) {
     auto proposal = propose(ev, plans, null_model, null_sample, null_means, recorded, inverse_se, jacobian, free,
                             effect_spec(library, e), options,
                             options.pursue == e ? Pursuit::Always

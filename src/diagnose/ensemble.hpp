@@ -116,8 +116,8 @@ struct EnsembleOptions {
   const Clump* finer = nullptr;
   /// Whether the candidates are tried when the calibrated null leaves the outcomes inconsistent.
   /// Off for a rung of the particle-model check with a finer one after it: there only whether its
-  /// null explains the outcomes is asked (about a fifth of a diagnosis's time, on the generated
-  /// nine-set-up strong adhesion case, went to candidates nothing read).
+  /// null explains the outcomes is asked (on the generated nine-set-up strong adhesion case the
+  /// 64-sphere rung's comparison took 14.2 s with its candidates and 2.3 s without).
   bool candidates_when_inconsistent = true;
 };
 
