@@ -33,6 +33,14 @@ nlohmann::json finite_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
 }
 
+// Where the recordings prefer a candidate's strong magnitude: each set-up's share.
+nlohmann::json preferred_json(const std::vector<SetUpShare>& shares) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& s : shares)
+    out.push_back({{"surface", s.surface}, {"test", std::string(to_string(s.test))}, {"delta_chi2", s.delta_chi2}});
+  return out;
+}
+
 // How a rung's replayed outcomes moved from the previous clump's (null when not compared).
 nlohmann::json outcome_shift_json(const std::optional<OutcomeShift>& shift, const std::vector<std::string>& names) {
   if (!shift) return nlohmann::json();
@@ -292,7 +300,8 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                                {"smallest_detectable", finite_or_null(h.smallest_detectable)},
                                {"replay_shown", finite_or_null(h.replay_shown)},
                                {"strong_delta_chi2", finite_or_null(h.strong_delta_chi2)},
-                               {"strong_resolution_chi2", finite_or_null(h.strong_resolution_chi2)}});
+                               {"strong_resolution_chi2", finite_or_null(h.strong_resolution_chi2)},
+                               {"strong_preferred_in", preferred_json(h.strong_preferred_in)}});
   }
   auto phases_of = [](const std::vector<PhaseOf>& list) {
     nlohmann::json out = nlohmann::json::array();

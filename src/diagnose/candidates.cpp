@@ -387,19 +387,19 @@ RejectionShares rejection_shares(const Context& c, const std::vector<std::pair<G
 /// 99 so). Only the coefficients of the tests whose trials alone reject `model` by `needed` are
 /// searched; none when its first flights alone do (nullopt: before the first contact no
 /// coefficient acts, so none could absorb it).
-Result<std::optional<double>> recalibrated_where_rejected(Context& c, CellProbe& cells, const AbsenceCheck& check,
+Result<std::optional<Fitted>> recalibrated_where_rejected(Context& c, CellProbe& cells, const AbsenceCheck& check,
                                                           const Model& model, double needed) {
   auto fitted_cells = cells(model);
   if (!fitted_cells) return std::unexpected(fitted_cells.error());
   const RejectionShares shares = rejection_shares(c, cells.keys, check.bases.front().values, fitted_cells->values);
-  if (shares.flight >= needed) return std::optional<double>();
+  if (shares.flight >= needed) return std::optional<Fitted>();
   std::vector<std::size_t> which;
   for (std::size_t i : c.training) {
     const Recording& r = (*c.ev.recordings)[c.ev.trials[i].recording];
     const auto share = shares.tests.find({r.surface, r.test});
     if (share != shares.tests.end() && share->second >= needed) which.push_back(i);
   }
-  if (which.empty()) return std::optional<double>();
+  if (which.empty()) return std::optional<Fitted>();
   auto wide = fit_baseline(c, model, false, which, Pinning::Keep);
   if (!wide) return std::unexpected(wide.error());
   // Scored on every training trial, the other coefficients where the refit left them (a refit
@@ -407,7 +407,22 @@ Result<std::optional<double>> recalibrated_where_rejected(Context& c, CellProbe&
   // added a third to the grid's time and left the strong adhesion's rejection the same to 1e-4).
   auto scores = score(c, *wide, c.training, false);
   if (!scores) return std::unexpected(scores.error());
-  return std::optional<double>(total_chi_squared(*scores));
+  return std::optional<Fitted>(
+      Fitted{.model = *wide, .chi2 = total_chi_squared(*scores), .evaluations = 0, .values = total_values(*scores)});
+}
+
+/// Where the recordings fit `preferred` better than the baseline (its cells against `base`): each
+/// set-up's share, largest first, those that prefer it only.
+Result<std::vector<SetUpShare>> preferred_in(Context& c, CellProbe& cells, const Eigen::VectorXd& base,
+                                             const Model& preferred) {
+  auto preferred_cells = cells(preferred);
+  if (!preferred_cells) return std::unexpected(preferred_cells.error());
+  std::vector<SetUpShare> out;
+  for (const auto& [where, d] : rejection_shares(c, cells.keys, base, preferred_cells->values).tests) {
+    if (d < 0.0) out.push_back({where.first, where.second, -d});
+  }
+  std::ranges::sort(out, [](const SetUpShare& a, const SetUpShare& b) { return a.delta_chi2 > b.delta_chi2; });
+  return out;
 }
 
 /// Whether the recordings reject `probe` (an effect at its strong magnitude, `probed` its
@@ -468,7 +483,17 @@ Result<bool> rejected(Context& c, CellProbe& cells, AbsenceCheck& check, const M
   // The dearest check last.
   auto wide = recalibrated_where_rejected(c, cells, check, profile->model, needed);
   if (!wide) return std::unexpected(wide.error());
-  if (*wide) report.strong_delta_chi2 = std::min(report.strong_delta_chi2, **wide - base_cells.squaredNorm());
+  if (*wide) {
+    const double preference = base_cells.squaredNorm() - (*wide)->chi2;
+    report.strong_delta_chi2 = std::min(report.strong_delta_chi2, -preference);
+    if (preference >= needed) {
+      // Not a finding: with one set-up carrying it, where the effect trades with that test's
+      // coefficient, a control does the same (docs/diagnose.md); where it lies is reported.
+      auto where = preferred_in(c, cells, base_cells, (*wide)->model);
+      if (!where) return std::unexpected(where.error());
+      report.strong_preferred_in = std::move(*where);
+    }
+  }
   return report.strong_delta_chi2 >= needed + allowance;
 }
 
@@ -628,6 +653,16 @@ std::string why_undecided(const EffectSpec& spec, const ReplayShown& shown, cons
   const std::string replay = fmt::format("a replay shows {} {:.3g}", first.name, shown.magnitude);
   if (!shows)
     return fmt::format("{} ({}, but its strong {:.3g} does not reach both margins)", spec.name, replay, first.strong);
+  const SetUpShare* alone = preferred_alone(report);
+  if (report.strong_delta_chi2 < 0.0 && alone) {
+    const SetUpShare& most = *alone;
+    return fmt::format(
+        "{} ({}, but the recordings fit its strong {:.3g} better than the null, by {:.3g}, {:.3g} of it in the {} on "
+        "{}, where it trades with the {}: that one set-up cannot tell the effect from the particle model's inaccuracy "
+        "there)",
+        spec.name, replay, first.strong, -report.strong_delta_chi2, most.delta_chi2, to_string(most.test), most.surface,
+        coefficient_name(coefficient_for(most.test)));
+  }
   if (report.strong_delta_chi2 < 0.0)
     return fmt::format("{} ({}, but the recordings fit its strong {:.3g} better than the null, by {:.3g})", spec.name,
                        replay, first.strong, -report.strong_delta_chi2);

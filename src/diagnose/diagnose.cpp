@@ -154,6 +154,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     if (auto ok = judge_ensembles(c, result, baseline, *full_base, effects, options); !ok)
       return std::unexpected(ok.error());
   }
+  ask_for_deciding_experiments(result);
   track_plots(c, result, *full_base, *full_improved);
   took(Stage::Ensemble);
   result.evaluations = c.evaluations;

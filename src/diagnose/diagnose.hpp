@@ -120,6 +120,13 @@ struct ParameterValue {
   double value = 0.0, low = 0.0, high = 0.0;  ///< 95 % interval [low, high]
 };
 
+/// One surface's recordings of one test, and its share of a chi^2 difference.
+struct SetUpShare {
+  std::string surface;
+  LabTest test = LabTest::Drop;
+  double delta_chi2 = 0.0;
+};
+
 struct HypothesisReport {
   std::string name;
   /// False when no flagged phase had a large misfit for any candidate to clear: then none can
@@ -160,7 +167,17 @@ struct HypothesisReport {
   /// clump's. The rejection must also exceed twice this (it may be the clump's). NaN when not
   /// asked (no finer clump, or not rejected).
   double strong_resolution_chi2 = NAN;
+  /// With verdict "none": where the recordings fit the effect's strong magnitude better than the
+  /// null by the margin (with the coefficients of the tests that rejected it calibrated again over
+  /// their whole ranges, the last absence check): each set-up's share of that preference, largest
+  /// first; empty otherwise. A preference one set-up carries alone, where the effect trades with
+  /// that test's coefficient, does not name the effect: the diagnosed clump's own inaccuracy there
+  /// can do the same (see docs/diagnose.md), and the report says which experiment would decide.
+  std::vector<SetUpShare> strong_preferred_in;
 };
+
+/// The set-up that carries nine tenths or more of a report's strong_preferred_in, or null.
+const SetUpShare* preferred_alone(const HypothesisReport& report);
 
 struct FitQuality {
   double train_rms_mm = 0.0, heldout_rms_mm = 0.0;  ///< position residual RMS over fitted frames

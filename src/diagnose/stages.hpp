@@ -339,6 +339,8 @@ void say_unexplained_phases(DiagnoseResult& result, const DiagnoseOptions& optio
 Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline, const std::vector<Fitted>& fits,
                       const Groups& final_groups, const DiagnoseOptions& options);
 
+void ask_for_deciding_experiments(DiagnoseResult& result);
+
 /// The second null: the coefficients refitted on every trial, the held-out ones included,
 /// computed once, when first needed. When the training trials pin a coefficient poorly (a
 /// roll fitted only up to its short horizon), the held-out trials show a miscalibration, which

@@ -164,9 +164,31 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
   return {};
 }
 
+/// For each candidate still undecided whose strong magnitude one set-up alone prefers (see
+/// HypothesisReport::strong_preferred_in), the experiment that would tell it from the coefficient
+/// it trades with there, added to result.experiment (whichever stage wrote it last).
+void ask_for_deciding_experiments(DiagnoseResult& result) {
+  for (const HypothesisReport& h : result.hypotheses) {
+    const SetUpShare* alone = preferred_alone(h);
+    if (!alone || std::ranges::find(result.undecidable, h.name) == result.undecidable.end()) continue;
+    const std::string coefficient(coefficient_name(coefficient_for(alone->test)));
+    result.experiment += fmt::format("{}to tell {} from the {} (the {} on {} alone prefers its strong magnitude): {}",
+                                     result.experiment.empty() ? "" : "; ", h.name, coefficient, to_string(alone->test),
+                                     alone->surface, experiment_for(h.name, coefficient));
+  }
+}
+
 }  // namespace clumpforge::diagnosis
 
 namespace clumpforge {
+
+const SetUpShare* preferred_alone(const HypothesisReport& report) {
+  double total = 0.0;
+  for (const SetUpShare& share : report.strong_preferred_in) total += share.delta_chi2;
+  if (report.strong_preferred_in.empty() || !(report.strong_preferred_in.front().delta_chi2 >= 0.9 * total))
+    return nullptr;
+  return &report.strong_preferred_in.front();
+}
 
 std::string_view stage_name(Stage stage) {
   switch (stage) {

@@ -430,7 +430,18 @@ TEST(DiagnoseBlind, AnEffectTheCoefficientsAbsorbFarFromTheNullIsNotCalledAbsent
   RecordProperty("strong_delta_chi2", std::to_string(adhesion->strong_delta_chi2));
   EXPECT_EQ(std::count(result->undecidable.begin(), result->undecidable.end(), "adhesion"), 1) << result->statement;
   EXPECT_FALSE(adhesion->smallest_detectable <= 0.4) << result->statement;
-  EXPECT_LT(adhesion->strong_delta_chi2, 10.0 + std::log(adhesion->values_used)) << result->statement;
+  const double needed = 10.0 + std::log(adhesion->values_used);
+  EXPECT_LT(adhesion->strong_delta_chi2, needed) << result->statement;
+  // Where the recordings prefer it (-55 at 4d1d961, by the margin of about 19): the tilt carries
+  // it, where adhesion trades with the static friction (the report asks for the experiment that
+  // would tell them apart). A control of the generated nine-set-up set prefers a strong adhesion on
+  // its tilt too (docs/diagnose.md), so it is not named.
+  if (adhesion->strong_delta_chi2 <= -needed) {
+    const SetUpShare* alone = preferred_alone(*adhesion);
+    ASSERT_NE(alone, nullptr) << result->statement;
+    EXPECT_EQ(alone->test, LabTest::Tilt);
+    EXPECT_GE(alone->delta_chi2, needed);
+  }
 }
 
 TEST(DiagnoseBlind, AnEffectOutsideTheCandidatesIsUnexplainedNotNamed) {
