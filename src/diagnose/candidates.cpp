@@ -257,6 +257,7 @@ double largest_signal_misfit(const Context& c, const std::vector<std::pair<Group
 struct TrialCells {
   Eigen::VectorXd values;
   std::vector<std::size_t> extent;
+  double chi2 = 0.0;  ///< the trials' chi^2, as score gives it (from the same replays)
 };
 
 /// The recordings' rejection of a strong effect (chi^2 with it minus the null's, the part the
@@ -322,6 +323,7 @@ class CellProbe {
         keys.push_back({{c_.ev.trials[c_.training[k]].recording, phase}, axis});
     }
     out.values = Eigen::Map<Eigen::VectorXd>(all_cells.data(), static_cast<Eigen::Index>(all_cells.size()));
+    out.chi2 = total_chi_squared(*scores);
     return out;
   }
   std::vector<std::pair<GroupKey, Axis>> keys;  ///< the baseline's cells' groups and axes
@@ -377,7 +379,7 @@ RejectionShares rejection_shares(const Context& c, const std::vector<std::pair<G
   return out;
 }
 
-/// The least chi^2 of the training trials with `model`'s effect held and its base coefficients
+/// The training trials' cells (and their chi^2) with `model`'s effect held and its base coefficients
 /// calibrated again the baseline's way (fit_baseline: a grid over each coefficient's whole range,
 /// then golden section), where a refit from the null's coefficients may have stopped short: a
 /// chi^2 flat where it starts tells Levenberg-Marquardt nothing. A strong adhesion added at the
@@ -387,38 +389,36 @@ RejectionShares rejection_shares(const Context& c, const std::vector<std::pair<G
 /// 99 so). Only the coefficients of the tests whose trials alone reject `model` by `needed` are
 /// searched; none when its first flights alone do (nullopt: before the first contact no
 /// coefficient acts, so none could absorb it).
-Result<std::optional<Fitted>> recalibrated_where_rejected(Context& c, CellProbe& cells, const AbsenceCheck& check,
-                                                          const Model& model, double needed) {
+Result<std::optional<TrialCells>> recalibrated_where_rejected(Context& c, CellProbe& cells, const AbsenceCheck& check,
+                                                              const Model& model, double needed) {
   auto fitted_cells = cells(model);
   if (!fitted_cells) return std::unexpected(fitted_cells.error());
   const RejectionShares shares = rejection_shares(c, cells.keys, check.bases.front().values, fitted_cells->values);
-  if (shares.flight >= needed) return std::optional<Fitted>();
+  if (shares.flight >= needed) return std::optional<TrialCells>();
   std::vector<std::size_t> which;
   for (std::size_t i : c.training) {
     const Recording& r = (*c.ev.recordings)[c.ev.trials[i].recording];
     const auto share = shares.tests.find({r.surface, r.test});
     if (share != shares.tests.end() && share->second >= needed) which.push_back(i);
   }
-  if (which.empty()) return std::optional<Fitted>();
+  if (which.empty()) return std::optional<TrialCells>();
   auto wide = fit_baseline(c, model, false, which, Pinning::Keep);
   if (!wide) return std::unexpected(wide.error());
   // Scored on every training trial, the other coefficients where the refit left them (a refit
   // of all of them again, Levenberg-Marquardt over the 36 training trials of a nine-set-up set,
   // added a third to the grid's time and left the strong adhesion's rejection the same to 1e-4).
-  auto scores = score(c, *wide, c.training, false);
-  if (!scores) return std::unexpected(scores.error());
-  return std::optional<Fitted>(
-      Fitted{.model = *wide, .chi2 = total_chi_squared(*scores), .evaluations = 0, .values = total_values(*scores)});
+  // Cells and chi^2 from one replay: where the recordings prefer it is read from the cells.
+  auto wide_cells = cells(*wide);
+  if (!wide_cells) return std::unexpected(wide_cells.error());
+  return std::optional<TrialCells>(std::move(*wide_cells));
 }
 
-/// Where the recordings fit `preferred` better than the baseline (its cells against `base`): each
-/// set-up's share, largest first, those that prefer it only.
-Result<std::vector<SetUpShare>> preferred_in(Context& c, CellProbe& cells, const Eigen::VectorXd& base,
-                                             const Model& preferred) {
-  auto preferred_cells = cells(preferred);
-  if (!preferred_cells) return std::unexpected(preferred_cells.error());
+/// Where the recordings fit a model better than the baseline (its training cells `preferred`
+/// against `base`): each set-up's share, largest first, those that prefer it only.
+std::vector<SetUpShare> preferred_in(const Context& c, const std::vector<std::pair<GroupKey, Axis>>& keys,
+                                     const Eigen::VectorXd& base, const Eigen::VectorXd& preferred) {
   std::vector<SetUpShare> out;
-  for (const auto& [where, d] : rejection_shares(c, cells.keys, base, preferred_cells->values).tests) {
+  for (const auto& [where, d] : rejection_shares(c, keys, base, preferred).tests) {
     if (d < 0.0) out.push_back({where.first, where.second, -d});
   }
   std::ranges::sort(out, [](const SetUpShare& a, const SetUpShare& b) { return a.delta_chi2 > b.delta_chi2; });
@@ -486,13 +486,9 @@ Result<bool> rejected(Context& c, CellProbe& cells, AbsenceCheck& check, const M
   if (*wide) {
     const double preference = base_cells.squaredNorm() - (*wide)->chi2;
     report.strong_delta_chi2 = std::min(report.strong_delta_chi2, -preference);
-    if (preference >= needed) {
-      // Not a finding: with one set-up carrying it, where the effect trades with that test's
-      // coefficient, a control does the same (docs/diagnose.md); where it lies is reported.
-      auto where = preferred_in(c, cells, base_cells, (*wide)->model);
-      if (!where) return std::unexpected(where.error());
-      report.strong_preferred_in = std::move(*where);
-    }
+    // Not a finding: with one set-up carrying it, where the effect trades with that test's
+    // coefficient, a control does the same (docs/diagnose.md); where it lies is reported.
+    if (preference >= needed) report.strong_preferred_in = preferred_in(c, cells.keys, base_cells, (*wide)->values);
   }
   return report.strong_delta_chi2 >= needed + allowance;
 }
