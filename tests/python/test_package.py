@@ -118,7 +118,9 @@ def test_long_calls_release_the_gil_and_a_raising_callback_stops_them():
     done = threading.Event()
 
     def run():
-        cf.validate(clump, test="roll", surface="soil", trials=6)
+        # 24 trials: about 0.2 s on an idle machine (6 took 45 ms, too close to the 50 ticks of 1 ms
+        # a main thread that runs alongside counts).
+        cf.validate(clump, test="roll", surface="soil", trials=24)
         done.set()
 
     worker = threading.Thread(target=run)
