@@ -56,15 +56,42 @@ void bind_parts(py::module_& m) {
       .def_readonly("bias_z_mm", &PhaseReport::bias_z_mm)
       .def_readonly("axis", &PhaseReport::axis)
       .def_readonly("statement", &PhaseReport::statement);
+  py::class_<SetUpShare>(m, "SetUpShare", "One surface's recordings of one test, and its share of a chi^2 difference.")
+      .def_readonly("surface", &SetUpShare::surface)
+      .def_readonly("test", &SetUpShare::test)
+      .def_readonly("delta_chi2", &SetUpShare::delta_chi2);
   py::class_<HypothesisReport>(m, "HypothesisReport", "One candidate effect as fitted and tested.")
       .def_readonly("name", &HypothesisReport::name)
       .def_readonly("fitted", &HypothesisReport::fitted)
       .def_readonly("values", &HypothesisReport::values)
+      .def_readonly("values_used", &HypothesisReport::values_used)
       .def_readonly("delta_chi2", &HypothesisReport::delta_chi2)
       .def_readonly("delta_bic", &HypothesisReport::delta_bic)
       .def_readonly("heldout_delta_chi2", &HypothesisReport::heldout_delta_chi2)
+      .def_readonly("all_trials_delta_bic", &HypothesisReport::all_trials_delta_bic)
+      .def_readonly("plausible", &HypothesisReport::plausible)
+      .def_readonly("improves_heldout", &HypothesisReport::improves_heldout)
       .def_readonly("passes", &HypothesisReport::passes)
-      .def_readonly("evaluations", &HypothesisReport::evaluations);
+      .def_readonly("worsened_phases", &HypothesisReport::worsened_phases)
+      .def_readonly("evaluations", &HypothesisReport::evaluations)
+      .def_readonly("smallest_detectable", &HypothesisReport::smallest_detectable,
+                    "with verdict none: the smallest magnitude of its first parameter these recordings would have "
+                    "revealed (NaN where they do not decide the effect)")
+      .def_readonly("replay_shown", &HypothesisReport::replay_shown,
+                    "with verdict none: the smallest magnitude a replay of the diagnosed clump showed (NaN: none)")
+      .def_readonly("strong_delta_chi2", &HypothesisReport::strong_delta_chi2,
+                    "with verdict none: chi^2 at the effect's strong magnitude minus the null's (NaN: not probed)")
+      .def_readonly("strong_resolution_chi2", &HypothesisReport::strong_resolution_chi2,
+                    "the next finer clump's response to the strong magnitude, from the diagnosed clump's")
+      .def_readonly("strong_preferred_in", &HypothesisReport::strong_preferred_in,
+                    "each set-up's share where the recordings prefer the strong magnitude, largest first")
+      .def(
+          "preferred_alone",
+          [](const HypothesisReport& h) -> std::optional<SetUpShare> {
+            const SetUpShare* alone = preferred_alone(h);
+            return alone ? std::optional<SetUpShare>(*alone) : std::nullopt;
+          },
+          "the set-up carrying nine tenths or more of strong_preferred_in, or None");
   py::class_<FitQuality>(m, "FitQuality")
       .def_readonly("train_rms_mm", &FitQuality::train_rms_mm)
       .def_readonly("heldout_rms_mm", &FitQuality::heldout_rms_mm)

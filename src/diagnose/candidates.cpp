@@ -654,8 +654,8 @@ std::string why_undecided(const EffectSpec& spec, const ReplayShown& shown, cons
     const SetUpShare& most = *alone;
     return fmt::format(
         "{} ({}, but the recordings fit its strong {:.3g} better than the null, by {:.3g}, {:.3g} of it in the {} on "
-        "{}, where it trades with the {}; the particle model's inaccuracy in that one set-up can do the same, as "
-        "controls of the generated sets prefer a strong adhesion on their tilts)",
+        "{}, where it trades with the {}; the particle model's inaccuracy in that one set-up can do the same: see "
+        "docs/diagnose.md, 'Naming what the recalibration prefers')",
         spec.name, replay, first.strong, -report.strong_delta_chi2, most.delta_chi2, to_string(most.test), most.surface,
         coefficient_name(coefficient_for(most.test)));
   }

@@ -342,7 +342,10 @@ std::string experiment_for(const std::string& a, const std::string& b) {
   if (involves("static_kinetic_friction"))
     return "tilt more slowly and film the first 10 mm of sliding: a kinetic coefficient below the static one makes the "
            "block jump ahead at onset";
-  return "add set-ups that load the two effects differently (other drop heights, start distances, particle masses)";
+  return fmt::format(
+      "add set-ups that load {} and {} differently (other drop heights, start distances, particle "
+      "masses)",
+      a, b);
 }
 
 /// A misfit no particle model's inaccuracy could leave: three times hypot(noise, model

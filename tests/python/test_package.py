@@ -182,6 +182,27 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
     assert cf.Basis.free_flights != cf.Basis.ensemble
 
 
+def test_diagnose_from_python_names_the_bundled_air_drag_and_reports_each_candidate():
+    """The bundled recordings (air drag concealed, no release orientations) diagnosed from Python
+    as from the CLI: air drag named frame by frame, adhesion fitted and failing; each candidate's
+    report carries the absence-check fields report.json writes (NaN or empty where not probed)."""
+    recordings = cf.read_recordings(str(ROOT / "clumps/tuber-default-diagnosis/recordings"))
+    clump = cf.read_clump(str(ROOT / "clumps/tuber-default-diagnosis.h5"))
+    result = cf.diagnose(clump, recordings, effects=["air_drag", "adhesion"])
+    assert result.verdict == cf.Verdict.named and result.effect == "air_drag"
+    assert result.basis == cf.Basis.frame_by_frame
+    by_name = {h.name: h for h in result.hypotheses}
+    assert by_name["air_drag"].passes and not by_name["adhesion"].passes
+    # delta-BIC margin 10 (DiagnoseOptions::min_delta_bic)
+    assert by_name["air_drag"].delta_bic > 10 > by_name["adhesion"].delta_bic
+    for h in result.hypotheses:
+        assert h.values_used > 0 and isinstance(h.worsened_phases, list)
+        # The absence check runs only under verdict none: nothing probed, nothing preferred.
+        assert math.isnan(h.strong_delta_chi2) and math.isnan(h.strong_resolution_chi2)
+        assert h.strong_preferred_in == [] and h.preferred_alone() is None
+    assert {"surface", "test", "delta_chi2"} <= set(dir(cf.SetUpShare))
+
+
 def test_materials_export_names_its_conventions():
     text = cf.export_materials(cf.default_materials(), "liggghts", conventions="liggghts")
     assert "coefficientRestitution" in text and "Tsuji" in text
