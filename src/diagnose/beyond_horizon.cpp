@@ -702,8 +702,10 @@ void say_flights(DiagnoseResult& result, const FlightWobble& f) {
   std::erase(result.undecidable, spec.name);
   result.effect_parameters = {{"offset_m", f.offset_m, f.offset_low_m, f.offset_high_m}};
   result.statement = fmt::format(
-      "Missing physics found in the free flights: {} ({}), at least about {:.2f} mm from the tracked point (95 % "
-      "interval {:.2f} to {:.2f} mm). Between bounces nothing touches the body and its centre of mass flies on a "
+      "Missing physics found in the free flights: {} ({}), at least about {:.2f} mm from the tracked point (what "
+      "the wobble needs, 95 % interval {:.2f} to {:.2f} mm over the flights: a low estimate, since a body that turns "
+      "little between bounces shows less of its offset). Between bounces nothing touches the body and its centre of "
+      "mass flies on a "
       "parabola whatever the release; the tracked point leaves its own best parabola by {:.3f} mm RMS per "
       "coordinate (the median of {} flights after the first contact), beyond the camera noise ({:.3f} mm) and "
       "what this body's silhouette centroid wanders as it turns ({:.3f} mm). The direction of the offset in the "
