@@ -76,7 +76,7 @@ void bind_parts(py::module_& m) {
       .def_readonly("evaluations", &HypothesisReport::evaluations)
       .def_readonly("smallest_detectable", &HypothesisReport::smallest_detectable,
                     "with verdict none: the smallest magnitude of its first parameter these recordings would have "
-                    "revealed (NaN where they do not decide the effect)")
+                    "revealed (NaN where they do not decide the effect; 0 under any other verdict)")
       .def_readonly("replay_shown", &HypothesisReport::replay_shown,
                     "with verdict none: the smallest magnitude a replay of the diagnosed clump showed (NaN: none)")
       .def_readonly("strong_delta_chi2", &HypothesisReport::strong_delta_chi2,

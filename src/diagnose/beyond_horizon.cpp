@@ -705,10 +705,9 @@ void say_flights(DiagnoseResult& result, const FlightWobble& f) {
       "Missing physics found in the free flights: {} ({}), at least about {:.2f} mm from the tracked point (what "
       "the wobble needs, 95 % interval {:.2f} to {:.2f} mm over the flights: a low estimate, since a body that turns "
       "little between bounces shows less of its offset). Between bounces nothing touches the body and its centre of "
-      "mass flies on a "
-      "parabola whatever the release; the tracked point leaves its own best parabola by {:.3f} mm RMS per "
-      "coordinate (the median of {} flights after the first contact), beyond the camera noise ({:.3f} mm) and "
-      "what this body's silhouette centroid wanders as it turns ({:.3f} mm). The direction of the offset in the "
+      "mass flies on a parabola whatever the release; the tracked point leaves its own best parabola by {:.3f} mm "
+      "RMS per coordinate (the median of {} flights after the first contact), beyond the camera noise ({:.3f} mm) "
+      "and what this body's silhouette centroid wanders as it turns ({:.3f} mm). The direction of the offset in the "
       "body is not seen without the particle's angle; a tracker that follows a surface feature instead of the "
       "centroid would show the same.",
       spec.name, spec.description, f.offset_m * 1e3, f.offset_low_m * 1e3, f.offset_high_m * 1e3, f.wobble_m * 1e3,

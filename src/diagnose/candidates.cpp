@@ -649,15 +649,14 @@ std::string why_undecided(const EffectSpec& spec, const ReplayShown& shown, cons
   const std::string replay = fmt::format("a replay shows {} {:.3g}", first.name, shown.magnitude);
   if (!shows)
     return fmt::format("{} ({}, but its strong {:.3g} does not reach both margins)", spec.name, replay, first.strong);
-  const SetUpShare* alone = preferred_alone(report);
-  if (report.strong_delta_chi2 < 0.0 && alone) {
-    const SetUpShare& most = *alone;
+  // A share is reported only where the preference reached the margin, so strong_delta_chi2 < 0 here.
+  if (const SetUpShare* alone = preferred_alone(report)) {
     return fmt::format(
         "{} ({}, but the recordings fit its strong {:.3g} better than the null, by {:.3g}, {:.3g} of it in the {} on "
         "{}, where it trades with the {}; the particle model's inaccuracy in that one set-up can do the same: see "
         "docs/diagnose.md, 'Naming what the recalibration prefers')",
-        spec.name, replay, first.strong, -report.strong_delta_chi2, most.delta_chi2, to_string(most.test), most.surface,
-        coefficient_name(coefficient_for(most.test)));
+        spec.name, replay, first.strong, -report.strong_delta_chi2, alone->delta_chi2, to_string(alone->test),
+        alone->surface, coefficient_name(coefficient_for(alone->test)));
   }
   if (report.strong_delta_chi2 < 0.0)
     return fmt::format("{} ({}, but the recordings fit its strong {:.3g} better than the null, by {:.3g})", spec.name,
