@@ -243,6 +243,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                         {"replay_noise", d.replay_noise},
                         {"needed", d.needed},
                         {"trials_needed", finite_or_null(d.trials_needed)},
+                        {"misfit_limited", d.misfit_limited},
                         {"strong_rejection", d.strong_rejection},
                         {"strong_resolution", finite_or_null(d.strong_resolution)},
                         {"dispersion", d.dispersion}});

@@ -558,7 +558,7 @@ bool flights_rule_out_offset(DiagnoseResult& result) {
 /// decidable at its strong magnitude in two strong cases that then went unnamed (the
 /// viscoelastic and elastic-plastic restitutions). The experiment says how many trials
 /// per set-up would show each at its strong magnitude, where the estimate asks for more than were recorded.
-void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens) {
+void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens, int replays) {
   const auto library = effect_library();
   std::vector<std::string> more_trials;
   for (const auto& d : ens.detectability) {
@@ -587,12 +587,25 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
           std::isfinite(d.strong_resolution)
               ? fmt::format(" or twice the next finer clump's move of its response ({:.1f})", d.strong_resolution)
               : std::string()));
-    else if (!std::isfinite(d.trials_needed) || d.trials_needed > 1000)
+    else if (!std::isfinite(d.trials_needed) && d.misfit_limited)
+      more_trials.push_back(
+          fmt::format("{} (not by more trials: the null's own misfit, the particle model's, grows with them as its "
+                      "signal does; a finer particle model decides it)",
+                      name));
+    else if (!std::isfinite(d.trials_needed) && d.strong_signal > 0.0)
+      more_trials.push_back(
+          fmt::format("{} (at any number of trials its response stays within the comparisons' floor, what no particle "
+                      "model reproduces)",
+                      name));
+    else if (!std::isfinite(d.trials_needed))
       more_trials.push_back(d.replay_noise > 0.0
                                 ? fmt::format("{} (its response is within the replays' own noise)", name)
                                 : fmt::format("{} (the outcomes do not respond to it)", name));
     else if (d.trials_needed > ens.trials)
-      more_trials.push_back(fmt::format("{} about {:.0f}", name, d.trials_needed));
+      more_trials.push_back(fmt::format("{} about {:.0f}{}", name, d.trials_needed,
+                                        d.trials_needed > replays
+                                            ? fmt::format(" (and --ensemble-replays {:.0f})", d.trials_needed)
+                                            : std::string()));
     else
       more_trials.push_back(
           fmt::format("{} more than {:.0f} (to first order these would do, yet no candidate came "
@@ -654,7 +667,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
                     coefficient_of(ens->calibrated[f.surface].interaction, f.coefficient)));
   }
   result.ensemble = std::move(report);
-  say_what_outcomes_decide(result, *ens);
+  say_what_outcomes_decide(result, *ens, eo.replays);
   std::vector<const EnsembleHypothesis*> passing = passing_hypotheses(*ens, options.min_delta_bic, result.notes);
   if (!ens->outcomes || ens->hypotheses.empty() || passing.empty()) {
     if (ens->outcomes > 0 && result.verdict == Verdict::None)

@@ -187,6 +187,48 @@ ResponseSignal response_signal(const Eigen::VectorXd& response, const Eigen::Vec
   return out;
 }
 
+ErrorScaling error_scaling(const std::vector<OutcomeComparison>& made, const Eigen::VectorXd& inverse_se) {
+  const auto n = static_cast<Eigen::Index>(made.size());
+  ErrorScaling s{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n)};
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const OutcomeComparison& c = made[static_cast<std::size_t>(j)];
+    s.floor2(j) = c.floor * c.floor;
+    if (c.recorded_n < 1 || c.ensemble_n < 1 || !(inverse_se(j) > 0.0)) continue;
+    const double se2 = 1.0 / (inverse_se(j) * inverse_se(j));
+    s.pooled(j) = std::max(0.0, se2 - s.floor2(j)) / (1.0 / c.recorded_n + 1.0 / c.ensemble_n);
+  }
+  return s;
+}
+
+Eigen::VectorXd ErrorScaling::inverse_se(double trials, double replays) const {
+  const Eigen::ArrayXd se2 = pooled.array() * (1.0 / trials + 1.0 / replays) + floor2.array();
+  return (se2 > 0.0).select(se2.rsqrt(), 0.0).matrix();
+}
+
+TrialsToShow trials_to_show(const ErrorScaling& scaling, const Eigen::VectorXd& inverse_se,
+                            const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
+                            const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& null_residual, double null_chi2,
+                            double dof, double needed, double trials_now, double replays_now, int most) {
+  // Each statistic's bias estimate: its squared residual less its sampling variance (unbiased,
+  // so a negative term is kept: the sum is what is estimated).
+  const Eigen::ArrayXd w0 = inverse_se.array().square();
+  const Eigen::ArrayXd bias2 = null_residual.array().square() - (w0 > 0.0).select(w0.inverse(), 0.0);
+  TrialsToShow out;
+  for (int n = std::max(1, static_cast<int>(std::ceil(trials_now))); n <= most; ++n) {
+    const Eigen::VectorXd w = scaling.inverse_se(n, std::max(replays_now, static_cast<double>(n)));
+    const double signal = response_signal(response, variance, w, jacobian).signal();
+    const double chi2 = null_chi2 + (bias2 * (w.array().square() - w0)).sum();
+    const double dispersion = std::max(1.0, chi2 / std::max(1.0, dof));
+    if (signal >= dispersion * needed) {
+      out.trials = n;
+      out.misfit_limited = false;
+      return out;
+    }
+    out.misfit_limited = signal >= needed;
+  }
+  return out;
+}
+
 namespace {
 
 /// One recording compared: its recorded outcomes and the orientations its replays start from.
@@ -452,9 +494,9 @@ enum class Pursuit {
 Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<Plan>& plans, const Model& null_model,
                                         const Sample& null_sample, const Eigen::VectorXd& null_means,
                                         const Eigen::VectorXd& recorded, const Eigen::VectorXd& inverse_se,
-                                        const Eigen::MatrixXd& jacobian, const std::vector<FreeCoefficient>& free,
-                                        const EffectSpec& spec, const EnsembleOptions& options, Pursuit pursuit,
-                                        EnsembleResult& result) {
+                                        const ErrorScaling& scaling, const Eigen::MatrixXd& jacobian,
+                                        const std::vector<FreeCoefficient>& free, const EffectSpec& spec,
+                                        const EnsembleOptions& options, Pursuit pursuit, EnsembleResult& result) {
   const auto& recs = *ev.recordings;
   std::vector<bool> run(plans.size());
   bool any = false;
@@ -487,13 +529,21 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
   bool detectable = false;
   {
     // Its strong magnitude's signal with what the free coefficients absorb projected out and the
-    // replays' own noise taken off; the standard errors fall as 1/sqrt(trials), so the signal
-    // grows with them.
+    // replays' own noise taken off, and the trials per set-up at which it would show: the
+    // standard errors fall with the trials only to the replays' share and the floor, and the
+    // null's own misfit grows with them as the signal does (trials_to_show). Until this was
+    // modelled the count was trials x needed / signal: "viscous_rolling about 10" on the
+    // generated 4-trial set, where 12 replays and the 32-sphere clump's bias set the limit.
     const ResponseSignal s = response_signal(response[1], strong_variance, inverse_se, jacobian);
     Detectability d{spec.effect, s.signal(), s.noise, options.min_delta_bic + penalty,
                     std::numeric_limits<double>::infinity()};
-    if (d.strong_signal > 0.0) d.trials_needed = std::ceil(result.trials * d.needed / d.strong_signal);
     d.dispersion = margin_over_null(result.null_chi2, result.null_chi2, result.outcomes, free.size(), 0).dispersion;
+    const double dof = std::max(1.0, static_cast<double>(result.outcomes) - static_cast<double>(free.size()));
+    const TrialsToShow more =
+        trials_to_show(scaling, inverse_se, response[1], strong_variance, jacobian, recorded - null_means,
+                       result.null_chi2, dof, d.needed, result.trials, static_cast<double>(options.replays));
+    d.trials_needed = more.trials;
+    d.misfit_limited = more.misfit_limited;
     // How far the recorded means reject the strong magnitude; the strong replays' own sampling
     // noise adds to that chi^2 as it does to the raw signal.
     d.strong_rejection =
@@ -892,6 +942,7 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
     const double diff = c.recorded_value - c.ensemble_value;
     inverse_se(static_cast<Eigen::Index>(j)) = c.z != 0.0 ? std::abs(c.z / diff) : 1.0 / std::max(c.floor, 1e-12);
   }
+  const ErrorScaling scaling = error_scaling(base_cmp, inverse_se);
   auto null = calibrate_outcomes(ev, plans, Point{baseline}, Coordinates{free}, *base, base_cmp, recorded, inverse_se,
                                  options, result);
   if (!null) return std::unexpected(null.error());
@@ -907,8 +958,8 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   std::vector<Proposal> proposals;
   const bool try_candidates = !unexplained || options.candidates_when_inconsistent;
   for (Effect e : try_candidates ? candidates : std::vector<Effect>{}) {
-    auto proposal = propose(ev, plans, null_model, null_sample, null_means, recorded, inverse_se, jacobian, free,
-                            effect_spec(library, e), options,
+    auto proposal = propose(ev, plans, null_model, null_sample, null_means, recorded, inverse_se, scaling, jacobian,
+                            free, effect_spec(library, e), options,
                             options.pursue == e ? Pursuit::Always
                             : unexplained       ? Pursuit::IfDetectable
                                                 : Pursuit::No,

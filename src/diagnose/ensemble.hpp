@@ -183,7 +183,9 @@ struct Detectability {
   double strong_signal = 0.0;  ///< ResponseSignal::signal(): the replays' own noise taken off
   double replay_noise = 0.0;   ///< ResponseSignal::noise: what that noise alone adds to the raw signal
   double needed = 0.0;         ///< delta-chi^2 the margin asks for (margin + k ln n)
-  double trials_needed = 0.0;  ///< per recording; infinity when the outcomes do not respond
+  /// Trials per recording, replayed at least as often, at which strong_signal would reach
+  /// dispersion x needed (trials_to_show); infinity when no count up to 1000 does.
+  double trials_needed = 0.0;
   /// How far the recorded outcomes reject its strong magnitude: their chi^2 there (the free
   /// coefficients absorbing what they can, to first order) less the same chi^2 with no effect,
   /// the replays' own noise (replay_noise) taken off.
@@ -202,6 +204,9 @@ struct Detectability {
   /// dispersion units, the rejection also beyond kResolutionAllowance times the next finer
   /// clump's move of the response.
   bool decides_absence() const;
+  /// With trials_needed infinite: the response alone would reach the margin by then, but the
+  /// null's own misfit (the particle model's) grows with the trials as fast.
+  bool misfit_limited = false;
 };
 
 /// A candidate's response (its replays' statistics less the null's, from the same orientations),
@@ -217,6 +222,33 @@ struct ResponseSignal {
 };
 ResponseSignal response_signal(const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
                                const Eigen::VectorXd& inverse_se, const Eigen::MatrixXd& jacobian);
+
+/// How each compared statistic's standard error falls with the trials recorded (n) and the
+/// replays run (K): se^2 = s_p^2 (1/n + 1/K) + floor^2 (comparison_se), each s_p^2 read back from
+/// the comparison made and its standard error (`inverse_se`, which for a spread is that of the
+/// absolute deviations). What the advice on more trials per set-up rests on.
+struct ErrorScaling {
+  Eigen::VectorXd pooled, floor2;
+  Eigen::VectorXd inverse_se(double trials, double replays) const;  ///< every statistic at n and K
+};
+ErrorScaling error_scaling(const std::vector<OutcomeComparison>& made, const Eigen::VectorXd& inverse_se);
+
+/// The smallest trials per recording, up to `most`, each recording replayed max(replays_now, n)
+/// times, at which a strong response's signal (response_signal: `variance` its own sampling
+/// variance, `jacobian` what the free coefficients absorb) reaches `needed` in the units of the
+/// null's own misfit: that misfit's part beyond the sampling noise (each statistic's
+/// `null_residual` squared less its present se^2: the particle model's bias) grows with the
+/// trials as a signal does, from `null_chi2` on `dof` degrees of freedom at the present se
+/// (`inverse_se`). The floor of each comparison caps both. Infinity when no count does;
+/// misfit_limited then says whether the response alone would have.
+struct TrialsToShow {
+  double trials = std::numeric_limits<double>::infinity();
+  bool misfit_limited = false;
+};
+TrialsToShow trials_to_show(const ErrorScaling& scaling, const Eigen::VectorXd& inverse_se,
+                            const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
+                            const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& null_residual, double null_chi2,
+                            double dof, double needed, double trials_now, double replays_now, int most = 1000);
 
 struct EnsembleResult {
   std::vector<SurfaceParameters> calibrated;  ///< the null: free coefficients fitted to the outcomes

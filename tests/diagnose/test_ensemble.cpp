@@ -168,6 +168,69 @@ TEST(EnsembleDetectability, ReplayNoiseIsTakenOffACandidatesSignal) {
   EXPECT_NEAR(response_signal(truth, variance, inverse_se, Eigen::MatrixXd(kStats, 0)).noise, kStats, 1e-9);
 }
 
+TEST(EnsembleDetectability, StandardErrorsScaleWithTheTrialsAndTheReplays) {
+  // A mean's and a spread's comparison, with a floor: read back, each se at the trials and
+  // replays it was made with is the one compared, and at others se^2 = s_p^2 (1/n + 1/K) + f^2.
+  const std::vector<OutcomeComparison> made{compare_outcome({1.0, 2.0, 4.0, 7.0}, {2.0, 3.0, 3.5, 6.0, 8.0, 1.0}, 0.5),
+                                            compare_spread({0.0, 1.0, 2.0, 3.0}, {5.0, 7.0, 5.5, 4.0, 6.0, 9.0}, 0.0)};
+  Eigen::VectorXd inverse_se(2);
+  for (int j = 0; j < 2; ++j) {
+    const auto& c = made[static_cast<std::size_t>(j)];
+    inverse_se(j) = std::abs(c.z / (c.recorded_value - c.ensemble_value));
+  }
+  const ErrorScaling scaling = error_scaling(made, inverse_se);
+  const Eigen::VectorXd same = scaling.inverse_se(4, 6);
+  for (int j = 0; j < 2; ++j) EXPECT_NEAR(same(j), inverse_se(j), 1e-12 * inverse_se(j));
+  // The mean's pooled variance by hand: sums of squares 21 and 126.25 - 23.5^2 / 6 over 8
+  // degrees of freedom.
+  const double pooled = (21.0 + 126.25 - 23.5 * 23.5 / 6.0) / 8.0;
+  EXPECT_NEAR(scaling.pooled(0), pooled, 1e-12);
+  EXPECT_NEAR(scaling.inverse_se(30, 40)(0), 1.0 / std::sqrt(pooled * (1.0 / 30 + 1.0 / 40) + 0.25), 1e-12);
+  // With endless trials and replays only the floor is left.
+  EXPECT_NEAR(scaling.inverse_se(1e12, 1e12)(0), 2.0, 1e-6);
+}
+
+TEST(EnsembleDetectability, TrialsToShowCountTheReplaysTheFloorAndTheNullsOwnMisfit) {
+  // Four statistics, each with pooled variance 1 and no floor, a strong response of 1 each, no
+  // free coefficients and no sampling noise in the response; 4 trials, 12 replays, 49 needed.
+  // Each se^2 is 1/n + 1/max(12, n): the signal 4 / (1/n + 1/12) is at most 24 up to 12 trials,
+  // and 4 n / 2 beyond, so 25 trials (and replays) show it. The count that took se^2 as 1/n,
+  // trials x needed / signal, said 4 x 49 / 12: 17.
+  constexpr int kStats = 4;
+  const ErrorScaling flat{Eigen::VectorXd::Ones(kStats), Eigen::VectorXd::Zero(kStats)};
+  const Eigen::VectorXd now = flat.inverse_se(4, 12), response = Eigen::VectorXd::Ones(kStats);
+  const Eigen::VectorXd quiet = Eigen::VectorXd::Zero(kStats);
+  const Eigen::MatrixXd none(kStats, 0);
+  const auto residual_with_bias = [&](double bias2) {
+    return Eigen::VectorXd((now.array().square().inverse() + bias2).sqrt().matrix());
+  };
+  const auto chi2_of = [&](const Eigen::VectorXd& r) { return now.cwiseProduct(r).squaredNorm(); };
+  const Eigen::VectorXd unbiased = residual_with_bias(0.0);
+  const TrialsToShow plain =
+      trials_to_show(flat, now, response, quiet, none, unbiased, chi2_of(unbiased), kStats, 49.0, 4, 12);
+  EXPECT_EQ(plain.trials, 25.0);
+  EXPECT_FALSE(plain.misfit_limited);
+  EXPECT_NEAR(response_signal(response, quiet, flat.inverse_se(24, 24), none).signal(), 48.0, 1e-9);
+  // A floor of sqrt(0.1) caps the signal at 4 / 0.1 = 40: no count shows it.
+  const ErrorScaling floored{Eigen::VectorXd::Ones(kStats), Eigen::VectorXd::Constant(kStats, 0.1)};
+  const TrialsToShow capped = trials_to_show(floored, floored.inverse_se(4, 12), response, quiet, none, unbiased,
+                                             chi2_of(unbiased), kStats, 49.0, 4, 12);
+  EXPECT_TRUE(std::isinf(capped.trials));
+  EXPECT_FALSE(capped.misfit_limited);
+  // The null off by a bias b^2 = beta x the response's square on every statistic: its chi^2
+  // grows to 4 + beta s(n), the dispersion to 1 + beta s / 4, and the signal must reach that
+  // times 49. With beta = 0.02 that is s >= 49 / 0.755, 33 trials; with beta = 0.1 never (0.1 x
+  // 49 / 4 > 1), though the response alone would show by 25.
+  const Eigen::VectorXd slight = residual_with_bias(0.02);
+  EXPECT_EQ(trials_to_show(flat, now, response, quiet, none, slight, chi2_of(slight), kStats, 49.0, 4, 12).trials,
+            33.0);
+  const Eigen::VectorXd biased = residual_with_bias(0.1);
+  const TrialsToShow limited =
+      trials_to_show(flat, now, response, quiet, none, biased, chi2_of(biased), kStats, 49.0, 4, 12);
+  EXPECT_TRUE(std::isinf(limited.trials));
+  EXPECT_TRUE(limited.misfit_limited);
+}
+
 TEST(EnsembleComparison, StandardisedDifferenceOfSpreads) {
   // Recorded {0, 1, 2, 3}: absolute deviations from the median 1.5 are {1.5, 0.5, 0.5, 1.5},
   // mean 1, sum of squares about it 1; replays that all agree deviate by 0. Pooled over 6
@@ -447,7 +510,7 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
     tried.effect = Effect::PlasticSubstrate;
     tried.first_delta_bic = -1.7;
     ens.hypotheses.push_back(tried);
-    diagnosis::say_what_outcomes_decide(result, ens);
+    diagnosis::say_what_outcomes_decide(result, ens, 12);
     const bool undecided = std::count(result.undecidable.begin(), result.undecidable.end(), "plastic_substrate") == 1;
     EXPECT_EQ(undecided, !k.decided) << k.strong_signal << " " << k.rejection << " " << k.resolution << " "
                                      << k.dispersion;
