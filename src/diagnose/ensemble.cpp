@@ -224,7 +224,7 @@ TrialsToShow trials_to_show(const ErrorScaling& scaling, const Eigen::VectorXd& 
       out.misfit_limited = false;
       return out;
     }
-    out.misfit_limited = signal >= needed;
+    out.misfit_limited = out.misfit_limited || signal >= needed;
   }
   return out;
 }
