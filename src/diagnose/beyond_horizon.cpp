@@ -560,7 +560,7 @@ bool flights_rule_out_offset(DiagnoseResult& result) {
 /// per set-up would show each at its strong magnitude, where the estimate asks for more than were recorded.
 void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens, int replays) {
   const auto library = effect_library();
-  std::vector<std::string> more_trials;
+  std::vector<std::string> more_trials, no_more_trials;
   for (const auto& d : ens.detectability) {
     const std::string& name = effect_spec(library, d.effect).name;
     const bool tried = std::any_of(ens.hypotheses.begin(), ens.hypotheses.end(),
@@ -580,27 +580,25 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens,
     }
     if (std::find(result.undecidable.begin(), result.undecidable.end(), name) == result.undecidable.end()) continue;
     if (tried && d.strong_signal >= d.needed && d.strong_rejection >= d.needed)
-      more_trials.push_back(fmt::format(
+      no_more_trials.push_back(fmt::format(
           "{} (rejected by {:.1f}, within the null's own misfit ({:.1f} times its degrees of freedom){}: the "
-          "particle model decides it, not more trials)",
+          "particle model decides it)",
           name, d.strong_rejection, d.dispersion,
           std::isfinite(d.strong_resolution)
               ? fmt::format(" or twice the next finer clump's move of its response ({:.1f})", d.strong_resolution)
               : std::string()));
     else if (!std::isfinite(d.trials_needed) && d.misfit_limited)
-      more_trials.push_back(
-          fmt::format("{} (not by more trials: the null's own misfit, the particle model's, grows with them as its "
-                      "signal does; a finer particle model decides it)",
-                      name));
+      no_more_trials.push_back(fmt::format(
+          "{} (the null's own misfit, the particle model's, grows with them as its signal does: a finer particle "
+          "model decides it)",
+          name));
     else if (!std::isfinite(d.trials_needed) && d.strong_signal > 0.0)
-      more_trials.push_back(
-          fmt::format("{} (at any number of trials its response stays within the comparisons' floor, what no particle "
-                      "model reproduces)",
-                      name));
+      no_more_trials.push_back(fmt::format(
+          "{} (its response stays within the comparisons' floor, what no particle model reproduces)", name));
     else if (!std::isfinite(d.trials_needed))
-      more_trials.push_back(d.replay_noise > 0.0
-                                ? fmt::format("{} (its response is within the replays' own noise)", name)
-                                : fmt::format("{} (the outcomes do not respond to it)", name));
+      no_more_trials.push_back(d.replay_noise > 0.0
+                                   ? fmt::format("{} (its response is within the replays' own noise)", name)
+                                   : fmt::format("{} (the outcomes do not respond to it)", name));
     else if (d.trials_needed > ens.trials)
       more_trials.push_back(fmt::format("{} about {:.0f}{}", name, d.trials_needed,
                                         d.trials_needed > replays
@@ -612,14 +610,17 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens,
                       "near the margin to be tried)",
                       name, ens.trials));
   }
-  if (result.verdict == Verdict::None && !more_trials.empty()) {
-    result.experiment = fmt::format(
-        "{}; or repeat each set-up more often: compared as a sample with replays over the unknown release, the "
+  if (result.verdict != Verdict::None || (more_trials.empty() && no_more_trials.empty())) return;
+  std::string text = result.experiment.empty() ? std::string("record each trial's release orientation to a few degrees")
+                                               : result.experiment;
+  if (!more_trials.empty())
+    text += fmt::format(
+        "; or repeat each set-up more often: compared as a sample with replays over the unknown release, the "
         "recorded outcomes would show each at its strong magnitude with these trials per set-up: {}",
-        result.experiment.empty() ? std::string("record each trial's release orientation to a few degrees")
-                                  : result.experiment,
         fmt::join(more_trials, ", "));
-  }
+  if (!no_more_trials.empty())
+    text += fmt::format("; more trials per set-up would not show these: {}", fmt::join(no_more_trials, ", "));
+  result.experiment = std::move(text);
 }
 
 /// Beyond the release horizons: the recorded trials against replays from the release prior
