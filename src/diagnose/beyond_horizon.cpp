@@ -556,8 +556,9 @@ bool flights_rule_out_offset(DiagnoseResult& result) {
 /// detectability says: on the generated 1000 fps benchmark that estimate (the diagnosed clump's
 /// response, less what the coefficients absorb to first order) called the concealed effect
 /// decidable at its strong magnitude in two strong cases that then went unnamed (the
-/// viscoelastic and elastic-plastic restitutions). The experiment says how many trials
-/// per set-up would show each at its strong magnitude, where the estimate asks for more than were recorded.
+/// viscoelastic and elastic-plastic restitutions). The experiment says how many trials per
+/// set-up would show each at its strong magnitude (Detectability::trials_needed), and apart, why
+/// more trials would not show the others.
 void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens, int replays) {
   const auto library = effect_library();
   std::vector<std::string> more_trials, no_more_trials;

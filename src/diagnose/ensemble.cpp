@@ -187,6 +187,26 @@ ResponseSignal response_signal(const Eigen::VectorXd& response, const Eigen::Vec
   return out;
 }
 
+namespace {
+
+/// A candidate's margin over the null: its dispersion (chi^2 per degree of freedom, the
+/// outcomes less the free coefficients and its parameters, when above 1) and delta-BIC =
+/// (chi^2_null - chi^2) / dispersion - k ln n. Judged in units of the candidate's own misfit:
+/// no clump replays a real particle's outcomes exactly, and a candidate must not be named for
+/// absorbing the particle model's share of the misfit.
+struct Margin {
+  double dispersion = 1.0, delta_bic = 0.0;
+};
+Margin margin_over_null(double null_chi2, double chi2, int outcomes, std::size_t free, std::size_t parameters) {
+  const double dof =
+      std::max(1.0, static_cast<double>(outcomes) - static_cast<double>(free) - static_cast<double>(parameters));
+  const double dispersion = std::max(1.0, chi2 / dof);
+  return {dispersion,
+          (null_chi2 - chi2) / dispersion - static_cast<double>(parameters) * std::log(std::max(1, outcomes))};
+}
+
+}  // namespace
+
 ErrorScaling error_scaling(const std::vector<OutcomeComparison>& made, const Eigen::VectorXd& inverse_se) {
   const auto n = static_cast<Eigen::Index>(made.size());
   ErrorScaling s{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n)};
@@ -208,7 +228,8 @@ Eigen::VectorXd ErrorScaling::inverse_se(double trials, double replays) const {
 TrialsToShow trials_to_show(const ErrorScaling& scaling, const Eigen::VectorXd& inverse_se,
                             const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
                             const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& null_residual, double null_chi2,
-                            double dof, double needed, double trials_now, double replays_now, int most) {
+                            int outcomes, std::size_t free, double needed, double trials_now, double replays_now,
+                            int most) {
   // Each statistic's bias estimate: its squared residual less its sampling variance (unbiased,
   // so a negative term is kept: the sum is what is estimated).
   const Eigen::ArrayXd w0 = inverse_se.array().square();
@@ -218,7 +239,7 @@ TrialsToShow trials_to_show(const ErrorScaling& scaling, const Eigen::VectorXd& 
     const Eigen::VectorXd w = scaling.inverse_se(n, std::max(replays_now, static_cast<double>(n)));
     const double signal = response_signal(response, variance, w, jacobian).signal();
     const double chi2 = null_chi2 + (bias2 * (w.array().square() - w0)).sum();
-    const double dispersion = std::max(1.0, chi2 / std::max(1.0, dof));
+    const double dispersion = margin_over_null(null_chi2, chi2, outcomes, free, 0).dispersion;
     if (signal >= dispersion * needed) {
       out.trials = n;
       out.misfit_limited = false;
@@ -447,22 +468,6 @@ Model with_coefficients(const Model& start, const std::vector<FreeCoefficient>& 
   return m;
 }
 
-/// A candidate's margin over the null: its dispersion (chi^2 per degree of freedom, the
-/// outcomes less the free coefficients and its parameters, when above 1) and delta-BIC =
-/// (chi^2_null - chi^2) / dispersion - k ln n. Judged in units of the candidate's own misfit:
-/// no clump replays a real particle's outcomes exactly, and a candidate must not be named for
-/// absorbing the particle model's share of the misfit.
-struct Margin {
-  double dispersion = 1.0, delta_bic = 0.0;
-};
-Margin margin_over_null(double null_chi2, double chi2, int outcomes, std::size_t free, std::size_t parameters) {
-  const double dof =
-      std::max(1.0, static_cast<double>(outcomes) - static_cast<double>(free) - static_cast<double>(parameters));
-  const double dispersion = std::max(1.0, chi2 / dof);
-  return {dispersion,
-          (null_chi2 - chi2) / dispersion - static_cast<double>(parameters) * std::log(std::max(1, outcomes))};
-}
-
 struct Proposal {
   Effect effect = Effect::AirDrag;
   double level = 0.0, predicted = 0.0;
@@ -538,10 +543,9 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     Detectability d{spec.effect, s.signal(), s.noise, options.min_delta_bic + penalty,
                     std::numeric_limits<double>::infinity()};
     d.dispersion = margin_over_null(result.null_chi2, result.null_chi2, result.outcomes, free.size(), 0).dispersion;
-    const double dof = std::max(1.0, static_cast<double>(result.outcomes) - static_cast<double>(free.size()));
-    const TrialsToShow more =
-        trials_to_show(scaling, inverse_se, response[1], strong_variance, jacobian, recorded - null_means,
-                       result.null_chi2, dof, d.needed, result.trials, static_cast<double>(options.replays));
+    const TrialsToShow more = trials_to_show(scaling, inverse_se, response[1], strong_variance, jacobian,
+                                             recorded - null_means, result.null_chi2, result.outcomes, free.size(),
+                                             d.needed, result.trials, static_cast<double>(options.replays));
     d.trials_needed = more.trials;
     d.misfit_limited = more.misfit_limited;
     // How far the recorded means reject the strong magnitude; the strong replays' own sampling

@@ -238,9 +238,9 @@ ErrorScaling error_scaling(const std::vector<OutcomeComparison>& made, const Eig
 /// variance, `jacobian` what the free coefficients absorb) reaches `needed` in the units of the
 /// null's own misfit: that misfit's part beyond the sampling noise (each statistic's
 /// `null_residual` squared less its present se^2: the particle model's bias) grows with the
-/// trials as a signal does, from `null_chi2` on `dof` degrees of freedom at the present se
-/// (`inverse_se`). The floor of each comparison caps both. Infinity when no count does;
-/// misfit_limited then says whether the response alone would have.
+/// trials as a signal does, from `null_chi2` at the present se (`inverse_se`), its degrees of
+/// freedom the `outcomes` less the `free` coefficients. The floor of each comparison caps both. Infinity when no count
+/// does; misfit_limited then says whether the response alone would have.
 struct TrialsToShow {
   double trials = std::numeric_limits<double>::infinity();
   bool misfit_limited = false;
@@ -248,7 +248,8 @@ struct TrialsToShow {
 TrialsToShow trials_to_show(const ErrorScaling& scaling, const Eigen::VectorXd& inverse_se,
                             const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
                             const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& null_residual, double null_chi2,
-                            double dof, double needed, double trials_now, double replays_now, int most = 1000);
+                            int outcomes, std::size_t free, double needed, double trials_now, double replays_now,
+                            int most = 1000);
 
 struct EnsembleResult {
   std::vector<SurfaceParameters> calibrated;  ///< the null: free coefficients fitted to the outcomes

@@ -207,14 +207,14 @@ TEST(EnsembleDetectability, TrialsToShowCountTheReplaysTheFloorAndTheNullsOwnMis
   const auto chi2_of = [&](const Eigen::VectorXd& r) { return now.cwiseProduct(r).squaredNorm(); };
   const Eigen::VectorXd unbiased = residual_with_bias(0.0);
   const TrialsToShow plain =
-      trials_to_show(flat, now, response, quiet, none, unbiased, chi2_of(unbiased), kStats, 49.0, 4, 12);
+      trials_to_show(flat, now, response, quiet, none, unbiased, chi2_of(unbiased), kStats, 0, 49.0, 4, 12);
   EXPECT_EQ(plain.trials, 25.0);
   EXPECT_FALSE(plain.misfit_limited);
   EXPECT_NEAR(response_signal(response, quiet, flat.inverse_se(24, 24), none).signal(), 48.0, 1e-9);
   // A floor of sqrt(0.1) caps the signal at 4 / 0.1 = 40: no count shows it.
   const ErrorScaling floored{Eigen::VectorXd::Ones(kStats), Eigen::VectorXd::Constant(kStats, 0.1)};
   const TrialsToShow capped = trials_to_show(floored, floored.inverse_se(4, 12), response, quiet, none, unbiased,
-                                             chi2_of(unbiased), kStats, 49.0, 4, 12);
+                                             chi2_of(unbiased), kStats, 0, 49.0, 4, 12);
   EXPECT_TRUE(std::isinf(capped.trials));
   EXPECT_FALSE(capped.misfit_limited);
   // The null off by a bias b^2 = beta x the response's square on every statistic: its chi^2
@@ -222,11 +222,11 @@ TEST(EnsembleDetectability, TrialsToShowCountTheReplaysTheFloorAndTheNullsOwnMis
   // times 49. With beta = 0.02 that is s >= 49 / 0.755, 33 trials; with beta = 0.1 never (0.1 x
   // 49 / 4 > 1), though the response alone would show by 25.
   const Eigen::VectorXd slight = residual_with_bias(0.02);
-  EXPECT_EQ(trials_to_show(flat, now, response, quiet, none, slight, chi2_of(slight), kStats, 49.0, 4, 12).trials,
+  EXPECT_EQ(trials_to_show(flat, now, response, quiet, none, slight, chi2_of(slight), kStats, 0, 49.0, 4, 12).trials,
             33.0);
   const Eigen::VectorXd biased = residual_with_bias(0.1);
   const TrialsToShow limited =
-      trials_to_show(flat, now, response, quiet, none, biased, chi2_of(biased), kStats, 49.0, 4, 12);
+      trials_to_show(flat, now, response, quiet, none, biased, chi2_of(biased), kStats, 0, 49.0, 4, 12);
   EXPECT_TRUE(std::isinf(limited.trials));
   EXPECT_TRUE(limited.misfit_limited);
 }
