@@ -187,7 +187,7 @@ Command add_diagnose_command(CLI::App& app) {
                   "leaves grows with the time since the impact");
   sub->add_option("--ensemble-replays", args->ensemble_replays,
                   "Replays per drop and roll recording from the release prior, to compare the recorded outcomes "
-                  "beyond the release horizon (0: skip)");
+                  "beyond the release horizon; a recording with more trials is replayed once per trial (0: skip)");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   add_output_option(*sub, args->out, "Directory for report.json, tracks.json and the figures (PNG, SVG)");

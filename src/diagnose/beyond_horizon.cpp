@@ -559,7 +559,7 @@ bool flights_rule_out_offset(DiagnoseResult& result) {
 /// viscoelastic and elastic-plastic restitutions). The experiment says how many trials per
 /// set-up would show each at its strong magnitude (Detectability::trials_needed), and apart, why
 /// more trials would not show the others.
-void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens, int replays) {
+void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens) {
   const auto library = effect_library();
   std::vector<std::string> more_trials, no_more_trials;
   for (const auto& d : ens.detectability) {
@@ -601,10 +601,7 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens,
                                    ? fmt::format("{} (its response is within the replays' own noise)", name)
                                    : fmt::format("{} (the outcomes do not respond to it)", name));
     else if (d.trials_needed > ens.trials)
-      more_trials.push_back(fmt::format("{} about {:.0f}{}", name, d.trials_needed,
-                                        d.trials_needed > replays
-                                            ? fmt::format(" (and --ensemble-replays {:.0f})", d.trials_needed)
-                                            : std::string()));
+      more_trials.push_back(fmt::format("{} about {:.0f}", name, d.trials_needed));
     else
       more_trials.push_back(
           fmt::format("{} more than {:.0f} (to first order these would do, yet no candidate came "
@@ -669,7 +666,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
                     coefficient_of(ens->calibrated[f.surface].interaction, f.coefficient)));
   }
   result.ensemble = std::move(report);
-  say_what_outcomes_decide(result, *ens, eo.replays);
+  say_what_outcomes_decide(result, *ens);
   std::vector<const EnsembleHypothesis*> passing = passing_hypotheses(*ens, options.min_delta_bic, result.notes);
   if (!ens->outcomes || ens->hypotheses.empty() || passing.empty()) {
     if (ens->outcomes > 0 && result.verdict == Verdict::None)

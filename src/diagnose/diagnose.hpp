@@ -53,7 +53,8 @@ struct DiagnoseOptions {
   /// Weights in diagnose/tracks.hpp). 0 trusts replayed impacts exactly.
   double impact_accuracy = 0.01;
   /// Replays per drop and roll recording, from release orientations drawn from the prior,
-  /// for the comparison beyond the release horizon (see diagnose/ensemble.hpp); 0 skips it.
+  /// for the comparison beyond the release horizon (see diagnose/ensemble.hpp); a recording
+  /// with more tracked trials is replayed once per trial. 0 skips it.
   int ensemble_replays = 12;
   /// Finer particle models of the same body (more spheres, or built another way), coarsest
   /// first; the clump diagnosed is the coarsest of all. They serve twice (see

@@ -301,8 +301,12 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
         recorded_orientations.push_back(*rec.trials[tt.trial].release_orientation);
     }
     if (plan.recorded.front().size() < 2) continue;
+    // As many replays as recorded trials at least: with 30 trials (the seed study's 10 x 3) and
+    // 12 replays the replays' sampling noise, not the trials', would set each standard error.
+    EnsembleOptions each = options;
+    each.replays = replays_per_recording(options.replays, plan.recorded.front().size());
     plan.orientations = ensemble_orientations(
-        rec.test, every_recorded ? recorded_orientations : std::vector<Eigen::Quaterniond>{}, options, stream + r);
+        rec.test, every_recorded ? recorded_orientations : std::vector<Eigen::Quaterniond>{}, each, stream + r);
     plans.push_back(std::move(plan));
   }
   return plans;
@@ -894,6 +898,10 @@ std::vector<Eigen::Quaterniond> ensemble_orientations(LabTest test, const std::v
   std::vector<Eigen::Quaterniond> out;
   for (std::size_t k = 0; static_cast<int>(out.size()) < options.replays; ++k) out.push_back(draws[k % n][k / n]);
   return out;
+}
+
+int replays_per_recording(int replays, std::size_t trials) {
+  return std::max(replays, static_cast<int>(std::min<std::size_t>(trials, 1000)));
 }
 
 double null_dof(int outcomes, std::size_t free) {

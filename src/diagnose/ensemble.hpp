@@ -101,7 +101,9 @@ struct OutcomeShift {
 OutcomeShift outcome_shift(const std::vector<OutcomeComparison>& coarse, const std::vector<OutcomeComparison>& fine);
 
 struct EnsembleOptions {
-  int replays = 12;  ///< release orientations per recording, >= 4
+  /// Release orientations per recording, >= 4; a recording with more tracked trials is replayed
+  /// once per trial (replays_per_recording).
+  int replays = 12;
   double orientation_prior_deg = 15.0;
   bool roll_on_edge = false;  ///< rolls without a recorded orientation start on the rim (OrientationPrior::on_edge)
   double impact_accuracy = 0.01;
@@ -135,6 +137,10 @@ double null_dof(int outcomes, std::size_t free);
 /// kConsistentTail / 2 or more. Tested apart, a mean far off is not diluted by spreads that
 /// agree, nor the reverse.
 bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted);
+
+/// The replays of a recording of `trials` tracked trials: `replays`, or one per trial when there
+/// are more, so that the replays' sampling noise never exceeds the recorded sample's.
+int replays_per_recording(int replays, std::size_t trials);
 
 /// The release orientations of a recording's replays: from the uniform prior when `recorded`
 /// is empty, else mirroring the recorded sample, in turn from a ball of the prior's spread

@@ -322,9 +322,9 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
 bool flights_rule_out_offset(DiagnoseResult& result);
 /// What the outcomes decided: an effect leaves `result.undecidable` when its candidate was tried
 /// on the outcomes and its strong signal reaches the margin; `experiment` lists the trials per
-/// set-up the others need (and the replays per recording, `replays` now, where they need more),
-/// and apart those no count of trials would show.
-void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens, int replays);
+/// set-up the others need (each recording replayed once per trial from that count on), and apart
+/// those no count of trials would show.
+void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens);
 Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& baseline,
                              const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
                              const DiagnoseOptions& options);

@@ -734,6 +734,39 @@ TEST(DiagnoseEnsemble, ARestitutionFarFromTheTablesIsCalibratedOnTheOutcomes) {
   EXPECT_EQ(means, 4);  // rebound height and drift of each drop
 }
 
+TEST(DiagnoseEnsemble, ARecordingWithMoreTrialsThanReplaysIsReplayedOncePerTrial) {
+  // Fourteen tuber drops from 0.2 m on soil, made from the finer adaptive-340, no release
+  // orientation, diagnosed with the default 12 replays per recording. The recorded sample's mean
+  // has a standard error of s/sqrt(14); 12 replays would leave the comparison's at
+  // s sqrt(1/14 + 1/12), the replays' share the larger. Each recording is replayed once per trial
+  // when it has more trials than replays: every comparison's ensemble sample holds the 14.
+  auto generators = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
+  ASSERT_TRUE(generators) << generators.error().message;
+  auto generator = select_clump(std::move(*generators), "adaptive-340", "tuber-default.h5");
+  ASSERT_TRUE(generator) << generator.error().message;
+  const MaterialTable table = default_material_table();
+  ConcealOptions conceal;
+  conceal.surface = "soil";
+  conceal.trials = 14;
+  conceal.drop_heights = {0.2};
+  conceal.roll_starts = {};
+  conceal.tilt = false;
+  conceal.seed = 2612;
+  auto made = make_concealed_recordings(*generator, table, conceal);
+  ASSERT_TRUE(made) << made.error().message;
+  DiagnoseOptions options;
+  options.effects = {Effect::AirDrag};
+  ASSERT_EQ(options.ensemble_replays, 12);
+  auto result = diagnose(diagnosis_clump(), table, made->recordings, made->names, options);
+  ASSERT_TRUE(result) << result.error().message;
+  ASSERT_TRUE(result->ensemble.has_value()) << result->statement;
+  ASSERT_FALSE(result->ensemble->null_comparisons.empty());
+  for (const auto& c : result->ensemble->null_comparisons) {
+    EXPECT_EQ(c.recorded_n, 14) << outcome_name(c.outcome);
+    EXPECT_EQ(c.ensemble_n, 14) << outcome_name(c.outcome);
+  }
+}
+
 // The independent simulator's exact sphere (r 9.35 mm, 1085 kg/m^3) as a one-sphere clump.
 Clump lab_like_sphere() {
   constexpr double r = 9.35e-3, density = 1085.0;

@@ -510,7 +510,7 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
     tried.effect = Effect::PlasticSubstrate;
     tried.first_delta_bic = -1.7;
     ens.hypotheses.push_back(tried);
-    diagnosis::say_what_outcomes_decide(result, ens, 12);
+    diagnosis::say_what_outcomes_decide(result, ens);
     const bool undecided = std::count(result.undecidable.begin(), result.undecidable.end(), "plastic_substrate") == 1;
     EXPECT_EQ(undecided, !k.decided) << k.strong_signal << " " << k.rejection << " " << k.resolution << " "
                                      << k.dispersion;
