@@ -72,6 +72,40 @@ std::vector<std::string> right_verdicts(const std::string& effect) {
   return {effect};
 }
 
+/// What a report's experiment says more trials per set-up would do for the effects in `names`
+/// (the concealed effect's candidates): each one's `advice` from ensemble.detectability, with its
+/// trials per set-up when more would show it; "not_compared" when the outcomes were not compared.
+std::vector<std::string> advice_for(const nlohmann::json& report, const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  if (report.contains("ensemble") && report["ensemble"].is_object() && report["ensemble"].contains("detectability") &&
+      report["ensemble"]["detectability"].is_array()) {
+    for (const auto& d : report["ensemble"]["detectability"]) {
+      if (std::find(names.begin(), names.end(), d.value("name", "")) == names.end()) continue;
+      std::string advice = d.value("advice", "not_judged");
+      if (advice == "more_trials" && d.contains("trials_needed") && d["trials_needed"].is_number())
+        advice += fmt::format(" ({:.0f})", d["trials_needed"].get<double>());
+      out.push_back(std::move(advice));
+    }
+  }
+  if (out.empty()) out.emplace_back("not_compared");
+  return out;
+}
+
+/// The missed effects' advice counted (advice_for, the trials count left off): a markdown line,
+/// and summary["missed_advice"].
+std::string advice_tally(const std::vector<std::vector<std::string>>& missed, nlohmann::json& summary) {
+  std::map<std::string, int> count;
+  for (const auto& advice : missed)
+    for (const auto& a : advice) ++count[a.substr(0, a.find(" ("))];
+  std::vector<std::string> parts;
+  for (const auto& [advice, n] : count) {
+    parts.push_back(fmt::format("{} {}", advice, n));
+    summary["missed_advice"][advice] = n;
+  }
+  return fmt::format("what the reports say more trials per set-up would do for the {} missed effects: {}\n",
+                     missed.size(), parts.empty() ? std::string("-") : fmt::format("{}", fmt::join(parts, ", ")));
+}
+
 /// The particle a case's recordings name: the first manifest's mesh (relative to it) and density.
 std::optional<std::pair<fs::path, double>> case_particle(const fs::path& case_dir) {
   std::vector<fs::path> manifests;
@@ -163,6 +197,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       "[s] |\n|---|---|---|---|---|---|---|---:|---:|\n";
   int effects = 0, effects_right = 0, controls = 0, controls_none = 0, controls_named = 0;
   std::vector<double> seconds, improvements;
+  std::vector<std::vector<std::string>> missed_advice;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
     const fs::path report = out / id / "report.json";
@@ -189,19 +224,22 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       ++effects;
       effects_right += is_right;
       if (is_right) improvements.push_back(gain);
+      if (!is_right) missed_advice.push_back(advice_for(j, right));
     }
     seconds.push_back(j.value("seconds", NAN));
     table += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} |\n", id,
                          answer.value("particle", "?"), answer.value("label", effect), verdict, j.value("basis", "?"),
                          is_right ? "yes" : "no", before, after, 100.0 * gain, j.value("seconds", NAN));
-    rows.push_back({{"case", id},
-                    {"truth", effect},
-                    {"verdict", verdict},
-                    {"basis", j.value("basis", "?")},
-                    {"right", is_right},
-                    {"heldout_rms_before_mm", before},
-                    {"heldout_rms_after_mm", after},
-                    {"seconds", j.value("seconds", NAN)}});
+    rows.push_back(
+        {{"case", id},
+         {"truth", effect},
+         {"verdict", verdict},
+         {"basis", j.value("basis", "?")},
+         {"right", is_right},
+         {"heldout_rms_before_mm", before},
+         {"heldout_rms_after_mm", after},
+         {"seconds", j.value("seconds", NAN)},
+         {"advice", effect == "none" || is_right ? nlohmann::json() : nlohmann::json(missed_advice.back())}});
     std::cout << fmt::format("{}  truth {:18s} verdict {:28s} {}  {:.0f} s\n", id, effect, verdict,
                              is_right ? "right" : "WRONG", j.value("seconds", NAN))
               << std::flush;
@@ -211,17 +249,19 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   table += fmt::format("median held-out improvement of the cases named right: {:.1f} % of the held-out RMS\n",
                        100.0 * median(improvements));
   table += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
+  nlohmann::json summary;
+  table += advice_tally(missed_advice, summary);
   std::cout << "\n" << table;
-  nlohmann::json summary{{"set", set.string()},
-                         {"effects", effects},
-                         {"effects_right", effects_right},
-                         {"controls", controls},
-                         {"controls_none", controls_none},
-                         {"controls_named", controls_named},
-                         {"median_seconds", median(seconds)},
-                         {"median_heldout_improvement", median(improvements)},
-                         {"cases", rows},
-                         {"table_markdown", table}};
+  summary.update(nlohmann::json{{"set", set.string()},
+                                {"effects", effects},
+                                {"effects_right", effects_right},
+                                {"controls", controls},
+                                {"controls_none", controls_none},
+                                {"controls_named", controls_named},
+                                {"median_seconds", median(seconds)},
+                                {"median_heldout_improvement", median(improvements)},
+                                {"cases", rows},
+                                {"table_markdown", table}});
   std::ofstream(out / "summary.md") << table;
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
   return 0;
@@ -250,6 +290,7 @@ struct CaseScore {
   }
   std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
   std::vector<std::pair<std::string, double>> stages;      ///< the report's stage_seconds, in order
+  std::vector<std::string> advice;  ///< what the report says more trials would do for the truth (advice_for)
 };
 
 /// A case's report.json read for the score (nullopt when it is not JSON).
@@ -281,6 +322,7 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
       if (h.value("name", "") == truth && h.contains("smallest_detectable") && h["smallest_detectable"].is_number())
         o.smallest_detectable = h["smallest_detectable"].get<double>();
   }
+  if (truth != "none") o.advice = advice_for(j, {truth});
   if (j.contains("stage_seconds") && j["stage_seconds"].is_array()) {
     for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", NAN));
   }
@@ -315,6 +357,22 @@ std::string time_summary(const std::vector<CaseScore>& outcomes, nlohmann::json&
     summary["median_stage_share"][stage] = median(shares[stage]);
   }
   return md;
+}
+
+/// The effects missed, each with its verdict and what its report says more trials per set-up
+/// would do for it (advice_for), and their tally.
+std::string missed_summary(const std::vector<CaseScore>& outcomes, nlohmann::json& summary) {
+  std::string md = "\n| effect missed | verdict | what more trials per set-up would do (report) |\n|---|---|---|\n";
+  std::vector<std::vector<std::string>> missed;
+  for (const auto& o : outcomes) {
+    if (o.truth == "none" || o.detected) continue;
+    missed.push_back(o.advice);
+    md += fmt::format("| {} ({}) | {} | {} |\n", o.truth, o.magnitude, o.verdict, fmt::join(o.advice, ", "));
+    summary["missed"].push_back(
+        {{"effect", o.truth}, {"magnitude", o.magnitude}, {"verdict", o.verdict}, {"advice", o.advice}});
+  }
+  if (missed.empty()) return "";
+  return md + "\n" + advice_tally(missed, summary);
 }
 
 /// The generated set's score: the confusion matrix, detection per effect and magnitude, the
@@ -404,6 +462,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
                     100.0 * median(improvements));
   md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
   md += time_summary(outcomes, summary);
+  md += missed_summary(outcomes, summary);
   // On the controls the calibrated null's replays should sit on the recorded outcomes within
   // their standard errors (z about 0 +- 1): a mean z away from 0 is a bias of the diagnosed
   // particle model against the generator's, which the ensemble stage may blame on an effect.

@@ -244,6 +244,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                         {"needed", d.needed},
                         {"trials_needed", finite_or_null(d.trials_needed)},
                         {"misfit_limited", d.misfit_limited},
+                        {"advice", trials_advice_name(d.advice)},
                         {"strong_rejection", d.strong_rejection},
                         {"strong_resolution", finite_or_null(d.strong_resolution)},
                         {"dispersion", d.dispersion}});

@@ -575,38 +575,53 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
     // rejection beyond twice the next finer clump's move of the strong response, as frame by
     // frame: on that noisy:15 set the offset (2.5 and 1.2 mm on the 340-sphere body) was rejected
     // by 20.3 against 15 needed while the null's chi^2 was 3.4 times its degrees of freedom.
-    if (tried && d.decides_absence()) {
-      std::erase(result.undecidable, name);
-      continue;
+    const bool listed =
+        std::find(result.undecidable.begin(), result.undecidable.end(), name) != result.undecidable.end();
+    const TrialsAdvice advice = trials_advice(d, tried, listed, ens.trials);
+    if (result.ensemble) {
+      for (auto& reported : result.ensemble->detectability)
+        if (reported.effect == d.effect) reported.advice = advice;
     }
-    if (std::find(result.undecidable.begin(), result.undecidable.end(), name) == result.undecidable.end()) continue;
-    if (tried && d.strong_signal >= d.needed && d.strong_rejection >= d.needed)
-      no_more_trials.push_back(fmt::format(
-          "{} (rejected by {:.1f}, within the null's own misfit ({:.1f} times its degrees of freedom){}: the "
-          "particle model decides it)",
-          name, d.strong_rejection, d.dispersion,
-          std::isfinite(d.strong_resolution)
-              ? fmt::format(" or twice the next finer clump's move of its response ({:.1f})", d.strong_resolution)
-              : std::string()));
-    else if (!std::isfinite(d.trials_needed) && d.misfit_limited)
-      no_more_trials.push_back(fmt::format(
-          "{} (the null's own misfit, the particle model's, grows with them as its signal does: a finer particle "
-          "model decides it)",
-          name));
-    else if (!std::isfinite(d.trials_needed) && d.strong_signal > 0.0)
-      no_more_trials.push_back(fmt::format(
-          "{} (its response stays within the comparisons' floor, what no particle model reproduces)", name));
-    else if (!std::isfinite(d.trials_needed))
-      no_more_trials.push_back(d.replay_noise > 0.0
-                                   ? fmt::format("{} (its response is within the replays' own noise)", name)
-                                   : fmt::format("{} (the outcomes do not respond to it)", name));
-    else if (d.trials_needed > ens.trials)
-      more_trials.push_back(fmt::format("{} about {:.0f}", name, d.trials_needed));
-    else
-      more_trials.push_back(
-          fmt::format("{} more than {:.0f} (to first order these would do, yet no candidate came "
-                      "near the margin to be tried)",
-                      name, ens.trials));
+    switch (advice) {
+      case TrialsAdvice::NotJudged:
+      case TrialsAdvice::Decided:
+        std::erase(result.undecidable, name);
+        break;
+      case TrialsAdvice::ParticleModelDecides:
+        no_more_trials.push_back(fmt::format(
+            "{} (rejected by {:.1f}, within the null's own misfit ({:.1f} times its degrees of freedom){}: the "
+            "particle model decides it)",
+            name, d.strong_rejection, d.dispersion,
+            std::isfinite(d.strong_resolution)
+                ? fmt::format(" or twice the next finer clump's move of its response ({:.1f})", d.strong_resolution)
+                : std::string()));
+        break;
+      case TrialsAdvice::MisfitLimited:
+        no_more_trials.push_back(fmt::format(
+            "{} (the null's own misfit, the particle model's, grows with them as its signal does: a finer particle "
+            "model decides it)",
+            name));
+        break;
+      case TrialsAdvice::Floor:
+        no_more_trials.push_back(fmt::format(
+            "{} (its response stays within the comparisons' floor, what no particle model reproduces)", name));
+        break;
+      case TrialsAdvice::ReplayNoise:
+        no_more_trials.push_back(fmt::format("{} (its response is within the replays' own noise)", name));
+        break;
+      case TrialsAdvice::NoResponse:
+        no_more_trials.push_back(fmt::format("{} (the outcomes do not respond to it)", name));
+        break;
+      case TrialsAdvice::MoreTrials:
+        more_trials.push_back(fmt::format("{} about {:.0f}", name, d.trials_needed));
+        break;
+      case TrialsAdvice::FirstOrderWouldDo:
+        more_trials.push_back(
+            fmt::format("{} more than {:.0f} (to first order these would do, yet no candidate came "
+                        "near the margin to be tried)",
+                        name, ens.trials));
+        break;
+    }
   }
   if (result.verdict != Verdict::None || (more_trials.empty() && no_more_trials.empty())) return;
   std::string text = result.experiment.empty() ? std::string("record each trial's release orientation to a few degrees")

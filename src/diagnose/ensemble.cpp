@@ -34,6 +34,30 @@ std::string_view statistic_name(Statistic statistic) {
   return statistic == Statistic::Mean ? "mean" : "spread";
 }
 
+std::string_view trials_advice_name(TrialsAdvice advice) {
+  switch (advice) {
+    case TrialsAdvice::NotJudged:
+      return "not_judged";
+    case TrialsAdvice::Decided:
+      return "decided";
+    case TrialsAdvice::MoreTrials:
+      return "more_trials";
+    case TrialsAdvice::FirstOrderWouldDo:
+      return "first_order_would_do";
+    case TrialsAdvice::ParticleModelDecides:
+      return "particle_model_decides";
+    case TrialsAdvice::MisfitLimited:
+      return "misfit_limited";
+    case TrialsAdvice::Floor:
+      return "floor";
+    case TrialsAdvice::ReplayNoise:
+      return "replay_noise";
+    case TrialsAdvice::NoResponse:
+      return "no_response";
+  }
+  return "?";
+}
+
 namespace {
 
 std::vector<Outcome> outcomes_of(LabTest test) {
@@ -168,6 +192,16 @@ OutcomeComparison compare_spread(const std::vector<double>& recorded, const std:
   c.ensemble_mean = e.mean;
   c.ensemble_sd = e.sd;
   return c;
+}
+
+TrialsAdvice trials_advice(const Detectability& d, bool tried, bool undecidable, double trials_now) {
+  if ((tried && d.decides_absence()) || !undecidable) return TrialsAdvice::Decided;
+  if (tried && d.strong_signal >= d.needed && d.strong_rejection >= d.needed) return TrialsAdvice::ParticleModelDecides;
+  if (std::isfinite(d.trials_needed))
+    return d.trials_needed > trials_now ? TrialsAdvice::MoreTrials : TrialsAdvice::FirstOrderWouldDo;
+  if (d.misfit_limited) return TrialsAdvice::MisfitLimited;
+  if (d.strong_signal > 0.0) return TrialsAdvice::Floor;
+  return d.replay_noise > 0.0 ? TrialsAdvice::ReplayNoise : TrialsAdvice::NoResponse;
 }
 
 bool Detectability::decides_absence() const {

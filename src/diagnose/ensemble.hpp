@@ -181,6 +181,21 @@ struct EnsembleHypothesis {
 /// than its distance from the next rung, so this is an allowance, not a bound.
 constexpr double kResolutionAllowance = 2.0;
 
+/// What more trials per set-up would do for a candidate compared on the outcomes, as the
+/// experiment says it (say_what_outcomes_decide in diagnose/stages.hpp).
+enum class TrialsAdvice {
+  NotJudged,             ///< not said (the comparison ended before the candidates were judged)
+  Decided,               ///< not undecidable: the outcomes (or the frames before them) decided it
+  MoreTrials,            ///< trials_needed trials per set-up, more than recorded, would show it
+  FirstOrderWouldDo,     ///< the trials recorded would, to first order, yet it was never tried
+  ParticleModelDecides,  ///< rejected by the margin, but within the null's misfit or the finer clump's move
+  MisfitLimited,         ///< the null's own misfit grows with the trials as its signal does
+  Floor,                 ///< its response stays within the comparisons' floor
+  ReplayNoise,           ///< its response is within the replays' own noise
+  NoResponse,            ///< the outcomes do not respond to it
+};
+std::string_view trials_advice_name(TrialsAdvice advice);
+
 /// How well the outcomes could show a candidate: its strong magnitude's signal (delta-chi^2
 /// after the free coefficients absorb what they can, to first order) and the trials per
 /// recording at which that signal would reach the delta-BIC margin.
@@ -213,7 +228,16 @@ struct Detectability {
   /// With trials_needed infinite: the response alone would reach the margin by then, but the
   /// null's own misfit (the particle model's) grows with the trials as fast.
   bool misfit_limited = false;
+  /// What the experiment says more trials would do for it (set once the candidates are judged).
+  TrialsAdvice advice = TrialsAdvice::NotJudged;
 };
+
+/// What more trials would do for candidate `d`: decided when it was `tried` on the outcomes and
+/// they decide its absence, or when it is not `undecidable` (decided before the outcomes); else
+/// rejected within the particle model's misfit (tried, its strong signal and rejection both
+/// reaching the margin), or, from trials_needed against `trials_now`, more trials, none (the
+/// null's misfit, the floor, the replays' noise, no response) or the count recorded already.
+TrialsAdvice trials_advice(const Detectability& d, bool tried, bool undecidable, double trials_now);
 
 /// A candidate's response (its replays' statistics less the null's, from the same orientations),
 /// in standard errors of the recorded outcomes (`inverse_se`), with what the free coefficients

@@ -335,6 +335,7 @@ TEST(DiagnoseCli, AnAbsenceTheOutcomesDecideIsJudgedInTheUnitsOfTheNullsOwnMisfi
     EXPECT_GE(d["strong_signal"].get<double>(), needed) << d.dump();
     EXPECT_GE(d["strong_rejection"].get<double>(), needed) << d.dump();
     EXPECT_LT(d["strong_rejection"].get<double>(), dispersion * needed) << d.dump();
+    EXPECT_EQ(d["advice"], "particle_model_decides") << d.dump();
   }
   EXPECT_NE(j["experiment"].get<std::string>().find("com_offset (rejected by"), std::string::npos) << j["experiment"];
 }

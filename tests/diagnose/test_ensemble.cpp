@@ -485,6 +485,34 @@ TEST(EnsembleConvergence, AnOutcomeShiftCountsWhenItIsRealAndMatters) {
 // fitted level in its own strong case, failed the margin with a strong signal of 0.1 against 13
 // needed, and was called absent until 4e3e08b; the generated noisy:15 strong centre-of-mass
 // offset (strong signal 45 against 15) was called absent at 0674a71 while present.
+TEST(EnsembleDecided, TheAdviceOnMoreTrialsFollowsTheCandidatesDetectability) {
+  // The margin needs 13; 4 trials per set-up were recorded. Each case takes the branch the
+  // experiment's text takes (say_what_outcomes_decide), typed.
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  const auto make = [](double signal, double rejection, double trials, bool misfit, double noise) {
+    Detectability d{Effect::ViscousRolling, signal, noise, 13.0, trials};
+    d.strong_rejection = rejection;
+    d.misfit_limited = misfit;
+    return d;
+  };
+  // Tried, shown and rejected by the margin: decided; an effect not undecidable: decided.
+  EXPECT_EQ(trials_advice(make(30.0, 30.0, 4.0, false, 0.0), true, true, 4.0), TrialsAdvice::Decided);
+  EXPECT_EQ(trials_advice(make(0.0, 0.0, kNone, false, 0.0), false, false, 4.0), TrialsAdvice::Decided);
+  // Shown and rejected, but within the null's own misfit (dispersion 3: 39 needed).
+  Detectability misfit = make(30.0, 30.0, 4.0, false, 0.0);
+  misfit.dispersion = 3.0;
+  EXPECT_EQ(trials_advice(misfit, true, true, 4.0), TrialsAdvice::ParticleModelDecides);
+  // Not shown at 4 trials: a count beyond them, or the 4 recorded never tried.
+  EXPECT_EQ(trials_advice(make(5.0, 0.0, 11.0, false, 0.0), true, true, 4.0), TrialsAdvice::MoreTrials);
+  EXPECT_EQ(trials_advice(make(15.0, 0.0, 4.0, false, 0.0), false, true, 4.0), TrialsAdvice::FirstOrderWouldDo);
+  // No count: the null's misfit, the floor, the replays' noise, no response.
+  EXPECT_EQ(trials_advice(make(5.0, 0.0, kNone, true, 0.0), true, true, 4.0), TrialsAdvice::MisfitLimited);
+  EXPECT_EQ(trials_advice(make(5.0, 0.0, kNone, false, 0.0), true, true, 4.0), TrialsAdvice::Floor);
+  EXPECT_EQ(trials_advice(make(0.0, 0.0, kNone, false, 2.0), true, true, 4.0), TrialsAdvice::ReplayNoise);
+  EXPECT_EQ(trials_advice(make(0.0, 0.0, kNone, false, 0.0), true, true, 4.0), TrialsAdvice::NoResponse);
+  EXPECT_EQ(trials_advice_name(TrialsAdvice::MisfitLimited), "misfit_limited");
+}
+
 TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow) {
   // (strong signal, rejection, the next finer clump's move of the response (NaN: not replayed),
   // the null's dispersion); the margin needs 13 in the null's dispersion units, and the
@@ -510,6 +538,8 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
     tried.effect = Effect::PlasticSubstrate;
     tried.first_delta_bic = -1.7;
     ens.hypotheses.push_back(tried);
+    result.ensemble = EnsembleReport{};
+    result.ensemble->detectability = ens.detectability;
     diagnosis::say_what_outcomes_decide(result, ens);
     const bool undecided = std::count(result.undecidable.begin(), result.undecidable.end(), "plastic_substrate") == 1;
     EXPECT_EQ(undecided, !k.decided) << k.strong_signal << " " << k.rejection << " " << k.resolution << " "
@@ -523,6 +553,14 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
     EXPECT_EQ(std::count(result.undecidable.begin(), result.undecidable.end(), "viscous_rolling"), 1);
     EXPECT_NE(result.experiment.find("viscous_rolling (the outcomes do not respond to it)"), std::string::npos)
         << result.experiment;
+    // The report carries each candidate's advice as the text gives it.
+    const auto& reported = result.ensemble->detectability;
+    const TrialsAdvice by_count =
+        8.0 * 13.0 / k.strong_signal > 8.0 ? TrialsAdvice::MoreTrials : TrialsAdvice::FirstOrderWouldDo;
+    EXPECT_EQ(reported[0].advice, k.decided           ? TrialsAdvice::Decided
+                                  : by_particle_model ? TrialsAdvice::ParticleModelDecides
+                                                      : by_count);
+    EXPECT_EQ(reported[1].advice, TrialsAdvice::NoResponse);
   }
 }
 
