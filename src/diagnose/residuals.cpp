@@ -348,6 +348,25 @@ std::string experiment_for(const std::string& a, const std::string& b) {
       a, b);
 }
 
+std::string experiment_to_show(const std::string& effect) {
+  // A particle that rolls on the tilt (a sphere slips only beyond tan(angle) = 3.5 mu_s, about 57
+  // degrees at mu_s 0.45) never slides, so the tilt cannot part its static and kinetic friction.
+  if (effect == "static_kinetic_friction")
+    return "a sliding test: a flat-faced sample of the material (or the particle held from rolling) on the tilting "
+           "plate, its first 10 mm of sliding filmed; a kinetic coefficient below the static one makes it jump ahead "
+           "at onset";
+  if (effect == "viscoelastic_restitution" || effect == "elastic_plastic_restitution")
+    return "drops from more heights, especially low ones (0.05 and 0.1 m) and a high one (2 m): a speed-dependent "
+           "restitution changes the rebound ratio with the impact speed";
+  if (effect == "viscous_rolling" || effect == "epsd_rolling")
+    return "rolls from two more start distances: a viscous torque's stopping distance grows like v0, a constant "
+           "torque's like v0^2, and an EPSD spring rocks back at rest";
+  for (const char* own : {"air_drag", "adhesion", "com_offset", "plastic_substrate"})
+    if (effect == own) return experiment_for(effect, effect);
+  return fmt::format("add set-ups that load {} differently (other drop heights, start distances, particle masses)",
+                     effect);
+}
+
 /// A misfit no particle model's inaccuracy could leave: three times hypot(noise, model
 /// accuracy) RMS or more (chi^2 per value >= kLargeMisfit) on either axis of the camera: a
 /// drop's misfit lies in its height, and the horizontal values it fits to the noise would

@@ -213,6 +213,9 @@ std::string recording_label(const Recording& r, const std::string& name);
 std::vector<PhaseReport> locate(const Context& c, const Groups& groups);
 double flagged_excess(const Groups& groups, const std::vector<GroupKey>& flagged);
 std::string experiment_for(const std::string& a, const std::string& b);
+/// The set-up that would make one effect show where these set-ups do not (a sphere's tracks,
+/// fitted to their end).
+std::string experiment_to_show(const std::string& effect);
 bool large_misfit(const Context& c, const GroupKey& key, const Group& g);
 /// The figure large_misfit holds to kLargeMisfit: the group's chi^2 per value on its worse
 /// axis, a drop's first flight scaled to the camera noise alone.
