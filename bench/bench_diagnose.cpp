@@ -91,6 +91,20 @@ std::vector<std::string> advice_for(const nlohmann::json& report, const std::vec
   return out;
 }
 
+/// Whether a report calls the concealed effect (any of `names`) decided: none of them is in its
+/// undecidable list or among its ambiguous candidates (an ambiguous pair that holds the truth does
+/// not call it absent either). False when the report has no undecidable list.
+bool calls_decided(const nlohmann::json& report, const std::vector<std::string>& names) {
+  if (!report.contains("undecidable") || !report["undecidable"].is_array()) return false;
+  const auto listed = [&](const char* key) {
+    if (!report.contains(key) || !report[key].is_array()) return false;
+    return std::any_of(report[key].begin(), report[key].end(), [&](const nlohmann::json& v) {
+      return v.is_string() && std::find(names.begin(), names.end(), v.get<std::string>()) != names.end();
+    });
+  };
+  return !listed("undecidable") && !listed("candidates");
+}
+
 /// The missed effects' advice counted (advice_for, the trials count left off): a markdown line,
 /// and summary["missed_advice"].
 std::string advice_tally(const std::vector<std::vector<std::string>>& missed, nlohmann::json& summary) {
@@ -198,6 +212,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   int effects = 0, effects_right = 0, controls = 0, controls_none = 0, controls_named = 0;
   std::vector<double> seconds, improvements;
   std::vector<std::vector<std::string>> missed_advice;
+  std::vector<std::string> missed_called_decided;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
     const fs::path report = out / id / "report.json";
@@ -225,6 +240,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       effects_right += is_right;
       if (is_right) improvements.push_back(gain);
       if (!is_right) missed_advice.push_back(advice_for(j, right));
+      if (!is_right && calls_decided(j, right)) missed_called_decided.push_back(id);
     }
     seconds.push_back(j.value("seconds", NAN));
     table += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} |\n", id,
@@ -249,7 +265,13 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   table += fmt::format("median held-out improvement of the cases named right: {:.1f} % of the held-out RMS\n",
                        100.0 * median(improvements));
   table += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
+  table += fmt::format(
+      "effects missed that the report called decided (neither in its undecidable list nor an ambiguous candidate): "
+      "{}/{}{}\n",
+      missed_called_decided.size(), missed_advice.size(),
+      missed_called_decided.empty() ? std::string() : fmt::format(" ({})", fmt::join(missed_called_decided, ", ")));
   nlohmann::json summary;
+  summary["missed_called_decided"] = missed_called_decided;
   table += advice_tally(missed_advice, summary);
   std::cout << "\n" << table;
   summary.update(nlohmann::json{{"set", set.string()},
@@ -307,15 +329,11 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   o.heldout_before = j["fit"]["before"].value("heldout_rms_mm", NAN);
   o.heldout_after = j["fit"]["after"].value("heldout_rms_mm", NAN);
   o.seconds = j.value("seconds", NAN);
+  o.called_decided = calls_decided(j, {truth});
   if (j.contains("undecidable") && j["undecidable"].is_array()) {
-    const auto& u = j["undecidable"];
-    // An ambiguous pair that holds the truth does not call it absent either.
-    const bool among_candidates =
-        j.contains("candidates") && j["candidates"].is_array() &&
-        std::find(j["candidates"].begin(), j["candidates"].end(), truth) != j["candidates"].end();
-    o.called_decided = std::find(u.begin(), u.end(), truth) == u.end() && !among_candidates;
-    o.ambiguous_with_truth = o.verdict == "ambiguous" && among_candidates;
-    o.undecidable = static_cast<int>(u.size());
+    o.ambiguous_with_truth = o.verdict == "ambiguous" && j.contains("candidates") && j["candidates"].is_array() &&
+                             std::find(j["candidates"].begin(), j["candidates"].end(), truth) != j["candidates"].end();
+    o.undecidable = static_cast<int>(j["undecidable"].size());
   }
   if (j.contains("hypotheses") && j["hypotheses"].is_array()) {
     for (const auto& h : j["hypotheses"])
