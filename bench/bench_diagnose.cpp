@@ -109,15 +109,22 @@ bool calls_decided(const nlohmann::json& report, const std::vector<std::string>&
 /// and summary["missed_advice"].
 std::string advice_tally(const std::vector<std::vector<std::string>>& missed, nlohmann::json& summary) {
   std::map<std::string, int> count;
-  for (const auto& advice : missed)
+  std::size_t candidates = 0;
+  for (const auto& advice : missed) {
+    candidates += advice.size();
     for (const auto& a : advice) ++count[a.substr(0, a.find(" ("))];
+  }
   std::vector<std::string> parts;
   for (const auto& [advice, n] : count) {
     parts.push_back(fmt::format("{} {}", advice, n));
     summary["missed_advice"][advice] = n;
   }
-  return fmt::format("what the reports say more trials per set-up would do for the {} missed effects: {}\n",
-                     missed.size(), parts.empty() ? std::string("-") : fmt::format("{}", fmt::join(parts, ", ")));
+  const std::string each =
+      candidates == missed.size()
+          ? std::string()
+          : fmt::format(" ({} candidates: a speed-dependent restitution is right under either law)", candidates);
+  return fmt::format("what the reports say more trials per set-up would do for the {} missed effects{}: {}\n",
+                     missed.size(), each, parts.empty() ? std::string("-") : fmt::format("{}", fmt::join(parts, ", ")));
 }
 
 /// The particle a case's recordings name: the first manifest's mesh (relative to it) and density.
