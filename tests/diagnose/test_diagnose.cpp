@@ -683,6 +683,25 @@ TEST(DiagnoseParticleModel, AClumpThatAgreesExplainsOnlyOnceTheNextReplaysTheSam
   }
 }
 
+// Tuber drops on soil from `heights`, `trials` each, made from the finer adaptive-340 of the
+// default scan with `base` (the table's soil coefficients when unset), no release orientation.
+Result<ConcealResult> soil_drops_from_the_finer_body(int trials, const std::vector<double>& heights, std::uint64_t seed,
+                                                     std::optional<Interaction> base = {}) {
+  auto generators = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
+  if (!generators) return std::unexpected(generators.error());
+  auto generator = select_clump(std::move(*generators), "adaptive-340", "tuber-default.h5");
+  if (!generator) return std::unexpected(generator.error());
+  ConcealOptions conceal;
+  conceal.surface = "soil";
+  conceal.trials = trials;
+  conceal.drop_heights = heights;
+  conceal.roll_starts = {};
+  conceal.tilt = false;
+  conceal.seed = seed;
+  conceal.base = std::move(base);
+  return make_concealed_recordings(*generator, default_material_table(), conceal);
+}
+
 TEST(DiagnoseEnsemble, ARestitutionFarFromTheTablesIsCalibratedOnTheOutcomes) {
   // Tuber drops on soil from 0.2 and 0.5 m, six trials each, made from the finer adaptive-340
   // with a soil restitution of 0.92 against the table's 0.44, no release orientation. Frame by
@@ -695,23 +714,11 @@ TEST(DiagnoseEnsemble, ARestitutionFarFromTheTablesIsCalibratedOnTheOutcomes) {
   // it left the table's by more than 0.2. One free coefficient and no rolls: the earlier
   // calibration passed this too; its failure needed rolls pulling against the drops (see
   // DiagnoseCli.AnotherSimulatorsTuberControlIsConsistentWithTheDiagnosedClumpAlone).
-  auto generators = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
-  ASSERT_TRUE(generators) << generators.error().message;
-  auto generator = select_clump(std::move(*generators), "adaptive-340", "tuber-default.h5");
-  ASSERT_TRUE(generator) << generator.error().message;
   const MaterialTable table = default_material_table();
-  ConcealOptions conceal;
-  conceal.surface = "soil";
-  conceal.trials = 6;
-  conceal.drop_heights = {0.2, 0.5};
-  conceal.roll_starts = {};
-  conceal.tilt = false;
-  conceal.seed = 2611;
   Interaction base = *table.interaction("tuber", "soil");
   const double table_e = base.restitution;
   base.restitution = 0.92;
-  conceal.base = base;
-  auto made = make_concealed_recordings(*generator, table, conceal);
+  auto made = soil_drops_from_the_finer_body(6, {0.2, 0.5}, 2611, base);
   ASSERT_TRUE(made) << made.error().message;
   DiagnoseOptions options;
   options.effects = {Effect::AirDrag, Effect::ViscoelasticRestitution};
@@ -740,20 +747,9 @@ TEST(DiagnoseEnsemble, ARecordingWithMoreTrialsThanReplaysIsReplayedOncePerTrial
   // has a standard error of s/sqrt(14); 12 replays would leave the comparison's at
   // s sqrt(1/14 + 1/12), the replays' share the larger. Each recording is replayed once per trial
   // when it has more trials than replays: every comparison's ensemble sample holds the 14.
-  auto generators = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
-  ASSERT_TRUE(generators) << generators.error().message;
-  auto generator = select_clump(std::move(*generators), "adaptive-340", "tuber-default.h5");
-  ASSERT_TRUE(generator) << generator.error().message;
-  const MaterialTable table = default_material_table();
-  ConcealOptions conceal;
-  conceal.surface = "soil";
-  conceal.trials = 14;
-  conceal.drop_heights = {0.2};
-  conceal.roll_starts = {};
-  conceal.tilt = false;
-  conceal.seed = 2612;
-  auto made = make_concealed_recordings(*generator, table, conceal);
+  auto made = soil_drops_from_the_finer_body(14, {0.2}, 2612);
   ASSERT_TRUE(made) << made.error().message;
+  const MaterialTable table = default_material_table();
   DiagnoseOptions options;
   options.effects = {Effect::AirDrag};
   ASSERT_EQ(options.ensemble_replays, 12);
