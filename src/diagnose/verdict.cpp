@@ -156,7 +156,7 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
   // sphere. A body fitted to the end of every track (a sphere) has no such part: there these
   // set-ups do not make the effect show (a sphere rolls down a tilt without sliding, so static
   // and kinetic friction never part), and another set-up is what decides it. Until the commit
-  // after 1e4fec7 a sphere was told to repeat its tests with a sphere (six of the independent
+  // after 1e4fec7 a sphere was told to repeat its tests with a sphere (five of the independent
   // simulator's sphere cases).
   if (std::ranges::any_of(c.ev.trials, [](const TrackedTrial& t) { return t.horizon < t.duration; })) {
     result.statement += fmt::format(

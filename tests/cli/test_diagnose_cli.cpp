@@ -231,7 +231,7 @@ TEST(DiagnoseCli, ASphereIsNotToldToRepeatItsTestsWithASphere) {
   // candidate stays undecidable. Each track is fitted to its end (no release horizon), so the
   // unknown release is not why: the statement says these set-ups do not make it show, and the
   // experiment asks for a sliding test, not for the release orientation or "a sphere of the same
-  // material" (what six of the set's sphere cases were told before the commit after 1e4fec7).
+  // material" (what five of the set's sphere cases were told before the commit after 1e4fec7).
   const auto set = test::shared_dir() / "data" / "lab-like";
   const auto run = test::run_clumpforge(
       fmt::format("diagnose --recordings '{}' '{}' --mesh '{}' --density 1085 --effects static_kinetic_friction --json",
