@@ -238,6 +238,8 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
     const double before = j["fit"]["before"].value("heldout_rms_mm", NAN),
                  after = j["fit"]["after"].value("heldout_rms_mm", NAN);
     const double gain = before > 0.0 ? (before - after) / before : NAN;
+    const bool missed = effect != "none" && !is_right;
+    const std::vector<std::string> advice = missed ? advice_for(j, right) : std::vector<std::string>{};
     if (effect == "none") {
       ++controls;
       controls_none += verdict == "none";
@@ -246,23 +248,22 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       ++effects;
       effects_right += is_right;
       if (is_right) improvements.push_back(gain);
-      if (!is_right) missed_advice.push_back(advice_for(j, right));
-      if (!is_right && calls_decided(j, right)) missed_called_decided.push_back(id);
+      if (missed) missed_advice.push_back(advice);
+      if (missed && calls_decided(j, right)) missed_called_decided.push_back(id);
     }
     seconds.push_back(j.value("seconds", NAN));
     table += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} |\n", id,
                          answer.value("particle", "?"), answer.value("label", effect), verdict, j.value("basis", "?"),
                          is_right ? "yes" : "no", before, after, 100.0 * gain, j.value("seconds", NAN));
-    rows.push_back(
-        {{"case", id},
-         {"truth", effect},
-         {"verdict", verdict},
-         {"basis", j.value("basis", "?")},
-         {"right", is_right},
-         {"heldout_rms_before_mm", before},
-         {"heldout_rms_after_mm", after},
-         {"seconds", j.value("seconds", NAN)},
-         {"advice", effect == "none" || is_right ? nlohmann::json() : nlohmann::json(missed_advice.back())}});
+    rows.push_back({{"case", id},
+                    {"truth", effect},
+                    {"verdict", verdict},
+                    {"basis", j.value("basis", "?")},
+                    {"right", is_right},
+                    {"heldout_rms_before_mm", before},
+                    {"heldout_rms_after_mm", after},
+                    {"seconds", j.value("seconds", NAN)},
+                    {"advice", missed ? nlohmann::json(advice) : nlohmann::json()}});
     std::cout << fmt::format("{}  truth {:18s} verdict {:28s} {}  {:.0f} s\n", id, effect, verdict,
                              is_right ? "right" : "WRONG", j.value("seconds", NAN))
               << std::flush;

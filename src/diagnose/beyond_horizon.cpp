@@ -583,7 +583,8 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
         if (reported.effect == d.effect) reported.advice = advice;
     }
     switch (advice) {
-      case TrialsAdvice::NotJudged:
+      case TrialsAdvice::NotJudged:  // trials_advice always judges
+        break;
       case TrialsAdvice::Decided:
         std::erase(result.undecidable, name);
         break;

@@ -262,7 +262,7 @@ Eigen::VectorXd ErrorScaling::inverse_se(double trials, double replays) const {
 TrialsToShow trials_to_show(const ErrorScaling& scaling, const Eigen::VectorXd& inverse_se,
                             const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
                             const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& null_residual, double null_chi2,
-                            int outcomes, std::size_t free, double needed, double trials_now, double replays_now,
+                            int outcomes, std::size_t free, double needed, double trials_now, int replays_now,
                             int most) {
   // Each statistic's bias estimate: its squared residual less its sampling variance (unbiased,
   // so a negative term is kept: the sum is what is estimated).
@@ -270,7 +270,7 @@ TrialsToShow trials_to_show(const ErrorScaling& scaling, const Eigen::VectorXd& 
   const Eigen::ArrayXd bias2 = null_residual.array().square() - (w0 > 0.0).select(w0.inverse(), 0.0);
   TrialsToShow out;
   for (int n = std::max(1, static_cast<int>(std::ceil(trials_now))); n <= most; ++n) {
-    const Eigen::VectorXd w = scaling.inverse_se(n, std::max(replays_now, static_cast<double>(n)));
+    const Eigen::VectorXd w = scaling.inverse_se(n, replays_per_recording(replays_now, static_cast<std::size_t>(n)));
     const double signal = response_signal(response, variance, w, jacobian).signal();
     const double chi2 = null_chi2 + (bias2 * (w.array().square() - w0)).sum();
     const double dispersion = margin_over_null(null_chi2, chi2, outcomes, free, 0).dispersion;
@@ -581,9 +581,9 @@ Result<std::optional<Proposal>> propose(const Evaluator& ev, const std::vector<P
     Detectability d{spec.effect, s.signal(), s.noise, options.min_delta_bic + penalty,
                     std::numeric_limits<double>::infinity()};
     d.dispersion = margin_over_null(result.null_chi2, result.null_chi2, result.outcomes, free.size(), 0).dispersion;
-    const TrialsToShow more = trials_to_show(scaling, inverse_se, response[1], strong_variance, jacobian,
-                                             recorded - null_means, result.null_chi2, result.outcomes, free.size(),
-                                             d.needed, result.trials, static_cast<double>(options.replays));
+    const TrialsToShow more =
+        trials_to_show(scaling, inverse_se, response[1], strong_variance, jacobian, recorded - null_means,
+                       result.null_chi2, result.outcomes, free.size(), d.needed, result.trials, options.replays);
     d.trials_needed = more.trials;
     d.misfit_limited = more.misfit_limited;
     // How far the recorded means reject the strong magnitude; the strong replays' own sampling

@@ -263,14 +263,13 @@ struct ErrorScaling {
 };
 ErrorScaling error_scaling(const std::vector<OutcomeComparison>& made, const Eigen::VectorXd& inverse_se);
 
-/// The smallest trials per recording, up to `most`, each recording replayed max(replays_now, n)
-/// times, at which a strong response's signal (response_signal: `variance` its own sampling
-/// variance, `jacobian` what the free coefficients absorb) reaches `needed` in the units of the
-/// null's own misfit: that misfit's part beyond the sampling noise (each statistic's
-/// `null_residual` squared less its present se^2: the particle model's bias) grows with the
-/// trials as a signal does, from `null_chi2` at the present se (`inverse_se`), its degrees of
-/// freedom the `outcomes` less the `free` coefficients. The floor of each comparison caps both. Infinity when no count
-/// does; misfit_limited then says whether the response alone would have.
+/// The smallest trials per recording, up to `most`, each recording replayed
+/// replays_per_recording(replays_now, n) times, at which a strong response's signal (response_signal: `variance` its
+/// own sampling variance, `jacobian` what the free coefficients absorb) reaches `needed` in the units of the null's own
+/// misfit: that misfit's part beyond the sampling noise (each statistic's `null_residual` squared less its present
+/// se^2: the particle model's bias) grows with the trials as a signal does, from `null_chi2` at the present se
+/// (`inverse_se`), its degrees of freedom the `outcomes` less the `free` coefficients. The floor of each comparison
+/// caps both. Infinity when no count does; misfit_limited then says whether the response alone would have.
 struct TrialsToShow {
   double trials = std::numeric_limits<double>::infinity();
   bool misfit_limited = false;
@@ -278,7 +277,7 @@ struct TrialsToShow {
 TrialsToShow trials_to_show(const ErrorScaling& scaling, const Eigen::VectorXd& inverse_se,
                             const Eigen::VectorXd& response, const Eigen::VectorXd& variance,
                             const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& null_residual, double null_chi2,
-                            int outcomes, std::size_t free, double needed, double trials_now, double replays_now,
+                            int outcomes, std::size_t free, double needed, double trials_now, int replays_now,
                             int most = 1000);
 
 struct EnsembleResult {

@@ -355,16 +355,11 @@ std::string experiment_to_show(const std::string& effect) {
     return "a sliding test: a flat-faced sample of the material (or the particle held from rolling) on the tilting "
            "plate, its first 10 mm of sliding filmed; a kinetic coefficient below the static one makes it jump ahead "
            "at onset";
+  // The set-up that tells a law from its rival also shows it against none.
   if (effect == "viscoelastic_restitution" || effect == "elastic_plastic_restitution")
-    return "drops from more heights, especially low ones (0.05 and 0.1 m) and a high one (2 m): a speed-dependent "
-           "restitution changes the rebound ratio with the impact speed";
-  if (effect == "viscous_rolling" || effect == "epsd_rolling")
-    return "rolls from two more start distances: a viscous torque's stopping distance grows like v0, a constant "
-           "torque's like v0^2, and an EPSD spring rocks back at rest";
-  for (const char* own : {"air_drag", "adhesion", "com_offset", "plastic_substrate"})
-    if (effect == own) return experiment_for(effect, effect);
-  return fmt::format("add set-ups that load {} differently (other drop heights, start distances, particle masses)",
-                     effect);
+    return experiment_for("viscoelastic_restitution", "elastic_plastic_restitution");
+  if (effect == "viscous_rolling" || effect == "epsd_rolling") return experiment_for("viscous_rolling", "epsd_rolling");
+  return experiment_for(effect, effect);
 }
 
 /// A misfit no particle model's inaccuracy could leave: three times hypot(noise, model
