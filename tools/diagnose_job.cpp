@@ -131,6 +131,170 @@ Result<ParticleModels> particle_models(const DiagnoseJob& job, const RunContext&
   }
   return out;
 }
+/// report.json's particle_model: the clump ladder climbed and what each finer rung explained.
+nlohmann::json particle_model_json(const DiagnoseResult& r) {
+  if (!r.particle_model) return nlohmann::json();
+  const auto& m = *r.particle_model;
+  nlohmann::json rungs = nlohmann::json::array();
+  for (const auto& rung : m.rungs) {
+    rungs.push_back(
+        {{"clump", rung.name},
+         {"spheres", rung.spheres},
+         {"track_difference_mm", finite_or_null(rung.track_difference_m * 1e3)},
+         {"refitted", rung.refitted},
+         {"chi2_per_value", rung.refitted ? finite_or_null(rung.chi2_per_value) : nlohmann::json()},
+         {"worst_phase_chi2_per_value",
+          rung.refitted ? finite_or_null(rung.worst_phase_chi2_per_value) : nlohmann::json()},
+         {"explains", rung.explains},
+         {"outcome_shift",
+          outcome_shift_json(rung.outcome_shift, r.ensemble ? r.ensemble->recordings : std::vector<std::string>{})}});
+  }
+  return {{"diagnosed", m.diagnosed},
+          {"spheres", m.spheres},
+          {"track_tolerance_mm", finite_or_null(m.track_tolerance_m * 1e3)},
+          {"checked", m.checked},
+          {"chi2_per_value", m.checked ? finite_or_null(m.chi2_per_value) : nlohmann::json()},
+          {"worst_phase_chi2_per_value", m.checked ? finite_or_null(m.worst_phase_chi2_per_value) : nlohmann::json()},
+          {"resolution_needed_spheres", m.resolution_needed ? nlohmann::json(*m.resolution_needed) : nlohmann::json()},
+          {"rungs", rungs}};
+}
+
+/// report.json's flights: the free flights' wobble and the centre-of-mass offset they show.
+nlohmann::json flights_json(const DiagnoseResult& r) {
+  if (!r.flights) return nlohmann::json();
+  const auto& f = *r.flights;
+  // Too few flights to judge: only their number and the allowance; the measures are null.
+  const auto measured = [&f](double metres) { return f.judged ? nlohmann::json(metres * 1e3) : nlohmann::json(); };
+  return {{"flights", f.flights.size()},
+          {"judged", f.judged},
+          {"wobble_mm", measured(f.wobble_m)},
+          {"noise_mm", measured(f.noise_m)},
+          {"allowance_mm", f.allowance_m * 1e3},
+          {"detected", f.detected},
+          {"offset_mm", measured(f.offset_m)},
+          {"offset_low_mm", measured(f.offset_low_m)},
+          {"offset_high_mm", measured(f.offset_high_m)},
+          {"smallest_offset_mm", finite_or_null(f.smallest_offset_m * 1e3)}};
+}
+
+/// report.json's ensemble: the recorded outcomes against replays over the unknown release.
+nlohmann::json ensemble_json(const EnsembleReport& e) {
+  auto comparisons_json = [&](const std::vector<OutcomeComparison>& list) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& c : list) {
+      out.push_back({{"recording", e.recordings.at(c.recording)},
+                     {"outcome", outcome_name(c.outcome)},
+                     {"statistic", statistic_name(c.statistic)},
+                     {"recorded_value", c.recorded_value},
+                     {"replayed_value", c.ensemble_value},
+                     {"recorded_mean", c.recorded_mean},
+                     {"recorded_sd", c.recorded_sd},
+                     {"recorded_n", c.recorded_n},
+                     {"replayed_mean", c.ensemble_mean},
+                     {"replayed_sd", c.ensemble_sd},
+                     {"replays", c.ensemble_n},
+                     {"floor", c.floor},
+                     {"z", c.z}});
+    }
+    return out;
+  };
+  const nlohmann::json outcomes = comparisons_json(e.null_comparisons);
+  nlohmann::json tried = nlohmann::json::array();
+  const auto library = effect_library();
+  for (const auto& h : e.hypotheses) {
+    const EffectSpec& spec = effect_spec(library, h.effect);
+    nlohmann::json values = nlohmann::json::object();
+    for (std::size_t k = 0; k < spec.parameters.size() && k < h.values.size(); ++k)
+      values[spec.parameters[k].name] = h.values[k];
+    tried.push_back({{"name", spec.name},
+                     {"values", values},
+                     {"chi2", h.chi2},
+                     {"dispersion", h.dispersion},
+                     {"delta_bic", h.delta_bic()},
+                     {"fresh_delta_bic", finite_or_null(h.fresh_delta_bic)},
+                     {"first_delta_bic", finite_or_null(h.first_delta_bic)},
+                     {"plausible", h.plausible},
+                     {"comparisons", comparisons_json(h.comparisons)}});
+  }
+  nlohmann::json detect = nlohmann::json::array();
+  for (const auto& d : e.detectability) {
+    detect.push_back({{"name", effect_spec(library, d.effect).name},
+                      {"strong_signal", d.strong_signal},
+                      {"replay_noise", d.replay_noise},
+                      {"needed", d.needed},
+                      {"trials_needed", finite_or_null(d.trials_needed)},
+                      {"misfit_limited", d.misfit_limited},
+                      {"advice", trials_advice_name(d.advice)},
+                      {"strong_rejection", d.strong_rejection},
+                      {"strong_resolution", finite_or_null(d.strong_resolution)},
+                      {"dispersion", d.dispersion}});
+  }
+  return {{"replays", e.replays},
+          {"trials", e.trials},
+          {"detectability", detect},
+          {"outcomes", e.outcomes},
+          {"null_chi2", e.null_chi2},
+          {"calibrated", coefficients_json(e.calibrated)},
+          {"calibrated_here", e.calibrated_here},
+          {"comparisons", outcomes},
+          {"hypotheses", tried}};
+}
+
+/// report.json's phases: each recording's phases judged against the noise.
+nlohmann::json phases_json(const std::vector<PhaseReport>& phases) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& p : phases) {
+    out.push_back({{"recording", p.recording},
+                   {"phase", std::string(phase_name(p.phase))},
+                   {"values", p.values},
+                   {"chi2_per_value", p.chi2_per_value},
+                   {"p_value", p.p_value},
+                   {"significant", p.significant},
+                   {"bias_x_mm", p.bias_x_mm},
+                   {"bias_z_mm", p.bias_z_mm},
+                   {"axis", p.axis == Axis::Z ? "z" : "x"},
+                   {"growth_power", p.growth_power},
+                   {"end_residual_mm", p.end_residual_mm},
+                   {"improved_chi2_per_value", p.improved_chi2_per_value},
+                   {"statement", p.statement}});
+  }
+  return out;
+}
+
+/// report.json's hypotheses: each candidate fitted frame by frame and its checks.
+nlohmann::json hypotheses_json(const std::vector<HypothesisReport>& hypotheses) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& h : hypotheses) {
+    nlohmann::json values = nlohmann::json::object();
+    for (const auto& v : h.values) values[v.name] = v.value;
+    out.push_back({{"name", h.name},
+                   {"fitted", h.fitted},
+                   {"values", values},
+                   {"coefficients", coefficients_json(h.base)},
+                   {"values_used", h.values_used},
+                   {"delta_chi2", h.delta_chi2},
+                   {"delta_bic", h.delta_bic},
+                   {"heldout_delta_chi2", h.heldout_delta_chi2},
+                   {"plausible", h.plausible},
+                   {"improves_heldout", h.improves_heldout},
+                   {"clears_signature", h.clears_signature},
+                   {"clears_large_misfit", h.clears_large_misfit},
+                   {"all_trials_delta_bic", finite_or_null(h.all_trials_delta_bic)},
+                   {"beats_refitted_null", h.beats_refitted_null},
+                   {"flagged_excess_before", h.flagged_excess_before},
+                   {"flagged_excess_after", h.flagged_excess_after},
+                   {"worsened_phases", h.worsened_phases},
+                   {"passes", h.passes},
+                   {"evaluations", h.evaluations},
+                   {"smallest_detectable", finite_or_null(h.smallest_detectable)},
+                   {"replay_shown", finite_or_null(h.replay_shown)},
+                   {"strong_delta_chi2", finite_or_null(h.strong_delta_chi2)},
+                   {"strong_resolution_chi2", finite_or_null(h.strong_resolution_chi2)},
+                   {"strong_preferred_in", preferred_json(h.strong_preferred_in)}});
+  }
+  return out;
+}
+
 }  // namespace
 
 nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string& clump_name) {
@@ -154,157 +318,12 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["refitted_on_all"] = r.refitted_on_all.empty() ? nlohmann::json() : coefficients_json(r.refitted_on_all);
   j["improved"] = coefficients_json(r.improved);
   j["uncalibrated"] = r.uncalibrated;
-  j["particle_model"] = nlohmann::json();
-  if (r.particle_model) {
-    const auto& m = *r.particle_model;
-    nlohmann::json rungs = nlohmann::json::array();
-    for (const auto& rung : m.rungs) {
-      rungs.push_back(
-          {{"clump", rung.name},
-           {"spheres", rung.spheres},
-           {"track_difference_mm", finite_or_null(rung.track_difference_m * 1e3)},
-           {"refitted", rung.refitted},
-           {"chi2_per_value", rung.refitted ? finite_or_null(rung.chi2_per_value) : nlohmann::json()},
-           {"worst_phase_chi2_per_value",
-            rung.refitted ? finite_or_null(rung.worst_phase_chi2_per_value) : nlohmann::json()},
-           {"explains", rung.explains},
-           {"outcome_shift",
-            outcome_shift_json(rung.outcome_shift, r.ensemble ? r.ensemble->recordings : std::vector<std::string>{})}});
-    }
-    j["particle_model"] = {
-        {"diagnosed", m.diagnosed},
-        {"spheres", m.spheres},
-        {"track_tolerance_mm", finite_or_null(m.track_tolerance_m * 1e3)},
-        {"checked", m.checked},
-        {"chi2_per_value", m.checked ? finite_or_null(m.chi2_per_value) : nlohmann::json()},
-        {"worst_phase_chi2_per_value", m.checked ? finite_or_null(m.worst_phase_chi2_per_value) : nlohmann::json()},
-        {"resolution_needed_spheres", m.resolution_needed ? nlohmann::json(*m.resolution_needed) : nlohmann::json()},
-        {"rungs", rungs}};
-  }
-  j["flights"] = nlohmann::json();
-  if (r.flights) {
-    const auto& f = *r.flights;
-    // Too few flights to judge: only their number and the allowance; the measures are null.
-    const auto measured = [&f](double metres) { return f.judged ? nlohmann::json(metres * 1e3) : nlohmann::json(); };
-    j["flights"] = {{"flights", f.flights.size()},
-                    {"judged", f.judged},
-                    {"wobble_mm", measured(f.wobble_m)},
-                    {"noise_mm", measured(f.noise_m)},
-                    {"allowance_mm", f.allowance_m * 1e3},
-                    {"detected", f.detected},
-                    {"offset_mm", measured(f.offset_m)},
-                    {"offset_low_mm", measured(f.offset_low_m)},
-                    {"offset_high_mm", measured(f.offset_high_m)},
-                    {"smallest_offset_mm", finite_or_null(f.smallest_offset_m * 1e3)}};
-  }
-  if (r.ensemble) {
-    const auto& e = *r.ensemble;
-    auto comparisons_json = [&](const std::vector<OutcomeComparison>& list) {
-      nlohmann::json out = nlohmann::json::array();
-      for (const auto& c : list) {
-        out.push_back({{"recording", e.recordings.at(c.recording)},
-                       {"outcome", outcome_name(c.outcome)},
-                       {"statistic", statistic_name(c.statistic)},
-                       {"recorded_value", c.recorded_value},
-                       {"replayed_value", c.ensemble_value},
-                       {"recorded_mean", c.recorded_mean},
-                       {"recorded_sd", c.recorded_sd},
-                       {"recorded_n", c.recorded_n},
-                       {"replayed_mean", c.ensemble_mean},
-                       {"replayed_sd", c.ensemble_sd},
-                       {"replays", c.ensemble_n},
-                       {"floor", c.floor},
-                       {"z", c.z}});
-      }
-      return out;
-    };
-    const nlohmann::json outcomes = comparisons_json(e.null_comparisons);
-    nlohmann::json tried = nlohmann::json::array();
-    const auto library = effect_library();
-    for (const auto& h : e.hypotheses) {
-      const EffectSpec& spec = effect_spec(library, h.effect);
-      nlohmann::json values = nlohmann::json::object();
-      for (std::size_t k = 0; k < spec.parameters.size() && k < h.values.size(); ++k)
-        values[spec.parameters[k].name] = h.values[k];
-      tried.push_back({{"name", spec.name},
-                       {"values", values},
-                       {"chi2", h.chi2},
-                       {"dispersion", h.dispersion},
-                       {"delta_bic", h.delta_bic()},
-                       {"fresh_delta_bic", finite_or_null(h.fresh_delta_bic)},
-                       {"first_delta_bic", finite_or_null(h.first_delta_bic)},
-                       {"plausible", h.plausible},
-                       {"comparisons", comparisons_json(h.comparisons)}});
-    }
-    nlohmann::json detect = nlohmann::json::array();
-    for (const auto& d : e.detectability) {
-      detect.push_back({{"name", effect_spec(library, d.effect).name},
-                        {"strong_signal", d.strong_signal},
-                        {"replay_noise", d.replay_noise},
-                        {"needed", d.needed},
-                        {"trials_needed", finite_or_null(d.trials_needed)},
-                        {"misfit_limited", d.misfit_limited},
-                        {"advice", trials_advice_name(d.advice)},
-                        {"strong_rejection", d.strong_rejection},
-                        {"strong_resolution", finite_or_null(d.strong_resolution)},
-                        {"dispersion", d.dispersion}});
-    }
-    j["ensemble"] = {{"replays", e.replays},
-                     {"trials", e.trials},
-                     {"detectability", detect},
-                     {"outcomes", e.outcomes},
-                     {"null_chi2", e.null_chi2},
-                     {"calibrated", coefficients_json(e.calibrated)},
-                     {"calibrated_here", e.calibrated_here},
-                     {"comparisons", outcomes},
-                     {"hypotheses", tried}};
-  }
+  j["particle_model"] = particle_model_json(r);
+  j["flights"] = flights_json(r);
+  if (r.ensemble) j["ensemble"] = ensemble_json(*r.ensemble);
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
-  j["phases"] = nlohmann::json::array();
-  for (const auto& p : r.phases) {
-    j["phases"].push_back({{"recording", p.recording},
-                           {"phase", std::string(phase_name(p.phase))},
-                           {"values", p.values},
-                           {"chi2_per_value", p.chi2_per_value},
-                           {"p_value", p.p_value},
-                           {"significant", p.significant},
-                           {"bias_x_mm", p.bias_x_mm},
-                           {"bias_z_mm", p.bias_z_mm},
-                           {"axis", p.axis == Axis::Z ? "z" : "x"},
-                           {"growth_power", p.growth_power},
-                           {"end_residual_mm", p.end_residual_mm},
-                           {"improved_chi2_per_value", p.improved_chi2_per_value},
-                           {"statement", p.statement}});
-  }
-  j["hypotheses"] = nlohmann::json::array();
-  for (const auto& h : r.hypotheses) {
-    nlohmann::json values = nlohmann::json::object();
-    for (const auto& v : h.values) values[v.name] = v.value;
-    j["hypotheses"].push_back({{"name", h.name},
-                               {"fitted", h.fitted},
-                               {"values", values},
-                               {"coefficients", coefficients_json(h.base)},
-                               {"values_used", h.values_used},
-                               {"delta_chi2", h.delta_chi2},
-                               {"delta_bic", h.delta_bic},
-                               {"heldout_delta_chi2", h.heldout_delta_chi2},
-                               {"plausible", h.plausible},
-                               {"improves_heldout", h.improves_heldout},
-                               {"clears_signature", h.clears_signature},
-                               {"clears_large_misfit", h.clears_large_misfit},
-                               {"all_trials_delta_bic", finite_or_null(h.all_trials_delta_bic)},
-                               {"beats_refitted_null", h.beats_refitted_null},
-                               {"flagged_excess_before", h.flagged_excess_before},
-                               {"flagged_excess_after", h.flagged_excess_after},
-                               {"worsened_phases", h.worsened_phases},
-                               {"passes", h.passes},
-                               {"evaluations", h.evaluations},
-                               {"smallest_detectable", finite_or_null(h.smallest_detectable)},
-                               {"replay_shown", finite_or_null(h.replay_shown)},
-                               {"strong_delta_chi2", finite_or_null(h.strong_delta_chi2)},
-                               {"strong_resolution_chi2", finite_or_null(h.strong_resolution_chi2)},
-                               {"strong_preferred_in", preferred_json(h.strong_preferred_in)}});
-  }
+  j["phases"] = phases_json(r.phases);
+  j["hypotheses"] = hypotheses_json(r.hypotheses);
   auto phases_of = [](const std::vector<PhaseOf>& list) {
     nlohmann::json out = nlohmann::json::array();
     for (const auto& u : list) {
