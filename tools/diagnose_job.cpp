@@ -312,6 +312,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["summaries_only"] = r.summaries_only;
   j["decidable"] = r.decidable;
   j["undecidable"] = r.undecidable;
+  j["undecided_because"] = std::string(undecided_because_name(r.undecided_because));
   j["noise_m"] = nlohmann::json::object();
   for (const auto& [name, s] : r.noise_m) j["noise_m"][name] = s;
   j["baseline"] = coefficients_json(r.baseline);

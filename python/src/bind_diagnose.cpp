@@ -20,6 +20,10 @@ void bind_enums(py::module_& m) {
         Basis::TooFewTrials, Basis::TooNoisy, Basis::SummariesOnly, Basis::ParticleModel, Basis::UnexplainedOutcomes,
         Basis::UnconvergedParticleModel, Basis::FreeFlights})
     basis.value(std::string(basis_name(b)).c_str(), b);
+  py::enum_<UndecidedBecause> because(m, "UndecidedBecause");
+  for (UndecidedBecause u : {UndecidedBecause::Nothing, UndecidedBecause::UnknownRelease,
+                             UndecidedBecause::PartedTrials, UndecidedBecause::SetUps})
+    because.value(std::string(undecided_because_name(u)).c_str(), u);
   py::enum_<Phase> phase(m, "Phase");
   for (Phase p : {Phase::Hold, Phase::Flight, Phase::Impact, Phase::Rebound, Phase::SecondFlight, Phase::LaterBounces,
                   Phase::Incline, Phase::Transition, Phase::Flat, Phase::Rest, Phase::Stick, Phase::Slip})
@@ -196,6 +200,8 @@ void bind_result(py::module_& m) {
       .def_readonly("notes", &DiagnoseResult::notes)
       .def_readonly("parted", &DiagnoseResult::parted)
       .def_readonly("undecidable", &DiagnoseResult::undecidable)
+      .def_readonly("undecided_because", &DiagnoseResult::undecided_because,
+                    "why the tracks fitted frame by frame left candidates undecided")
       .def_readonly("particle_model", &DiagnoseResult::particle_model)
       .def_readonly("flights", &DiagnoseResult::flights)
       .def_readonly("evaluations", &DiagnoseResult::evaluations)

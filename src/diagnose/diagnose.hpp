@@ -242,6 +242,13 @@ enum class Basis {
 };
 std::string_view basis_name(Basis basis);
 
+/// Why the tracks fitted frame by frame left candidates undecided (with a `none` frame by frame;
+/// the ensemble stage may decide them after): nothing was left, the unknown release orientation
+/// cut the fitted windows, the recorded trials parted where the replays agree, or every track
+/// was fitted to its end and these set-ups do not make the candidates show.
+enum class UndecidedBecause { Nothing, UnknownRelease, PartedTrials, SetUps };
+std::string_view undecided_because_name(UndecidedBecause because);
+
 /// The stages of a diagnosis, in the order they run (DiagnoseResult::stage_seconds).
 enum class Stage {
   LoadAndNoise,   ///< the tracks read, checked and their camera noise estimated
@@ -292,6 +299,7 @@ struct DiagnoseResult {
   std::vector<TrackComparison> tracks;
   std::vector<std::string> notes;
   std::vector<PartedRecording> parted;  ///< recordings whose trials part where the replays agree
+  UndecidedBecause undecided_because = UndecidedBecause::Nothing;  ///< frame by frame
   bool summaries_only = false;  ///< no tracks: what summaries can and cannot decide (in `decidable`, `undecidable`)
   std::vector<std::string> decidable, undecidable;
   std::optional<EnsembleReport> ensemble;

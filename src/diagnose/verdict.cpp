@@ -10,6 +10,7 @@
 #include <numbers>
 #include <numeric>
 #include <ranges>
+#include <set>
 
 #include "core/rng.hpp"
 #include "diagnose/stages.hpp"
@@ -105,6 +106,69 @@ void say_unexplained_phases(DiagnoseResult& result, const DiagnoseOptions& optio
   result.experiment = "look at the residual plots of these phases; add set-ups that isolate them";
 }
 
+namespace {
+
+/// The candidates a `none` frame by frame leaves undecided, and the experiment for them, by
+/// what limited the fitted windows. An irregular body's contacts act after its release horizon,
+/// where the unknown orientation decides the path: these need the release known, or a sphere.
+/// A body whose replays agree for every release but whose recorded trials part from each other
+/// (a sphere with its mass off its centre: lab-like case-10) is limited by that parting: the
+/// recorded body's path hangs on something its model lacks, and neither a sphere nor the
+/// release alone is the answer. A body fitted to the end of every track (a sphere) has no such
+/// part: there these set-ups do not make the effect show (a sphere rolls down a tilt without
+/// sliding, so static and kinetic friction never part), and another set-up is what decides it.
+/// Until the commit after 1e4fec7 a sphere was told to repeat its tests with a sphere (five of
+/// the independent simulator's sphere cases).
+void say_undecided(const Context& c, DiagnoseResult& result, const std::vector<std::string>& untestable,
+                   const std::vector<std::string>& why) {
+  std::set<std::string> parted;
+  for (const auto& p : result.parted) parted.insert(p.recording);
+  const auto cut = [&](const TrackedTrial& t) { return t.horizon < t.duration; };
+  const auto cut_by_release = [&](const TrackedTrial& t) { return cut(t) && !parted.contains(c.names[t.recording]); };
+  const std::string each_to_show =
+      fmt::format("{}", fmt::join(untestable | std::views::transform([](const std::string& name) {
+                                    return fmt::format("to show {}: {}", name, experiment_to_show(name));
+                                  }),
+                                  "; "));
+  if (std::ranges::any_of(c.ev.trials, cut_by_release)) {
+    result.undecided_because = UndecidedBecause::UnknownRelease;
+    result.statement += fmt::format(
+        " Not decided by the predictable parts of these tracks, and no limit claimed: {}; they act where the unknown "
+        "release orientation decides the path.",
+        fmt::join(why, "; "));
+    result.experiment =
+        "record each trial's release orientation to a few degrees (a marked particle, a release jig), or repeat the "
+        "tests with a sphere of the same material, whose path does not depend on it";
+    return;
+  }
+  if (std::ranges::any_of(c.ev.trials, cut)) {
+    result.undecided_because = UndecidedBecause::PartedTrials;
+    result.statement += fmt::format(
+        " Not decided by the parts of these tracks fitted frame by frame, and no limit claimed: {}; they act after the "
+        "recorded trials part from each other ({}), where replays of this particle from every release orientation "
+        "agree: the recorded particle's path hangs on something its model lacks (its mass off its visible centre, a "
+        "spin the release gives it), and no single replay stands for a trial beyond that.",
+        fmt::join(why, "; "),
+        fmt::join(result.parted | std::views::transform([](const PartedRecording& p) {
+                    return fmt::format("{} at {:.3f} s", p.recording, p.seconds);
+                  }),
+                  ", "));
+    result.experiment = fmt::format(
+        "find what parts the recorded trials (track a marked axis on the particle, or weigh its mass distribution "
+        "against its visible centre); {}",
+        each_to_show);
+    return;
+  }
+  result.undecided_because = UndecidedBecause::SetUps;
+  result.statement += fmt::format(
+      " Not decided by these tracks, though each was fitted to its end, and no limit claimed: {}; these set-ups do not "
+      "make them show.",
+      fmt::join(why, "; "));
+  result.experiment = each_to_show;
+}
+
+}  // namespace
+
 /// None frame by frame: what is left (phases slightly beyond the noise with no shape the trials
 /// share, outlier trials: said, not hidden), the smallest effects the recordings would have
 /// shown, and the candidates their predictable parts cannot decide.
@@ -153,32 +217,7 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
         options.min_delta_bic, fmt::join(limits, "; "));
   if (untestable.empty()) return {};
   result.undecidable = untestable;
-  // What the frame-by-frame fit cannot reach. An irregular body's contacts act after its release
-  // horizon, where the unknown orientation decides the path: these need the release known, or a
-  // sphere. A body fitted to the end of every track (a sphere) has no such part: there these
-  // set-ups do not make the effect show (a sphere rolls down a tilt without sliding, so static
-  // and kinetic friction never part), and another set-up is what decides it. Until the commit
-  // after 1e4fec7 a sphere was told to repeat its tests with a sphere (five of the independent
-  // simulator's sphere cases).
-  if (std::ranges::any_of(c.ev.trials, [](const TrackedTrial& t) { return t.horizon < t.duration; })) {
-    result.statement += fmt::format(
-        " Not decided by the predictable parts of these tracks, and no limit claimed: {}; they act where the unknown "
-        "release orientation decides the path.",
-        fmt::join(why, "; "));
-    result.experiment =
-        "record each trial's release orientation to a few degrees (a marked particle, a release jig), or repeat the "
-        "tests with a sphere of the same material, whose path does not depend on it";
-    return {};
-  }
-  result.statement += fmt::format(
-      " Not decided by these tracks, though each was fitted to its end, and no limit claimed: {}; these set-ups do not "
-      "make them show.",
-      fmt::join(why, "; "));
-  result.experiment =
-      fmt::format("{}", fmt::join(untestable | std::views::transform([](const std::string& name) {
-                                    return fmt::format("to show {}: {}", name, experiment_to_show(name));
-                                  }),
-                                  "; "));
+  say_undecided(c, result, untestable, why);
   return {};
 }
 
@@ -232,6 +271,20 @@ std::string_view stage_name(Stage stage) {
       return "ensemble";
   }
   return "unknown";
+}
+
+std::string_view undecided_because_name(UndecidedBecause because) {
+  switch (because) {
+    case UndecidedBecause::Nothing:
+      return "nothing";
+    case UndecidedBecause::UnknownRelease:
+      return "unknown_release";
+    case UndecidedBecause::PartedTrials:
+      return "parted_trials";
+    case UndecidedBecause::SetUps:
+      return "set_ups";
+  }
+  return "?";
 }
 
 std::string_view basis_name(Basis basis) {

@@ -241,12 +241,40 @@ TEST(DiagnoseCli, ASphereIsNotToldToRepeatItsTestsWithASphere) {
   const auto j = nlohmann::json::parse(run.out);
   EXPECT_EQ(j["verdict"], "none") << j["statement"];
   ASSERT_EQ(j["undecidable"], nlohmann::json::array({"static_kinetic_friction"})) << j["statement"];
+  EXPECT_EQ(j["undecided_because"], "set_ups") << j["statement"];
   const auto statement = j["statement"].get<std::string>(), experiment = j["experiment"].get<std::string>();
   EXPECT_NE(statement.find("these set-ups do not make them show"), std::string::npos) << statement;
   EXPECT_EQ(statement.find("release orientation"), std::string::npos) << statement;
   EXPECT_NE(experiment.find("to show static_kinetic_friction: a sliding test"), std::string::npos) << experiment;
   EXPECT_EQ(experiment.find("release orientation"), std::string::npos) << experiment;
   EXPECT_EQ(experiment.find("sphere of the same material"), std::string::npos) << experiment;
+}
+
+TEST(DiagnoseCli, ASphereWhoseTrialsPartIsNotBlamedOnItsUnknownRelease) {
+  // Case-10 of ../shared/data/lab-like: the independent simulator's sphere with its centre of
+  // mass off its centre. Replays of the one-sphere clump agree for every release orientation, yet
+  // its recorded drops from 0.2 m part from each other after 0.21 s (the offset turns each
+  // bounce its own way), so the fitted windows end there. With the static-kinetic friction drop
+  // as the only candidate it is left undecided frame by frame; the reason given must be the
+  // parting, not the unknown release (which a sphere's replays do not depend on), and it must
+  // not be asked to repeat its tests with a sphere: it is one. (Until the commit after fea3190 it was told
+  // "they act where the unknown release orientation decides the path".) The ensemble stage then
+  // calls the outcomes unexplained: the offset, the drift's cause, is not a candidate here.
+  const auto set = test::shared_dir() / "data" / "lab-like";
+  const auto run = test::run_clumpforge(
+      fmt::format("diagnose --recordings '{}' '{}' --mesh '{}' --density 1085 --effects static_kinetic_friction --json",
+                  (set / "case-10" / "drop-Q235-0.2").string(), (set / "case-10" / "tilt-Q235").string(),
+                  (set / "meshes" / "sphere.stl").string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["undecided_because"], "parted_trials") << j["statement"];
+  ASSERT_FALSE(j["parted"].empty());
+  EXPECT_EQ(j["parted"][0]["recording"], "drop-Q235-0.2");
+  EXPECT_EQ(j["undecidable"], nlohmann::json::array({"static_kinetic_friction"})) << j["statement"];
+  for (const auto& note : j["notes"]) {
+    const auto text = note.get<std::string>();
+    EXPECT_EQ(text.find("release orientation decides the path"), std::string::npos) << text;
+  }
 }
 
 TEST(DiagnoseCli, AnotherSimulatorsSpeedDependentRestitutionIsFoundByCalibratingItsLevel) {
