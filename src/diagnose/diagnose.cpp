@@ -155,6 +155,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
       return std::unexpected(ok.error());
   }
   ask_for_deciding_experiments(result);
+  say_which_were_asked(result, options);
   track_plots(c, result, *full_base, *full_improved);
   took(Stage::Ensemble);
   result.evaluations = c.evaluations;

@@ -344,6 +344,11 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
                       const Groups& final_groups, const DiagnoseOptions& options);
 
 void ask_for_deciding_experiments(DiagnoseResult& result);
+/// When DiagnoseOptions::effects asks about only part of the library, the statement says which
+/// were asked: a verdict among them is not one over the library (lab-like case-10's 35 mm roll,
+/// a sphere with its mass off its centre, asked about the static-kinetic friction drop alone,
+/// names it: the offset it carries was not asked about).
+void say_which_were_asked(DiagnoseResult& result, const DiagnoseOptions& options);
 
 /// The second null: the coefficients refitted on every trial, the held-out ones included,
 /// computed once, when first needed. When the training trials pin a coefficient poorly (a

@@ -235,6 +235,16 @@ void ask_for_deciding_experiments(DiagnoseResult& result) {
   }
 }
 
+void say_which_were_asked(DiagnoseResult& result, const DiagnoseOptions& options) {
+  const std::size_t library = effect_library().size();
+  if (options.effects.empty() || options.effects.size() >= library) return;
+  result.statement += fmt::format(
+      " Only {} of the library's {} candidate effects {} asked about ({}; --effects): one outside them may explain "
+      "the same tracks.",
+      options.effects.size(), library, options.effects.size() == 1 ? "was" : "were",
+      fmt::join(options.effects | std::views::transform([](Effect e) { return effect_name(e); }), ", "));
+}
+
 }  // namespace clumpforge::diagnosis
 
 namespace clumpforge {

@@ -248,6 +248,10 @@ TEST(DiagnoseCli, ASphereIsNotToldToRepeatItsTestsWithASphere) {
   EXPECT_NE(experiment.find("to show static_kinetic_friction: a sliding test"), std::string::npos) << experiment;
   EXPECT_EQ(experiment.find("release orientation"), std::string::npos) << experiment;
   EXPECT_EQ(experiment.find("sphere of the same material"), std::string::npos) << experiment;
+  // Asked about one candidate only: the statement says so (a verdict among the asked is not one
+  // over the library).
+  EXPECT_NE(statement.find("Only 1 of the library's 9 candidate effects was asked about"), std::string::npos)
+      << statement;
 }
 
 TEST(DiagnoseCli, ASphereWhoseTrialsPartIsNotBlamedOnItsUnknownRelease) {
