@@ -29,6 +29,18 @@ const char* kManifest = R"({
   "camera": { "frame_rate_hz": 1000 },
   "trials": [ { "id": "01", "track": "trial-01.csv" } ]
 })";
+
+/// report.json of a lab-like sphere case's two recordings diagnosed from the sphere's mesh (one
+/// sphere) with the static-kinetic friction drop as the only candidate.
+nlohmann::json lab_like_sphere_with_static_kinetic_only(const std::string& name, const std::string& first,
+                                                        const std::string& second) {
+  const auto set = test::shared_dir() / "data" / "lab-like";
+  const auto run = test::run_clumpforge(fmt::format(
+      "diagnose --recordings '{}' '{}' --mesh '{}' --density 1085 --effects static_kinetic_friction --json",
+      (set / name / first).string(), (set / name / second).string(), (set / "meshes" / "sphere.stl").string()));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return run.exit_code == 0 ? nlohmann::json::parse(run.out) : nlohmann::json::object();
+}
 }  // namespace
 
 TEST(DiagnoseCli, BadInputIsAClearError) {
@@ -232,13 +244,8 @@ TEST(DiagnoseCli, ASphereIsNotToldToRepeatItsTestsWithASphere) {
   // unknown release is not why: the statement says these set-ups do not make it show, and the
   // experiment asks for a sliding test, not for the release orientation or "a sphere of the same
   // material" (what five of the set's sphere cases were told before the commit after 1e4fec7).
-  const auto set = test::shared_dir() / "data" / "lab-like";
-  const auto run = test::run_clumpforge(
-      fmt::format("diagnose --recordings '{}' '{}' --mesh '{}' --density 1085 --effects static_kinetic_friction --json",
-                  (set / "case-02" / "roll-Q235-35mm").string(), (set / "case-02" / "tilt-Q235").string(),
-                  (set / "meshes" / "sphere.stl").string()));
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto j = nlohmann::json::parse(run.out);
+  const auto j = lab_like_sphere_with_static_kinetic_only("case-02", "roll-Q235-35mm", "tilt-Q235");
+  ASSERT_TRUE(j.contains("verdict"));
   EXPECT_EQ(j["verdict"], "none") << j["statement"];
   ASSERT_EQ(j["undecidable"], nlohmann::json::array({"static_kinetic_friction"})) << j["statement"];
   EXPECT_EQ(j["undecided_because"], "set_ups") << j["statement"];
@@ -264,13 +271,8 @@ TEST(DiagnoseCli, ASphereWhoseTrialsPartIsNotBlamedOnItsUnknownRelease) {
   // not be asked to repeat its tests with a sphere: it is one. (Until the commit after fea3190 it was told
   // "they act where the unknown release orientation decides the path".) The ensemble stage then
   // calls the outcomes unexplained: the offset, the drift's cause, is not a candidate here.
-  const auto set = test::shared_dir() / "data" / "lab-like";
-  const auto run = test::run_clumpforge(
-      fmt::format("diagnose --recordings '{}' '{}' --mesh '{}' --density 1085 --effects static_kinetic_friction --json",
-                  (set / "case-10" / "drop-Q235-0.2").string(), (set / "case-10" / "tilt-Q235").string(),
-                  (set / "meshes" / "sphere.stl").string()));
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const auto j = nlohmann::json::parse(run.out);
+  const auto j = lab_like_sphere_with_static_kinetic_only("case-10", "drop-Q235-0.2", "tilt-Q235");
+  ASSERT_TRUE(j.contains("verdict"));
   EXPECT_EQ(j["undecided_because"], "parted_trials") << j["statement"];
   ASSERT_FALSE(j["parted"].empty());
   EXPECT_EQ(j["parted"][0]["recording"], "drop-Q235-0.2");
