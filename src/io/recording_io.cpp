@@ -144,6 +144,8 @@ Result<Track> read_track(const fs::path& path) {
   std::string line;
   if (!std::getline(in, line)) return fail(ErrorCode::ParseError, fmt::format("{}:1: empty track file", path.string()));
   if (!line.empty() && line.back() == '\r') line.pop_back();
+  // A spreadsheet's "CSV UTF-8" export opens with a byte-order mark; the header is the same.
+  if (line.starts_with("\xEF\xBB\xBF")) line.erase(0, 3);
   std::vector<std::string> columns;
   {
     std::stringstream header(line);

@@ -61,6 +61,21 @@ TEST(Recording, RoundTripKeepsTracksAndExtraKeys) {
   EXPECT_NE(manifest.find("\"orientation\""), std::string::npos);
 }
 
+TEST(Recording, ASpreadsheetsByteOrderMarkAndLineEndsAreRead) {
+  // "CSV UTF-8" from a spreadsheet opens with a byte-order mark and ends lines with CRLF; the
+  // header is still t_s, x_m, z_m (before the commit after a46805e: "unknown column 't_s'").
+  test::ScratchDir dir("rec");
+  test::write_text(dir / "recording.json", R"({"format": "recording/1", "test": "drop", "surface": "Q235",
+  "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})");
+  test::write_text(dir / "t.csv", "\xEF\xBB\xBFt_s,x_m,z_m\r\n0.000,0.001,0.2\r\n0.001,0.001,0.19999\r\n");
+  const auto r = read_recording(dir.path());
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_TRUE(r->trials[0].track);
+  EXPECT_EQ(r->trials[0].track->size(), 2u);
+  EXPECT_EQ(r->trials[0].track->x[0], 0.001);
+  EXPECT_EQ(r->trials[0].track->z[1], 0.19999);
+}
+
 TEST(Recording, BadInputNamesFileAndLine) {
   test::ScratchDir dir("rec");
   struct Case {
