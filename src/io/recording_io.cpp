@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "core/atomic_file.hpp"
@@ -136,6 +137,35 @@ std::optional<Eigen::Quaterniond> parse_orientation(const json& value) {
   const Eigen::Quaterniond out(q[0], q[1], q[2], q[3]);
   if (std::abs(out.norm() - 1.0) > 0.01) return std::nullopt;
   return out.normalized();
+}
+
+/// What is wrong with a drop's track that does not fall, or nothing. The particle is released
+/// from rest with its lowest point `height` above the plate, so its tracked point falls about
+/// `height` (the spec's z_m is up positive): a track that falls less than a quarter of it is
+/// not this drop's (a still frame, the wrong file, z down or in other units). Judged only on
+/// tracks of 10 or more heights (shorter ones are the diagnosis's to refuse as unusable).
+std::optional<std::string> drop_that_does_not_fall(const Track& track, double height) {
+  std::vector<double> z;
+  for (double v : track.z) {
+    if (std::isfinite(v)) z.push_back(v);
+  }
+  if (z.size() < 10) return std::nullopt;
+  std::vector<double> first(z.begin(), z.begin() + 5);
+  std::ranges::nth_element(first, first.begin() + 2);
+  const double start = first[2];
+  const auto [low, high] = std::ranges::minmax(z);
+  const double fall = start - low, rise = high - start;
+  if (fall >= 0.25 * height) return std::nullopt;
+  if (rise >= 0.25 * height) {
+    return fmt::format(
+        "its tracked point rises {:.1f} mm and falls only {:.1f} mm, where a drop from {:g} m falls about that far: "
+        "z_m must be the height, up positive",
+        rise * 1e3, fall * 1e3, height);
+  }
+  return fmt::format(
+      "its tracked point falls only {:.1f} mm, where a drop from {:g} m falls about that far: not this drop's track "
+      "(a still frame, the wrong file, or other units)",
+      fall * 1e3, height);
 }
 
 Result<Track> read_track(const fs::path& path) {
@@ -304,6 +334,10 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
       if (!path) reader.error("track", fmt::format("trial '{}': {}", trial.id, path.error().message), search_from);
       auto track = read_track(*path);
       if (!track) throw ManifestError{track.error().message};
+      if (r.test == LabTest::Drop) {
+        if (auto wrong = drop_that_does_not_fall(*track, r.release_height))
+          throw ManifestError{fmt::format("{}: {}", path->string(), *wrong)};
+      }
       trial.track = std::move(*track);
     }
     if (entry.contains("orientation_wxyz")) {

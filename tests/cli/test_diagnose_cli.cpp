@@ -30,6 +30,13 @@ const char* kManifest = R"({
   "trials": [ { "id": "01", "track": "trial-01.csv" } ]
 })";
 
+/// A drop's track whose tracked point never falls (a still frame).
+std::string still_track() {
+  std::string out = "t_s,x_m,z_m\n";
+  for (int i = 0; i < 50; ++i) out += fmt::format("{:.3f},0.001,0.21\n", 0.001 * i);
+  return out;
+}
+
 /// report.json of a lab-like sphere case's two recordings diagnosed from the sphere's mesh (one
 /// sphere) with the static-kinetic friction drop as the only candidate.
 nlohmann::json lab_like_sphere_with_static_kinetic_only(const std::string& name, const std::string& first,
@@ -113,6 +120,7 @@ TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
       {manifest("1e9", "trial-01.csv"), "t_s,x_m,z_m\n0,0,0.2\n", "must lie in (0, 100] m"},
       {manifest("0.2", "trial-01.csv"), "t_s,x_m,z_m\n0,0,0.2\n0.001,1e308,0.2\n", "beyond the limit of +-100 m"},
       {"{\"format\": \"recording/1\", \"test\": [", "", "not valid JSON"},
+      {manifest("0.2", "trial-01.csv"), still_track(), "falls only 0.0 mm"},
   };
   for (const auto& [m, track, expected] : cases) {
     SCOPED_TRACE(expected);

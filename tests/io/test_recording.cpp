@@ -246,6 +246,25 @@ TEST(RecordingLimits, MalformedJsonAnywhereIsAParseError) {
   }
 }
 
+TEST(RecordingLimits, ADropWhoseTrackDoesNotFallIsRefused) {
+  // A drop from 0.2 m falls about 0.2 m (z_m up positive): a track that does not fall is not
+  // this drop's (a still frame, the wrong file); one that rises has z pointing down. Before the
+  // commit after 52d4741 both ran to an `unexplained` verdict on the flight phases.
+  test::ScratchDir dir("rec");
+  std::string still = "t_s,x_m,z_m\n", rising = still, falling = still;
+  for (int i = 0; i < 200; ++i) {
+    const double t = 0.001 * i, fall = std::min(0.2, 0.5 * 9.81 * t * t);
+    still += fmt::format("{:.3f},0.001,0.21\n", t);
+    rising += fmt::format("{:.3f},0.001,{:.5f}\n", t, -0.21 + fall);
+    falling += fmt::format("{:.3f},0.001,{:.5f}\n", t, 0.21 - fall);
+  }
+  EXPECT_NE(refusal(dir / "a", with_track("t.csv"), still).find("t.csv: its tracked point falls only 0.0 mm"),
+            std::string::npos);
+  EXPECT_NE(refusal(dir / "b", with_track("t.csv"), rising).find("z_m must be the height, up positive"),
+            std::string::npos);
+  EXPECT_EQ(refusal(dir / "c", with_track("t.csv"), falling), "(accepted)");
+}
+
 TEST(RecordingLimits, RecordedOrientationIsATypedPrior) {
   test::ScratchDir dir("rec-limits");
   fs::create_directories(dir / "r");
