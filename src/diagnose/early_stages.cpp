@@ -450,8 +450,8 @@ std::optional<std::pair<Basis, std::string>> undecidable_tracks(const Context& c
   }
   if (c.ev.trials.size() < 2 || c.training.empty() || c.heldout.empty()) {
     return std::pair{Basis::TooFewTrials, fmt::format("only {} usable tracked trial(s): at least two (one to fit, "
-                                                      "one held out), each with 30 or more frames, are "
-                                                      "needed to decide anything",
+                                                      "one held out), each with 30 or more frames where both "
+                                                      "x_m and z_m were tracked, are needed to decide anything",
                                                       c.ev.trials.size())};
   }
   if (worst_sigma > 1e-3) {
