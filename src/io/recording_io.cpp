@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <optional>
 #include <sstream>
 
@@ -139,6 +140,12 @@ std::optional<Eigen::Quaterniond> parse_orientation(const json& value) {
   return out.normalized();
 }
 
+/// The median of five values (taken by copy).
+double median_of_five(std::vector<double> v) {
+  std::ranges::nth_element(v, v.begin() + 2);
+  return v[2];
+}
+
 /// What is wrong with a drop's track that does not fall, or nothing. The particle is released
 /// from rest with its lowest point `height` above the plate, so its tracked point falls about
 /// `height` (the spec's z_m is up positive): a track that falls less than a quarter of it is
@@ -150,9 +157,7 @@ std::optional<std::string> drop_that_does_not_fall(const Track& track, double he
     if (std::isfinite(v)) z.push_back(v);
   }
   if (z.size() < 10) return std::nullopt;
-  std::vector<double> first(z.begin(), z.begin() + 5);
-  std::ranges::nth_element(first, first.begin() + 2);
-  const double start = first[2];
+  const double start = median_of_five({z.begin(), z.begin() + 5});
   const auto [low, high] = std::ranges::minmax(z);
   const double fall = start - low, rise = high - start;
   if (fall >= 0.25 * height) return std::nullopt;
@@ -166,6 +171,27 @@ std::optional<std::string> drop_that_does_not_fall(const Track& track, double he
       "its tracked point falls only {:.1f} mm, where a drop from {:g} m falls about that far: not this drop's track "
       "(a still frame, the wrong file, or other units)",
       fall * 1e3, height);
+}
+
+/// What is wrong with a roll's track that ends uphill of its start, or nothing. x_m is
+/// positive in the direction of travel (the spec), and a particle released from rest on the
+/// incline cannot come to rest above where it started: a track whose tracked point ends more
+/// than a quarter of the incline's horizontal run (at least 5 mm) on the negative side ran the
+/// other way (x pointing uphill). A particle that stays where it was set is a result, not an
+/// error. Judged on tracks of 10 or more positions.
+std::optional<std::string> roll_that_runs_uphill(const Track& track, double start_distance, double incline_deg) {
+  std::vector<double> x;
+  for (double v : track.x) {
+    if (std::isfinite(v)) x.push_back(v);
+  }
+  if (x.size() < 10) return std::nullopt;
+  const double run = start_distance * std::cos(incline_deg * std::numbers::pi / 180.0);
+  const double moved = median_of_five({x.end() - 5, x.end()}) - median_of_five({x.begin(), x.begin() + 5});
+  if (moved >= -std::max(0.25 * run, 5e-3)) return std::nullopt;
+  return fmt::format(
+      "its tracked point ends {:.1f} mm on the negative side of where it started, where a roll runs down the slope: "
+      "x_m must be positive in the direction of travel",
+      -moved * 1e3);
 }
 
 Result<Track> read_track(const fs::path& path) {
@@ -334,10 +360,10 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
       if (!path) reader.error("track", fmt::format("trial '{}': {}", trial.id, path.error().message), search_from);
       auto track = read_track(*path);
       if (!track) throw ManifestError{track.error().message};
-      if (r.test == LabTest::Drop) {
-        if (auto wrong = drop_that_does_not_fall(*track, r.release_height))
-          throw ManifestError{fmt::format("{}: {}", path->string(), *wrong)};
-      }
+      const auto wrong = r.test == LabTest::Drop   ? drop_that_does_not_fall(*track, r.release_height)
+                         : r.test == LabTest::Roll ? roll_that_runs_uphill(*track, r.start_distance, r.incline_deg)
+                                                   : std::nullopt;
+      if (wrong) throw ManifestError{fmt::format("{}: {}", path->string(), *wrong)};
       trial.track = std::move(*track);
     }
     if (entry.contains("orientation_wxyz")) {

@@ -265,6 +265,25 @@ TEST(RecordingLimits, ADropWhoseTrackDoesNotFallIsRefused) {
   EXPECT_EQ(refusal(dir / "c", with_track("t.csv"), falling), "(accepted)");
 }
 
+TEST(RecordingLimits, ARollWhoseTrackEndsUphillIsRefused) {
+  // x_m is positive in the direction of travel: a roll whose tracked point ends well on the
+  // negative side of its start ran with x pointing uphill (before the commit after 0777f64 it
+  // ran to `unexplained`, "recorded roll distance -100 mm"). One that stays put is a result.
+  test::ScratchDir dir("rec");
+  const std::string roll = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+    "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  std::string down = "t_s,x_m,z_m\n", up = down, still = down;
+  for (int i = 0; i < 100; ++i) {
+    const double t = 0.004 * i, s = std::min(0.12, 1.5 * t * t);
+    down += fmt::format("{:.3f},{:.5f},0.009\n", t, -0.03 + s);
+    up += fmt::format("{:.3f},{:.5f},0.009\n", t, 0.03 - s);
+    still += fmt::format("{:.3f},-0.03,0.02\n", t);
+  }
+  EXPECT_NE(refusal(dir / "a", roll, up).find("x_m must be positive in the direction of travel"), std::string::npos);
+  EXPECT_EQ(refusal(dir / "b", roll, down), "(accepted)");
+  EXPECT_EQ(refusal(dir / "c", roll, still), "(accepted)");
+}
+
 TEST(RecordingLimits, RecordedOrientationIsATypedPrior) {
   test::ScratchDir dir("rec-limits");
   fs::create_directories(dir / "r");
