@@ -160,9 +160,7 @@ nlohmann::json particle_model_json(const DiagnoseResult& r) {
 }
 
 /// report.json's flights: the free flights' wobble and the centre-of-mass offset they show.
-nlohmann::json flights_json(const DiagnoseResult& r) {
-  if (!r.flights) return nlohmann::json();
-  const auto& f = *r.flights;
+nlohmann::json flights_json(const FlightWobble& f) {
   // Too few flights to judge: only their number and the allowance; the measures are null.
   const auto measured = [&f](double metres) { return f.judged ? nlohmann::json(metres * 1e3) : nlohmann::json(); };
   return {{"flights", f.flights.size()},
@@ -320,7 +318,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["improved"] = coefficients_json(r.improved);
   j["uncalibrated"] = r.uncalibrated;
   j["particle_model"] = particle_model_json(r);
-  j["flights"] = flights_json(r);
+  j["flights"] = r.flights ? flights_json(*r.flights) : nlohmann::json();
   if (r.ensemble) j["ensemble"] = ensemble_json(*r.ensemble);
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
   j["phases"] = phases_json(r.phases);

@@ -14,6 +14,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/text.hpp"
+#include "numerics/statistics.hpp"
 
 namespace clumpforge {
 namespace fs = std::filesystem;
@@ -140,10 +141,13 @@ std::optional<Eigen::Quaterniond> parse_orientation(const json& value) {
   return out.normalized();
 }
 
-/// The median of five values (taken by copy).
-double median_of_five(std::vector<double> v) {
-  std::ranges::nth_element(v, v.begin() + 2);
-  return v[2];
+/// A track column's tracked values (lost cells left out).
+std::vector<double> tracked(const std::vector<double>& column) {
+  std::vector<double> out;
+  for (double v : column) {
+    if (std::isfinite(v)) out.push_back(v);
+  }
+  return out;
 }
 
 /// What is wrong with a drop's track that does not fall, or nothing. The particle is released
@@ -152,12 +156,9 @@ double median_of_five(std::vector<double> v) {
 /// not this drop's (a still frame, the wrong file, z down or in other units). Judged only on
 /// tracks of 10 or more heights (shorter ones are the diagnosis's to refuse as unusable).
 std::optional<std::string> drop_that_does_not_fall(const Track& track, double height) {
-  std::vector<double> z;
-  for (double v : track.z) {
-    if (std::isfinite(v)) z.push_back(v);
-  }
+  const std::vector<double> z = tracked(track.z);
   if (z.size() < 10) return std::nullopt;
-  const double start = median_of_five({z.begin(), z.begin() + 5});
+  const double start = median({z.begin(), z.begin() + 5});
   const auto [low, high] = std::ranges::minmax(z);
   const double fall = start - low, rise = high - start;
   if (fall >= 0.25 * height) return std::nullopt;
@@ -180,13 +181,10 @@ std::optional<std::string> drop_that_does_not_fall(const Track& track, double he
 /// other way (x pointing uphill). A particle that stays where it was set is a result, not an
 /// error. Judged on tracks of 10 or more positions.
 std::optional<std::string> roll_that_runs_uphill(const Track& track, double start_distance, double incline_deg) {
-  std::vector<double> x;
-  for (double v : track.x) {
-    if (std::isfinite(v)) x.push_back(v);
-  }
+  const std::vector<double> x = tracked(track.x);
   if (x.size() < 10) return std::nullopt;
   const double run = start_distance * std::cos(incline_deg * std::numbers::pi / 180.0);
-  const double moved = median_of_five({x.end() - 5, x.end()}) - median_of_five({x.begin(), x.begin() + 5});
+  const double moved = median({x.end() - 5, x.end()}) - median({x.begin(), x.begin() + 5});
   if (moved >= -std::max(0.25 * run, 5e-3)) return std::nullopt;
   return fmt::format(
       "its tracked point ends {:.1f} mm on the negative side of where it started, where a roll runs down the slope: "

@@ -37,6 +37,13 @@ std::string still_track() {
   return out;
 }
 
+/// A roll's track whose tracked point runs 100 mm towards negative x (x pointing uphill).
+std::string uphill_roll() {
+  std::string out = "t_s,x_m,z_m\n";
+  for (int i = 0; i < 50; ++i) out += fmt::format("{:.3f},{:.4f},0.009\n", 0.004 * i, -0.002 * i);
+  return out;
+}
+
 /// report.json of a lab-like sphere case's two recordings diagnosed from the sphere's mesh (one
 /// sphere) with the static-kinetic friction drop as the only candidate.
 nlohmann::json lab_like_sphere_with_static_kinetic_only(const std::string& name, const std::string& first,
@@ -121,6 +128,9 @@ TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
       {manifest("0.2", "trial-01.csv"), "t_s,x_m,z_m\n0,0,0.2\n0.001,1e308,0.2\n", "beyond the limit of +-100 m"},
       {"{\"format\": \"recording/1\", \"test\": [", "", "not valid JSON"},
       {manifest("0.2", "trial-01.csv"), still_track(), "falls only 0.0 mm"},
+      {R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+          "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "trials": [{"id": "01", "track": "trial-01.csv"}]})",
+       uphill_roll(), "x_m must be positive in the direction of travel"},
   };
   for (const auto& [m, track, expected] : cases) {
     SCOPED_TRACE(expected);
