@@ -119,7 +119,8 @@ void bind_parts(py::module_& m) {
       .def_readonly("chi2_per_value", &PhaseOf::chi2_per_value)
       .def_readonly("where", &PhaseOf::where);
   py::enum_<Outcome> outcome(m, "Outcome");
-  for (Outcome o : {Outcome::ReboundHeight, Outcome::Drift, Outcome::RollDistance, Outcome::RollTime})
+  for (Outcome o : {Outcome::ReboundHeight, Outcome::Drift, Outcome::RollDistance, Outcome::RollTime,
+                    Outcome::SlipAngle, Outcome::SlideTime})
     outcome.value(std::string(outcome_name(o)).c_str(), o);
   py::class_<OutcomeShift>(m, "OutcomeShift",
                            "How a finer clump's replayed outcomes moved from the previous clump's at the same "

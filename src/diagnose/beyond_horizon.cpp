@@ -22,13 +22,14 @@ namespace clumpforge::diagnosis {
 
 namespace {
 
-/// An outcome as the statements show it: lengths in mm, a roll's time in s.
+/// An outcome as the statements show it: lengths in mm, times in s, a plate's angle in degrees.
 struct Shown {
   double scale = 1e3;
   std::string_view unit = "mm";
 };
 Shown shown(Outcome outcome) {
-  return outcome == Outcome::RollTime ? Shown{1.0, "s"} : Shown{};
+  if (outcome == Outcome::RollTime || outcome == Outcome::SlideTime) return Shown{1.0, "s"};
+  return outcome == Outcome::SlipAngle ? Shown{1.0, "deg"} : Shown{};
 }
 
 /// A verdict reached beyond the release horizon replaces the frame-by-frame one, whose

@@ -26,6 +26,10 @@ std::string_view outcome_name(Outcome outcome) {
       return "roll_distance";
     case Outcome::RollTime:
       return "roll_time";
+    case Outcome::SlipAngle:
+      return "slip_angle";
+    case Outcome::SlideTime:
+      return "slide_time";
   }
   return "?";
 }
@@ -60,20 +64,70 @@ std::string_view trials_advice_name(TrialsAdvice advice) {
 
 namespace {
 
-std::vector<Outcome> outcomes_of(LabTest test) {
-  if (test == LabTest::Drop) return {Outcome::ReboundHeight, Outcome::Drift};
-  if (test == LabTest::Roll) return {Outcome::RollDistance, Outcome::RollTime};
+/// The outcomes compared of a recording. A tilt's only for four particles glued in a square:
+/// a single irregular particle on a tilting plate rocks or rolls at an angle its underside's
+/// shape sets, and a clump's bumpy underside does not reproduce it (lab-like case-01, a tuber
+/// control: its 32-sphere clump's replays moved 1 mm at 12.1 +- 4.4 degrees, the recorded body
+/// at 24.8 +- 1.0, and then crept 3 mm more in 5 s where it slid in 0.09 s). Four glued
+/// particles cannot roll: their slip angle and slide are friction's.
+std::vector<Outcome> outcomes_of(const Recording& rec) {
+  if (rec.test == LabTest::Drop) return {Outcome::ReboundHeight, Outcome::Drift};
+  if (rec.test == LabTest::Roll) return {Outcome::RollDistance, Outcome::RollTime};
+  if (rec.composite == Composite::FourSquare) return {Outcome::SlipAngle, Outcome::SlideTime};
   return {};
+}
+
+/// The first time a sequence of (time, value) pairs reaches `level`, interpolated between the
+/// frames on either side; NaN when it never does.
+double first_reaching(const std::vector<std::pair<double, double>>& series, double level, std::size_t from = 0) {
+  for (std::size_t k = std::max<std::size_t>(from, 1); k < series.size(); ++k) {
+    const auto [t1, v1] = series[k];
+    if (v1 < level) continue;
+    const auto [t0, v0] = series[k - 1];
+    if (v0 >= level) return t1;
+    return t0 + (t1 - t0) * (level - v0) / (v1 - v0);
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+/// A tilt's outcomes. The tracked point's coordinate along the plate (about the axis through
+/// x = z = 0; an axis a few millimetres away moves it by well under a millimetre over 30
+/// degrees), less its median over the first ten frames, smoothed by a running median of five
+/// frames against the camera's noise. Sliding starts where it first reaches `onset` (the
+/// spec's slip angle counts 1 mm), and the slide time is the time from there to 3 mm more: a
+/// kinetic friction below the static one shortens it, the plate's further turning hardly.
+std::vector<std::pair<Outcome, double>> tilt_outcomes(const PathSample& path, const std::vector<std::size_t>& valid,
+                                                      double moved, double rate_deg_per_s) {
+  const double rate = rate_deg_per_s * std::numbers::pi / 180.0;
+  std::vector<double> along;
+  for (std::size_t i : valid) {
+    const double angle = rate * path.t[i];
+    along.push_back(path.x[i] * std::cos(angle) - path.z[i] * std::sin(angle));
+  }
+  const double rest = median(std::vector<double>(along.begin(), along.begin() + 10));
+  std::vector<std::pair<double, double>> series;
+  for (std::size_t k = 0; k < along.size(); ++k) {
+    const std::size_t a = k >= 2 ? k - 2 : 0, b = std::min(along.size(), k + 3);
+    series.emplace_back(path.t[valid[k]], median(std::vector<double>(along.begin() + static_cast<std::ptrdiff_t>(a),
+                                                                     along.begin() + static_cast<std::ptrdiff_t>(b))) -
+                                              rest);
+  }
+  const double onset = std::max(1e-3, 0.5 * moved);
+  const double started = first_reaching(series, onset);
+  const double slid = first_reaching(series, onset + 3e-3);
+  return {{Outcome::SlipAngle, started * rate_deg_per_s}, {Outcome::SlideTime, slid - started}};
 }
 
 }  // namespace
 
-std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved) {
+std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved,
+                                                         double tilt_rate_deg_per_s) {
   std::vector<std::size_t> valid;
   for (std::size_t i = 0; i < path.t.size(); ++i) {
     if (path.t[i] >= 0.0 && std::isfinite(path.x[i]) && std::isfinite(path.z[i])) valid.push_back(i);
   }
-  if (valid.size() < 10 || (test != LabTest::Drop && test != LabTest::Roll)) return {};
+  if (valid.size() < 10) return {};
+  if (test == LabTest::Tilt) return tilt_outcomes(path, valid, moved, tilt_rate_deg_per_s);
   // Where it came to rest: the median of its last ten frames.
   std::vector<double> xs, zs;
   for (std::size_t k = valid.size() - 10; k < valid.size(); ++k) {
@@ -293,6 +347,7 @@ struct Plan {
   std::vector<std::vector<double>> recorded;  ///< [outcome][trial]
   std::vector<Eigen::Quaterniond> orientations;
   double duration = 0.0, frame = 1e-3, moved = 1e-3, sigma = 1e-4;
+  double tilt_rate_deg_per_s = 0.0;  ///< a tilt's plate
 };
 
 using Sample = std::vector<std::vector<std::vector<double>>>;  ///< [plan][outcome][replay]
@@ -306,6 +361,18 @@ PathSample recorded_path(const Track& track, const TrialScore& score) {
   return {std::move(moved.t), std::move(moved.x), std::move(moved.z)};
 }
 
+/// Keeps the outcomes measured on every recorded trial: a lab's tilt track often ends a few
+/// frames after sliding starts, before the slide time could be measured.
+void keep_measured_outcomes(Plan& plan) {
+  for (std::size_t o = plan.outcomes.size(); o-- > 0;) {
+    const auto& values = plan.recorded[o];
+    const bool every = std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+    if (every && !values.empty()) continue;
+    plan.outcomes.erase(plan.outcomes.begin() + static_cast<std::ptrdiff_t>(o));
+    plan.recorded.erase(plan.recorded.begin() + static_cast<std::ptrdiff_t>(o));
+  }
+}
+
 /// The plans of every recording compared, their replays' orientations drawn from `stream` on.
 std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>& scores, const EnsembleOptions& options,
                              std::uint64_t stream) {
@@ -315,10 +382,11 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
     const Recording& rec = recs[r];
     Plan plan;
     plan.recording = r;
-    plan.outcomes = outcomes_of(rec.test);
+    plan.outcomes = outcomes_of(rec);
     if (plan.outcomes.empty()) continue;
     plan.sigma = ev.sigma[r];
     plan.moved = std::max(1e-3, 6.0 * ev.sigma[r]);
+    plan.tilt_rate_deg_per_s = rec.tilt_rate_deg_per_s.value_or(ev.lab.tilt_rate_deg_per_s);
     plan.recorded.resize(plan.outcomes.size());
     std::vector<Eigen::Quaterniond> recorded_orientations;
     bool every_recorded = true;
@@ -328,13 +396,15 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
       const Track& track = *rec.trials[tt.trial].track;
       plan.frame = frame_interval(track);
       plan.duration = std::max(plan.duration, tt.duration);
-      const auto measured = measure_outcomes(rec.test, recorded_path(track, scores[i]), plan.moved);
+      const auto measured =
+          measure_outcomes(rec.test, recorded_path(track, scores[i]), plan.moved, plan.tilt_rate_deg_per_s);
       for (std::size_t k = 0; k < measured.size(); ++k) plan.recorded[k].push_back(measured[k].second);
       every_recorded = every_recorded && rec.trials[tt.trial].release_orientation.has_value();
       if (rec.trials[tt.trial].release_orientation)
         recorded_orientations.push_back(*rec.trials[tt.trial].release_orientation);
     }
-    if (plan.recorded.front().size() < 2) continue;
+    keep_measured_outcomes(plan);
+    if (plan.outcomes.empty() || plan.recorded.front().size() < 2) continue;
     // As many replays as recorded trials at least: with 30 trials (the seed study's 10 x 3) and
     // 12 replays the replays' sampling noise, not the trials', would set each standard error.
     EnsembleOptions each = options;
@@ -367,6 +437,12 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
       ReplayOptions replay;
       replay.duration = plan.duration;
       replay.sample_interval = plan.frame;  // sampled as the camera samples
+      if (rec.test == LabTest::Tilt) {
+        // Until it has slid 10 mm, however late that is: a replay that stopped where the
+        // recorded tracks stop would leave out the replays that slide later.
+        replay.duration = 89.0 / plan.tilt_rate_deg_per_s;
+        replay.stop_after_slip = 0.0;
+      }
       const auto samples = replay_trial(*world, rec, plan.orientations[k], lab, replay);
       PathSample path;
       const double x0 = samples.empty() ? 0.0 : samples.front().x;
@@ -375,12 +451,19 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
         path.x.push_back(s.x - x0);
         path.z.push_back(s.z);
       }
-      measured[k] = measure_outcomes(rec.test, path, plan.moved);
+      measured[k] = measure_outcomes(rec.test, path, plan.moved, plan.tilt_rate_deg_per_s);
     });
     replays += static_cast<int>(plan.orientations.size());
     out[p].assign(plan.outcomes.size(), {});
     for (const auto& m : measured) {
-      for (std::size_t o = 0; o < m.size() && o < plan.outcomes.size(); ++o) out[p][o].push_back(m[o].second);
+      for (std::size_t o = 0; o < plan.outcomes.size(); ++o) {
+        const auto it = std::find_if(m.begin(), m.end(), [&](const auto& v) { return v.first == plan.outcomes[o]; });
+        // A replay that never slid by 89 degrees counts as sliding there.
+        const double value = it == m.end() ? std::numeric_limits<double>::quiet_NaN()
+                             : plan.outcomes[o] == Outcome::SlipAngle && !std::isfinite(it->second) ? 89.0
+                                                                                                    : it->second;
+        if (std::isfinite(value)) out[p][o].push_back(value);
+      }
     }
   }
   return out;
@@ -395,7 +478,10 @@ double floor_for(const Plan& plan, Outcome outcome, double recorded_mean, double
     case Outcome::Drift:
       return std::hypot(3.0 * plan.sigma, 1e-3, scaled);
     case Outcome::RollTime:
+    case Outcome::SlideTime:
       return std::hypot(2.0 * plan.frame, scaled);
+    case Outcome::SlipAngle:
+      return std::hypot(2.0 * plan.frame * plan.tilt_rate_deg_per_s, scaled);
   }
   return scaled;
 }

@@ -28,7 +28,7 @@
 
 namespace clumpforge {
 
-enum class Outcome { ReboundHeight, Drift, RollDistance, RollTime };
+enum class Outcome { ReboundHeight, Drift, RollDistance, RollTime, SlipAngle, SlideTime };
 std::string_view outcome_name(Outcome outcome);
 
 /// What of an outcome's sample is compared: its mean, or its spread (the mean absolute
@@ -38,17 +38,20 @@ std::string_view outcome_name(Outcome outcome);
 enum class Statistic { Mean, Spread };
 std::string_view statistic_name(Statistic statistic);
 
-/// A path in the replay's frame: time since release [s], x from the release point and the
-/// tracked point's height [m].
+/// A path in the replay's frame: time since release (a tilt: since the plate started turning)
+/// [s], x from the release point and the tracked point's height [m].
 struct PathSample {
   std::vector<double> t, x, z;
 };
 
-/// The outcomes of a drop (rebound height above the rest height, drift) or a
-/// roll (distance, time to rest), measured alike on a recorded track and a replay. `moved`
-/// is the displacement that counts as motion [m] (well above the noise). Empty for a tilt
-/// or a path with fewer than 10 frames.
-std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved);
+/// The outcomes of a drop (rebound height above the rest height, drift), a roll (distance,
+/// time to rest) or a tilt (the plate angle at the onset of sliding, and the time the tracked
+/// point then takes to slide 3 mm further along the plate), measured alike on a recorded track
+/// and a replay. `moved` is the displacement that counts as motion [m] (well above the noise);
+/// a tilt's plate turns at `tilt_rate_deg_per_s` from t = 0 about an axis through x = z = 0.
+/// A tilt's outcome the path does not reach is NaN. Empty for a path with fewer than 10 frames.
+std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved,
+                                                         double tilt_rate_deg_per_s = 0.0);
 
 /// One outcome of one recording: the recorded trials against the replays.
 struct OutcomeComparison {

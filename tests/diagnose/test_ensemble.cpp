@@ -60,8 +60,7 @@ TEST(EnsembleOutcomes, ReboundHeightAndDriftOfABouncingPath) {
   const auto dead = measure_outcomes(LabTest::Drop, bouncing_path(0.2, 0.0, 0.0, 1000.0), 1e-3);
   ASSERT_EQ(dead.size(), 2u);
   EXPECT_DOUBLE_EQ(dead[0].second, 0.0);
-  // Tilts have no ensemble outcomes; ten frames are the least.
-  EXPECT_TRUE(measure_outcomes(LabTest::Tilt, bouncing_path(0.2, 0.5, 0.0, 1000.0), 1e-3).empty());
+  // Ten frames are the least.
   PathSample short_path;
   short_path.t = {0, 1e-3, 2e-3};
   short_path.x = short_path.z = {0, 0, 0};
@@ -82,6 +81,61 @@ TEST(EnsembleOutcomes, RollDistanceAndTimeToRest) {
   EXPECT_NEAR(outcomes[0].second, 0.09, 1e-9);
   // 1 mm short of rest: 0.25 (0.6 - t)^2 = 1e-3, t = 0.6 - 0.0632 s, to a frame (4 ms).
   EXPECT_NEAR(outcomes[1].second, 0.6 - std::sqrt(1e-3 / 0.25), 4e-3);
+}
+
+namespace {
+
+/// A point riding a plate that turns at `rate` deg/s about the axis through x = z = 0, `height`
+/// above it and `along` down it (plus `hinge_x`: the lab's axis elsewhere), resting until the
+/// plate stands at `slip` degrees and then sliding down it at `accel` m/s^2, filmed at `fps`
+/// with Gaussian noise `noise` until `until` s after the slip.
+PathSample tilting_path(double rate, double slip, double accel, double fps, double until, double noise = 0.0,
+                        double hinge_x = 0.0) {
+  constexpr double height = 8e-3, along = 2e-3, deg = 3.14159265358979323846 / 180.0;
+  const double t_slip = slip / rate;
+  Rng rng(77);
+  PathSample p;
+  for (double t = t_slip - 1.0; t < t_slip + until; t += 1.0 / fps) {
+    const double tau = std::max(0.0, t - t_slip), s = along + 0.5 * accel * tau * tau, angle = rate * t * deg;
+    p.t.push_back(t);
+    p.x.push_back(hinge_x + s * std::cos(angle) + height * std::sin(angle) + rng.normal(0.0, noise));
+    p.z.push_back(-s * std::sin(angle) + height * std::cos(angle) + rng.normal(0.0, noise));
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST(EnsembleOutcomes, SlipAngleAndSlideTimeOfATilt) {
+  // Analytic: 1 mm of slide at tau1 = sqrt(2e-3 / a), 4 mm at tau2 = sqrt(8e-3 / a); the slip
+  // angle is the plate's at tau1, the slide time tau2 - tau1. At 2 m/s^2 (a kinetic friction
+  // 0.25 below a static 0.45 at 24 degrees) the slide takes 31.6 ms.
+  const double a = 2.0, tau1 = std::sqrt(2e-3 / a), tau2 = std::sqrt(8e-3 / a);
+  const auto clean = measure_outcomes(LabTest::Tilt, tilting_path(5.0, 24.0, a, 1000.0, 0.1), 1e-3, 5.0);
+  ASSERT_EQ(clean.size(), 2u);
+  EXPECT_EQ(clean[0].first, Outcome::SlipAngle);
+  EXPECT_NEAR(clean[0].second, 24.0 + 5.0 * tau1, 0.005);  // to 1 ms of the frames' interpolation
+  EXPECT_EQ(clean[1].first, Outcome::SlideTime);
+  EXPECT_NEAR(clean[1].second, tau2 - tau1, 1e-3);
+  // With 0.1 mm of camera noise, and the lab's axis 3 mm from the replay's: the axis moves the
+  // point along the plate by 3 mm (cos 19 - cos 24 deg) = 0.1 mm from the rest frames (1 s
+  // before) to the slip, and 5 um during the slide. 0.1 mm is 1.6 ms of slide at its speed there
+  // (63 mm/s): to 0.02 degree (4 ms) and 2 ms of slide.
+  const auto noisy = measure_outcomes(LabTest::Tilt, tilting_path(5.0, 24.0, a, 1000.0, 0.1, 1e-4, 3e-3), 1e-3, 5.0);
+  ASSERT_EQ(noisy.size(), 2u);
+  EXPECT_NEAR(noisy[0].second, 24.0 + 5.0 * tau1, 0.02);
+  EXPECT_NEAR(noisy[1].second, tau2 - tau1, 2e-3);
+  // A slower slide (no friction drop: 0.2 m/s^2) takes sqrt(10) times as long.
+  const auto slow = measure_outcomes(LabTest::Tilt, tilting_path(5.0, 24.0, 0.2, 1000.0, 0.3), 1e-3, 5.0);
+  EXPECT_NEAR(slow[1].second, std::sqrt(10.0) * (tau2 - tau1), 1e-3);
+  // A track that ends 40 ms after the slip at 0.2 m/s^2 (0.16 mm into the slide) gives neither;
+  // one that ends 50 ms after it at 2 m/s^2 (2.5 mm) gives the angle alone.
+  const auto early = measure_outcomes(LabTest::Tilt, tilting_path(5.0, 24.0, 0.2, 1000.0, 0.04), 1e-3, 5.0);
+  EXPECT_TRUE(std::isnan(early[0].second));
+  EXPECT_TRUE(std::isnan(early[1].second));
+  const auto short_slide = measure_outcomes(LabTest::Tilt, tilting_path(5.0, 24.0, a, 1000.0, 0.05), 1e-3, 5.0);
+  EXPECT_NEAR(short_slide[0].second, 24.0 + 5.0 * tau1, 0.005);
+  EXPECT_TRUE(std::isnan(short_slide[1].second));
 }
 
 TEST(EnsembleComparison, StandardisedDifferenceOfMeans) {
