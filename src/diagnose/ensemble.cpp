@@ -120,6 +120,10 @@ std::vector<std::pair<Outcome, double>> tilt_outcomes(const PathSample& path, co
 
 }  // namespace
 
+bool compared_as_sample(const Recording& recording) {
+  return !outcomes_of(recording).empty();
+}
+
 std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved,
                                                          double tilt_rate_deg_per_s) {
   std::vector<std::size_t> valid;

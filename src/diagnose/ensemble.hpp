@@ -53,6 +53,11 @@ struct PathSample {
 std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved,
                                                          double tilt_rate_deg_per_s = 0.0);
 
+/// Whether a recording's trials are compared as a sample with replays over the release: every
+/// drop and roll, and a tilt of four particles glued in a square (a single particle's slip
+/// angle on a tilting plate is set by its underside's shape, which a clump does not reproduce).
+bool compared_as_sample(const Recording& recording);
+
 /// One outcome of one recording: the recorded trials against the replays.
 struct OutcomeComparison {
   std::size_t recording = 0;

@@ -741,6 +741,55 @@ TEST(DiagnoseEnsemble, ARestitutionFarFromTheTablesIsCalibratedOnTheOutcomes) {
   EXPECT_EQ(means, 4);  // rebound height and drift of each drop
 }
 
+/// Four-square tilts on steel, made from the finer adaptive-340 (no release orientation), with a
+/// kinetic friction `drop` below the static one (none: a control).
+Result<ConcealResult> four_square_tilts_from_the_finer_body(int trials, std::optional<double> drop,
+                                                            std::uint64_t seed) {
+  auto generators = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
+  if (!generators) return std::unexpected(generators.error());
+  auto generator = select_clump(std::move(*generators), "adaptive-340", "tuber-default.h5");
+  if (!generator) return std::unexpected(generator.error());
+  ConcealOptions conceal;
+  conceal.trials = trials;
+  conceal.drop_heights = {};
+  conceal.roll_starts = {};
+  conceal.seed = seed;
+  if (drop) {
+    conceal.effect = Effect::StaticKineticFriction;
+    conceal.values = {*drop};
+  }
+  return make_concealed_recordings(*generator, default_material_table(), conceal);
+}
+
+TEST(DiagnoseEnsemble, AKineticFrictionBelowTheStaticOneIsNamedFromFourSquareTiltsAndAControlIsNot) {
+  // Six four-square tilts each, from the finer adaptive-340, no release orientation. Frame by
+  // frame the fits stop where the trials part, at the first sliding onset (the body's onset
+  // changes with its heading), so the slide after it is seen only as a sample: the slide time
+  // from 1 to 4 mm along the plate. With the library's strong drop (0.25) the friction drop is
+  // named there; the control, with the same candidates, is `none`. Adhesion, which acts on a tilt
+  // too, is the rival asked about.
+  const MaterialTable table = default_material_table();
+  DiagnoseOptions options;
+  options.effects = {Effect::StaticKineticFriction, Effect::Adhesion};
+  for (const std::optional<double> drop : {std::optional<double>(0.25), std::optional<double>()}) {
+    auto made = four_square_tilts_from_the_finer_body(6, drop, 2613);
+    ASSERT_TRUE(made) << made.error().message;
+    auto result = diagnose(diagnosis_clump(), table, made->recordings, made->names, options);
+    ASSERT_TRUE(result) << result.error().message;
+    ASSERT_TRUE(result->ensemble.has_value()) << result->statement;
+    if (drop) {
+      EXPECT_EQ(result->verdict, Verdict::Named) << result->statement;
+      EXPECT_EQ(result->effect, Effect::StaticKineticFriction) << result->statement;
+      EXPECT_EQ(result->basis, Basis::Ensemble) << result->statement;
+    } else {
+      EXPECT_EQ(result->verdict, Verdict::None) << result->statement;
+    }
+    const auto& compared = result->ensemble->null_comparisons;
+    EXPECT_TRUE(std::any_of(compared.begin(), compared.end(),
+                            [](const OutcomeComparison& c) { return c.outcome == Outcome::SlideTime; }));
+  }
+}
+
 TEST(DiagnoseEnsemble, ARecordingWithMoreTrialsThanReplaysIsReplayedOncePerTrial) {
   // Fourteen tuber drops from 0.2 m on soil, made from the finer adaptive-340, no release
   // orientation, diagnosed with the default 12 replays per recording. The recorded sample's mean
