@@ -119,7 +119,8 @@ void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
     result.experiment = experiment_for(result.candidates[0], result.candidates[1]);
     result.statement = fmt::format(
         "Frame by frame nothing is named, but the recorded outcomes (rebound heights, drifts, roll distances, times "
-        "to rest) differ from replays over the unknown release orientation, and {} and {} explain that about equally "
+        "to rest, four-square slip angles and slide times) differ from replays over the unknown release orientation, "
+        "and {} and {} explain that about equally "
         "well (delta-BIC {:.1f} vs {:.1f} on the lower of two draws of release orientations, {:.1f} vs {:.1f} on the "
         "higher). To separate them: {}.",
         result.candidates[0], result.candidates[1], best.delta_bic(), rival->delta_bic(), best.best_delta_bic(),

@@ -373,18 +373,19 @@ TEST(DiagnoseCli, AnAgreementThatMovesWithTheResolutionNamesNothingAndClaimsNoAb
   }
 }
 
-TEST(DiagnoseCli, AnAbsenceTheOutcomesDecideIsJudgedInTheUnitsOfTheNullsOwnMisfit) {
+TEST(DiagnoseCli, AStrongOffsetTriedOnTheOutcomesIsNotCalledAbsent) {
   // The generated benchmark's noisy:15 com_offset-strong case (bench_diagnose --orientation
   // noisy:15 makes the same recordings): the default tuber's 340-sphere fill with its centre of
   // mass 2.5 and 1.2 mm off, four set-ups of 4 trials, each trial's release orientation recorded
   // 15 degrees off; diagnosed with the ladder's 32-sphere clump and its three finer rungs. The
-  // offset is tried on the outcomes beyond the release horizon and not named; the recorded
-  // outcomes reject the 32-sphere clump's strong offset by 20.3 against the 15.0 needed, but the
-  // null calibrated on them misfits them by 3.4 times its degrees of freedom (the 340-sphere body
-  // does not follow the 32-sphere clump's response to the offset). Judged in those units, as a
-  // candidate's margin is, the outcomes do not decide the offset absent: `none` with com_offset
-  // in `undecidable`, and the experiment says the particle model decides it. (At 9f56c9a it was
-  // called absent while present.)
+  // offset is tried on the outcomes beyond the release horizon and not named; its strong
+  // magnitude would show, but the recorded outcomes do not reject it beyond the margin in the
+  // units of the null's own misfit (the 340-sphere body does not follow the 32-sphere clump's
+  // response to the offset): `none` with com_offset in `undecidable`, never decided absent. (At
+  // 9f56c9a it was called absent while present.) Until 6e8e5c6 the rejection was 20.3 against
+  // 15.0 needed, within 3.4 times the null's degrees of freedom (advice particle_model_decides);
+  // with the four-square tilt's slip angle and slide time compared too it is 10.5 against 15.5
+  // (first_order_would_do). The rule itself: EnsembleDecided.TheAdviceOnMoreTrialsFollowsTheCandidatesDetectability.
   test::ScratchDir dir("diagnose-absence-in-dispersion-units");
   const auto made = test::run_command(fmt::format(
       "'{}' '{}' --clump adaptive-340 --effect com_offset --magnitude strong --surface Q235 --trials 4 --seed 1016 "
@@ -401,20 +402,21 @@ TEST(DiagnoseCli, AnAbsenceTheOutcomesDecideIsJudgedInTheUnitsOfTheNullsOwnMisfi
   ASSERT_EQ(j["verdict"], "none") << j["statement"];
   const auto undecidable = j["undecidable"].get<std::vector<std::string>>();
   EXPECT_EQ(std::count(undecidable.begin(), undecidable.end(), "com_offset"), 1) << j["undecidable"].dump();
-  // The path this test is about: tried on the outcomes, shown and rejected by the margin in
-  // chi^2, yet not beyond it in the null's dispersion units.
+  // Tried on the outcomes, its strong magnitude shown, yet not rejected beyond the margin in the
+  // null's dispersion units: not decided.
   ASSERT_TRUE(j["ensemble"].is_object());
   bool tried = false;
   for (const auto& h : j["ensemble"]["hypotheses"]) tried = tried || h["name"] == "com_offset";
   EXPECT_TRUE(tried);
+  int judged = 0;
   for (const auto& d : j["ensemble"]["detectability"]) {
     if (d["name"] != "com_offset") continue;
+    ++judged;
     const double needed = d["needed"].get<double>(), dispersion = d["dispersion"].get<double>();
     EXPECT_GE(d["strong_signal"].get<double>(), needed) << d.dump();
-    EXPECT_GE(d["strong_rejection"].get<double>(), needed) << d.dump();
     EXPECT_LT(d["strong_rejection"].get<double>(), dispersion * needed) << d.dump();
-    EXPECT_EQ(d["advice"], "particle_model_decides") << d.dump();
+    EXPECT_NE(d["advice"], "decided") << d.dump();
   }
-  EXPECT_NE(j["experiment"].get<std::string>().find("com_offset (rejected by"), std::string::npos) << j["experiment"];
+  EXPECT_EQ(judged, 1);
 }
 }  // namespace clumpforge
