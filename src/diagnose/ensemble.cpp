@@ -79,8 +79,8 @@ std::vector<Outcome> outcomes_of(const Recording& rec) {
 
 /// The first time a sequence of (time, value) pairs reaches `level`, interpolated between the
 /// frames on either side; NaN when it never does.
-double first_reaching(const std::vector<std::pair<double, double>>& series, double level, std::size_t from = 0) {
-  for (std::size_t k = std::max<std::size_t>(from, 1); k < series.size(); ++k) {
+double first_reaching(const std::vector<std::pair<double, double>>& series, double level) {
+  for (std::size_t k = 1; k < series.size(); ++k) {
     const auto [t1, v1] = series[k];
     if (v1 < level) continue;
     const auto [t0, v0] = series[k - 1];
@@ -460,13 +460,14 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
     replays += static_cast<int>(plan.orientations.size());
     out[p].assign(plan.outcomes.size(), {});
     for (const auto& m : measured) {
+      // Looked up by outcome: a plan keeps only those measured on every recorded trial.
       for (std::size_t o = 0; o < plan.outcomes.size(); ++o) {
         const auto it = std::find_if(m.begin(), m.end(), [&](const auto& v) { return v.first == plan.outcomes[o]; });
-        // A replay that never slid by 89 degrees counts as sliding there.
-        const double value = it == m.end() ? std::numeric_limits<double>::quiet_NaN()
-                             : plan.outcomes[o] == Outcome::SlipAngle && !std::isfinite(it->second) ? 89.0
-                                                                                                    : it->second;
-        if (std::isfinite(value)) out[p][o].push_back(value);
+        if (it == m.end()) continue;
+        if (std::isfinite(it->second))
+          out[p][o].push_back(it->second);
+        else if (it->first == Outcome::SlipAngle)
+          out[p][o].push_back(89.0);  // a replay runs to 89 degrees: one that never slid counts as sliding there
       }
     }
   }
