@@ -110,6 +110,18 @@ void place_tilt(RigidBody& body, const Eigen::Quaterniond& q) {
   body.position = {0, 0, 1e-7 - lowest_offset(body, q, Eigen::Vector3d::UnitZ())};
 }
 
+// Tilt: the plate and the body resting on it turned together about the plate's axis (y), the
+// +x side down, as the turning plate does.
+void tilt_together(Wall& plate, RigidBody& body, double angle) {
+  const Eigen::AngleAxisd turn(angle, Eigen::Vector3d::UnitY());
+  const Eigen::Matrix3d r = turn.toRotationMatrix();
+  plate.point = plate.pivot + r * (plate.point - plate.pivot);
+  plate.normal = (r * plate.normal).normalized();
+  plate.u_axis = (r * plate.u_axis).normalized();
+  body.position = plate.pivot + r * (body.position - plate.pivot);
+  body.orientation = (Eigen::Quaterniond(turn) * body.orientation).normalized();
+}
+
 // Whether the caller asked to stop, looked at every 1024 steps (well under a millisecond of
 // work each time), so an interrupt stops a trial at once.
 bool stop_requested(const World& world, const RunContext& context) {
@@ -333,18 +345,21 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
       break;
     case LabTest::Tilt:
       place_tilt(body, orientation);
+      if (replay.tilt_start_deg > 0.0) tilt_together(world.walls[0], body, replay.tilt_start_deg * kPi / 180.0);
       break;
   }
-  double origin = 0.0, rate = 0.0;
+  double origin = 0.0, rate = 0.0, next = 0.0;
   if (setup.test == LabTest::Tilt) {
     while (world.time < replay.settle) step(world, dt);
     rate = (setup.tilt_rate_deg_per_s ? *setup.tilt_rate_deg_per_s : options.tilt_rate_deg_per_s) * kPi / 180.0;
     world.walls[0].spin = {0, rate, 0};  // as tilt_trial: travel towards +x
-    origin = world.time;
+    // Where the plate would have been level; samples keep the grid of a plate that started there.
+    origin = world.time - replay.tilt_start_deg * kPi / 180.0 / rate;
+    next = origin + std::ceil((world.time - origin) / replay.sample_interval - 1e-9) * replay.sample_interval;
   }
   std::vector<ReplaySample> samples;
   samples.reserve(static_cast<std::size_t>(replay.duration / replay.sample_interval) + 2);
-  double next = origin, slid_at = -1.0, rest_since = -1.0;
+  double slid_at = -1.0, rest_since = -1.0;
   const double end = origin + replay.duration;
   for (;;) {
     if (world.time + 1e-12 >= next && (samples.empty() || world.time - origin + 1e-12 >= replay.record_from)) {

@@ -80,6 +80,10 @@ struct ReplayOptions {
   double duration = 1.0;          ///< [s] simulated after release
   double sample_interval = 1e-4;  ///< [s]
   double settle = 0.05;           ///< tilt: settling before the plate turns [s]
+  /// Tilt: the plate's angle when it starts turning [deg]. Below the onset of sliding the body
+  /// rests on the plate, so it may be settled on the plate already tilted: times and angles stay
+  /// those of a plate that started level (t = 0 where it would have been level).
+  double tilt_start_deg = 0.0;
   double record_from = 0.0;       ///< [s] samples before this are left out (the first one is kept)
   double stop_after_rest = -1.0;  ///< end this long after the body came to rest (speed < 2 mm/s) [s]; < 0 never
   double stop_after_slip = -1.0;  ///< tilt: end this long after 10 mm of slip along the plate [s]; < 0 never

@@ -1,8 +1,10 @@
 // The study's lab tests in the DEM: physics sanity and determinism.
 #include <gtest/gtest.h>
-
 #include <tbb/global_control.h>
 
+#include <cmath>
+#include <limits>
+#include <numbers>
 #include <numeric>
 
 #include "dem/lab.hpp"
@@ -32,22 +34,27 @@ TEST(LabTests, ResultsAreBitIdenticalWhateverTheThreadCount) {
   std::vector<double> one, two;
   {
     tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
-    one = run_lab_test(clump, default_material_table(), setup_for(LabTest::Drop, "Q235"), options)->recording.summaries();
+    one =
+        run_lab_test(clump, default_material_table(), setup_for(LabTest::Drop, "Q235"), options)->recording.summaries();
   }
   {
     tbb::global_control pair(tbb::global_control::max_allowed_parallelism, 2);
-    two = run_lab_test(clump, default_material_table(), setup_for(LabTest::Drop, "Q235"), options)->recording.summaries();
+    two =
+        run_lab_test(clump, default_material_table(), setup_for(LabTest::Drop, "Q235"), options)->recording.summaries();
   }
   EXPECT_EQ(one, two);
   options.seed = 8;
-  EXPECT_NE(run_lab_test(clump, default_material_table(), setup_for(LabTest::Drop, "Q235"), options)->recording.summaries(), one);
+  EXPECT_NE(
+      run_lab_test(clump, default_material_table(), setup_for(LabTest::Drop, "Q235"), options)->recording.summaries(),
+      one);
 }
 
 TEST(LabTests, DropReboundsBelowTheRestitutionBoundAndSpreadsWithOrientation) {
   // No rebound can rise above e^2 H (energy), and orientation makes trials differ.
   LabOptions options;
   options.trials = 6;
-  const auto result = run_lab_test(lattice_clump(), default_material_table(), setup_for(LabTest::Drop, "Q235"), options);
+  const auto result =
+      run_lab_test(lattice_clump(), default_material_table(), setup_for(LabTest::Drop, "Q235"), options);
   ASSERT_TRUE(result) << result.error().message;
   const auto h = result->recording.summaries();
   for (double v : h) EXPECT_LT(v, 0.728 * 0.728 * 0.2 + 1e-3);
@@ -61,7 +68,8 @@ TEST(LabTests, FourSquareSlipsNearTheFrictionAngle) {
   LabOptions options;
   options.trials = 1;
   options.interaction = Interaction{0.5, 0.41, 0.0};
-  const auto result = run_lab_test(lattice_clump(), default_material_table(), setup_for(LabTest::Tilt, "Q235"), options);
+  const auto result =
+      run_lab_test(lattice_clump(), default_material_table(), setup_for(LabTest::Tilt, "Q235"), options);
   ASSERT_TRUE(result) << result.error().message;
   const double angle = result->recording.summaries()[0];
   EXPECT_GT(angle, 22.29 - 0.3);  // atan(0.41)
@@ -73,7 +81,8 @@ TEST(LabTests, MoreRollingFrictionRollsShorter) {
   options.trials = 4;
   auto mean = [&](double mu_r) {
     options.interaction = Interaction{0.5, 0.6, mu_r};
-    const auto v = run_lab_test(lattice_clump(), default_material_table(), setup_for(LabTest::Roll, "Q235"), options)->recording.summaries();
+    const auto v = run_lab_test(lattice_clump(), default_material_table(), setup_for(LabTest::Roll, "Q235"), options)
+                       ->recording.summaries();
     return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
   };
   EXPECT_GT(mean(0.01), mean(0.1));
@@ -92,4 +101,61 @@ TEST(LabTests, BadSetupsAreRefused) {
   EXPECT_NE(refused.error().message.find("stable limit"), std::string::npos);
 }
 
+}  // namespace clumpforge
+
+namespace clumpforge {
+namespace {
+// The plate angle at which the tracked point has moved 1 mm along the plate, and the time it
+// then takes to move 3 mm more (NaN when not reached).
+std::pair<double, double> onset_and_slide(const std::vector<ReplaySample>& samples) {
+  const double start = samples.front().along_plate;
+  double onset_t = std::numeric_limits<double>::quiet_NaN(), angle = onset_t;
+  for (const auto& s : samples) {
+    const double moved = std::abs(s.along_plate - start);
+    if (std::isnan(onset_t) && moved > 1e-3) {
+      onset_t = s.t;
+      angle = s.tilt_deg;
+    }
+    if (!std::isnan(onset_t) && moved > 4e-3) return {angle, s.t - onset_t};
+  }
+  return {angle, std::numeric_limits<double>::quiet_NaN()};
+}
+}  // namespace
+
+TEST(LabTests, ATiltReplayStartedOnATiltedPlateSlidesAsOneStartedLevel) {
+  // Below the friction angle the block rests on the plate, so a replay may settle it on the
+  // plate already at 70 % of that angle (what the ensemble does to save the first 4 s of plate
+  // travel). Onset and slide must be the level start's within 0.01 deg (two frames of plate travel
+  // at 1000 fps and 5 deg/s) and 1 ms (one frame); they agree to 5e-5 deg (the sample grid).
+  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default-ladder.h5");
+  ASSERT_TRUE(library);
+  Recording setup = setup_for(LabTest::Tilt, "Q235");
+  setup.tilt_rate_deg_per_s = 5.0;
+  for (const auto& [name, mu_s] : {std::pair{"adaptive-32", 0.41}, {"adaptive-32", 0.6}, {"adaptive-128", 0.41}}) {
+    const Clump clump = *select_clump(*library, name, "tuber-default-ladder.h5");
+    LabOptions options;
+    options.interaction = Interaction{0.5, mu_s, 0.02};
+    const auto world = make_lab_world(clump, default_material_table(), setup, options);
+    ASSERT_TRUE(world) << world.error().message;
+    for (double yaw : {0.0, 1.9}) {
+      const Eigen::Quaterniond q(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+      ReplayOptions replay;
+      replay.duration = 89.0 / 5.0;
+      replay.sample_interval = 1e-3;
+      replay.stop_after_slip = 0.0;
+      const auto level = onset_and_slide(replay_trial(*world, setup, q, options, replay));
+      replay.tilt_start_deg = 0.7 * std::atan(mu_s) * 180.0 / std::numbers::pi;
+      const auto tilted_samples = replay_trial(*world, setup, q, options, replay);
+      ASSERT_FALSE(tilted_samples.empty());
+      EXPECT_NEAR(tilted_samples.front().tilt_deg, replay.tilt_start_deg, 5e-3);
+      const auto tilted = onset_and_slide(tilted_samples);
+      SCOPED_TRACE(testing::Message() << name << ", mu_s " << mu_s << " yaw " << yaw << ": level " << level.first
+                                      << " deg, " << level.second << " s; started tilted " << tilted.first << " deg, "
+                                      << tilted.second << " s");
+      ASSERT_TRUE(std::isfinite(level.first) && std::isfinite(level.second));
+      EXPECT_NEAR(tilted.first, level.first, 0.01);
+      EXPECT_NEAR(tilted.second, level.second, 1e-3);
+    }
+  }
+}
 }  // namespace clumpforge
