@@ -115,9 +115,7 @@ void place_tilt(RigidBody& body, const Eigen::Quaterniond& q) {
 void tilt_together(Wall& plate, RigidBody& body, double angle) {
   const Eigen::AngleAxisd turn(angle, Eigen::Vector3d::UnitY());
   const Eigen::Matrix3d r = turn.toRotationMatrix();
-  plate.point = plate.pivot + r * (plate.point - plate.pivot);
-  plate.normal = (r * plate.normal).normalized();
-  plate.u_axis = (r * plate.u_axis).normalized();
+  plate.turn(r);
   body.position = plate.pivot + r * (body.position - plate.pivot);
   body.orientation = (Eigen::Quaterniond(turn) * body.orientation).normalized();
 }

@@ -194,10 +194,7 @@ void rotate(RigidBody& body, double dt) {
 void rotate_wall(Wall& wall, double dt) {
   const double angle = wall.spin.norm() * dt;
   if (angle <= 0.0) return;
-  const Eigen::Matrix3d r = Eigen::AngleAxisd(angle, wall.spin.normalized()).toRotationMatrix();
-  wall.point = wall.pivot + r * (wall.point - wall.pivot);
-  wall.normal = (r * wall.normal).normalized();
-  wall.u_axis = (r * wall.u_axis).normalized();
+  wall.turn(Eigen::AngleAxisd(angle, wall.spin.normalized()).toRotationMatrix());
 }
 }  // namespace
 

@@ -59,6 +59,12 @@ struct Wall {
   Eigen::Vector3d v_axis() const { return normal.cross(u_axis); }
   /// Velocity of the wall's material point at p.
   Eigen::Vector3d velocity_at(const Eigen::Vector3d& p) const { return spin.cross(p - pivot); }
+  /// Turns the wall by `r` about its pivot.
+  void turn(const Eigen::Matrix3d& r) {
+    point = pivot + r * (point - pivot);
+    normal = (r * normal).normalized();
+    u_axis = (r * u_axis).normalized();
+  }
 };
 
 /// The lever arm of the rolling torque.

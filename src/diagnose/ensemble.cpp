@@ -475,6 +475,7 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
     auto world = make_lab_world(*ev.clump, *ev.table, rec, lab);
     if (!world) return std::unexpected(world.error());
     std::vector<std::vector<std::pair<Outcome, double>>> measured(plan.orientations.size());
+    const double tilt_start = rec.test == LabTest::Tilt ? tilt_start_deg(world->interaction) : 0.0;
     tbb::parallel_for(std::size_t{0}, plan.orientations.size(), [&](std::size_t k) {
       ReplayOptions replay;
       replay.duration = plan.duration;
@@ -484,7 +485,7 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
         // recorded tracks stop would leave out the replays that slide later.
         replay.duration = 89.0 / plan.tilt_rate_deg_per_s;
         replay.stop_after_slip = 0.0;
-        replay.tilt_start_deg = tilt_start_deg(world->interaction);
+        replay.tilt_start_deg = tilt_start;
       }
       measured[k] = replay_and_measure(*world, rec, plan, plan.orientations[k], lab, replay);
       if (slid_near_start(measured[k], replay.tilt_start_deg)) {

@@ -101,9 +101,6 @@ TEST(LabTests, BadSetupsAreRefused) {
   EXPECT_NE(refused.error().message.find("stable limit"), std::string::npos);
 }
 
-}  // namespace clumpforge
-
-namespace clumpforge {
 namespace {
 // The plate angle at which the tracked point has moved 1 mm along the plate, and the time it
 // then takes to move 3 mm more (NaN when not reached).
