@@ -196,7 +196,8 @@ enum class TrialsAdvice {
   Decided,               ///< not undecidable: the outcomes (or the frames before them) decided it
   MoreTrials,            ///< trials_needed trials per set-up, more than recorded, would show it
   FirstOrderWouldDo,     ///< the trials recorded would, to first order, yet it was never tried
-  ParticleModelDecides,  ///< rejected by the margin, but within the null's misfit or the finer clump's move
+  ParticleModelDecides,  ///< rejected by the margin, but within the null's misfit or the finer clump's move,
+                         ///< or only by a clump a finer one showed inadequate (absences_on_explaining_clump)
   MisfitLimited,         ///< the null's own misfit grows with the trials as its signal does
   Floor,                 ///< its response stays within the comparisons' floor
   ReplayNoise,           ///< its response is within the replays' own noise

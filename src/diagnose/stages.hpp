@@ -315,6 +315,10 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
                                            const std::vector<Effect>& candidates, const EnsembleOptions& eo,
                                            int max_evaluations, std::optional<LetThrough> let_through);
 bool particle_model_unconverged(const Context& c, DiagnoseResult& result);
+/// Once a finer clump explains the outcomes and nothing passes there: the absences the diagnosed
+/// clump's outcomes decided that the explaining clump's comparison (`fine`) does not decide go
+/// back to undecidable (advice ParticleModelDecides); returns their names.
+std::vector<std::string> absences_on_explaining_clump(DiagnoseResult& result, const EnsembleResult& fine);
 /// The ladder converged on its finest clump, which still leaves the outcomes inconsistent: the
 /// candidates are judged on that clump's comparison; named there when one passes.
 bool judge_on_converged_clump(DiagnoseResult& result, const ParticleModelCheck& check, const EnsembleResult& finest,

@@ -618,6 +618,68 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
   }
 }
 
+TEST(EnsembleDecided, AnAbsenceDecidedOnlyOnAClumpAFinerOneShowedInadequateIsUndecided) {
+  // The diagnosed clump's outcomes rejected the strong elastic-plastic restitution (decided
+  // absent there); air drag was decided frame by frame. A finer clump then explained the outcomes
+  // (`none` on the particle model's basis). The elastic-plastic absence stands only when the
+  // explaining clump tried the candidate and its outcomes reject it too; air drag stays decided.
+  constexpr double kNotReplayed = std::numeric_limits<double>::quiet_NaN();
+  const auto coarse_result = [&] {
+    DiagnoseResult result;
+    result.verdict = Verdict::None;
+    result.basis = Basis::ParticleModel;
+    result.undecidable = {"viscous_rolling"};
+    EnsembleReport report;
+    report.detectability.push_back({Effect::ElasticPlasticRestitution, 537.0, 31.0, 13.5, 9.0, 242.0, 9.9, 6.2});
+    report.detectability.push_back({Effect::AirDrag, 0.2, 0.4, 13.5, kNotReplayed, -13.6, kNotReplayed, 6.2});
+    for (auto& d : report.detectability) d.advice = TrialsAdvice::Decided;
+    EnsembleHypothesis tried;
+    tried.effect = Effect::ElasticPlasticRestitution;
+    tried.first_delta_bic = 3.9;
+    report.hypotheses.push_back(tried);
+    result.ensemble = report;
+    return result;
+  };
+  const auto ep_undecided = [](const DiagnoseResult& r) {
+    return std::count(r.undecidable.begin(), r.undecidable.end(), "elastic_plastic_restitution") == 1;
+  };
+  // Not tried on the explaining clump: taken back.
+  {
+    DiagnoseResult result = coarse_result();
+    EnsembleResult fine;
+    fine.detectability.push_back({Effect::ElasticPlasticRestitution, 40.0, 1.0, 13.5, 4.0, 30.0, kNotReplayed, 1.0});
+    EXPECT_EQ(diagnosis::absences_on_explaining_clump(result, fine),
+              std::vector<std::string>{"elastic_plastic_restitution"});
+    EXPECT_TRUE(ep_undecided(result));
+    EXPECT_EQ(result.ensemble->detectability[0].advice, TrialsAdvice::ParticleModelDecides);
+    EXPECT_EQ(result.ensemble->detectability[1].advice, TrialsAdvice::Decided);
+    EXPECT_EQ(std::count(result.undecidable.begin(), result.undecidable.end(), "air_drag"), 0);
+  }
+  // Tried there, but its strong magnitude not rejected by the margin: taken back.
+  {
+    DiagnoseResult result = coarse_result();
+    EnsembleResult fine;
+    fine.detectability.push_back({Effect::ElasticPlasticRestitution, 40.0, 1.0, 13.5, 4.0, 5.0, kNotReplayed, 1.0});
+    EnsembleHypothesis h;
+    h.effect = Effect::ElasticPlasticRestitution;
+    fine.hypotheses.push_back(h);
+    EXPECT_EQ(diagnosis::absences_on_explaining_clump(result, fine).size(), 1u);
+    EXPECT_TRUE(ep_undecided(result));
+  }
+  // Tried there and rejected by the margin: the absence stands.
+  {
+    DiagnoseResult result = coarse_result();
+    EnsembleResult fine;
+    fine.detectability.push_back({Effect::ElasticPlasticRestitution, 40.0, 1.0, 13.5, 4.0, 30.0, kNotReplayed, 1.0});
+    EnsembleHypothesis h;
+    h.effect = Effect::ElasticPlasticRestitution;
+    fine.hypotheses.push_back(h);
+    EXPECT_TRUE(diagnosis::absences_on_explaining_clump(result, fine).empty());
+    EXPECT_FALSE(ep_undecided(result));
+    EXPECT_EQ(result.ensemble->detectability[0].advice, TrialsAdvice::Decided);
+  }
+}
+
 // A ladder of clumps whose finest one leaves the recorded outcomes inconsistent: the candidates
 // are judged on it only when its outcomes agree with the previous clump's (converged); before
 // that the mismatch may still be the particle model's, and nothing is named. A candidate that
