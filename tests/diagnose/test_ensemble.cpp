@@ -643,12 +643,23 @@ TEST(EnsembleDecided, AnAbsenceDecidedOnlyOnAClumpAFinerOneShowedInadequateIsUnd
   const auto ep_undecided = [](const DiagnoseResult& r) {
     return std::count(r.undecidable.begin(), r.undecidable.end(), "elastic_plastic_restitution") == 1;
   };
+  // The explaining clump's comparison: the candidate tried there or not, its strong magnitude
+  // rejected by `rejection` (13.5 needed).
+  const auto explaining = [&](bool tried_there, double rejection) {
+    EnsembleResult fine;
+    fine.detectability.push_back(
+        {Effect::ElasticPlasticRestitution, 40.0, 1.0, 13.5, 4.0, rejection, kNotReplayed, 1.0});
+    if (tried_there) {
+      EnsembleHypothesis h;
+      h.effect = Effect::ElasticPlasticRestitution;
+      fine.hypotheses.push_back(h);
+    }
+    return fine;
+  };
   // Not tried on the explaining clump: taken back.
   {
     DiagnoseResult result = coarse_result();
-    EnsembleResult fine;
-    fine.detectability.push_back({Effect::ElasticPlasticRestitution, 40.0, 1.0, 13.5, 4.0, 30.0, kNotReplayed, 1.0});
-    EXPECT_EQ(diagnosis::absences_on_explaining_clump(result, fine),
+    EXPECT_EQ(diagnosis::absences_on_explaining_clump(result, explaining(false, 30.0)),
               std::vector<std::string>{"elastic_plastic_restitution"});
     EXPECT_TRUE(ep_undecided(result));
     EXPECT_EQ(result.ensemble->detectability[0].advice, TrialsAdvice::ParticleModelDecides);
@@ -658,23 +669,13 @@ TEST(EnsembleDecided, AnAbsenceDecidedOnlyOnAClumpAFinerOneShowedInadequateIsUnd
   // Tried there, but its strong magnitude not rejected by the margin: taken back.
   {
     DiagnoseResult result = coarse_result();
-    EnsembleResult fine;
-    fine.detectability.push_back({Effect::ElasticPlasticRestitution, 40.0, 1.0, 13.5, 4.0, 5.0, kNotReplayed, 1.0});
-    EnsembleHypothesis h;
-    h.effect = Effect::ElasticPlasticRestitution;
-    fine.hypotheses.push_back(h);
-    EXPECT_EQ(diagnosis::absences_on_explaining_clump(result, fine).size(), 1u);
+    EXPECT_EQ(diagnosis::absences_on_explaining_clump(result, explaining(true, 5.0)).size(), 1u);
     EXPECT_TRUE(ep_undecided(result));
   }
   // Tried there and rejected by the margin: the absence stands.
   {
     DiagnoseResult result = coarse_result();
-    EnsembleResult fine;
-    fine.detectability.push_back({Effect::ElasticPlasticRestitution, 40.0, 1.0, 13.5, 4.0, 30.0, kNotReplayed, 1.0});
-    EnsembleHypothesis h;
-    h.effect = Effect::ElasticPlasticRestitution;
-    fine.hypotheses.push_back(h);
-    EXPECT_TRUE(diagnosis::absences_on_explaining_clump(result, fine).empty());
+    EXPECT_TRUE(diagnosis::absences_on_explaining_clump(result, explaining(true, 30.0)).empty());
     EXPECT_FALSE(ep_undecided(result));
     EXPECT_EQ(result.ensemble->detectability[0].advice, TrialsAdvice::Decided);
   }
