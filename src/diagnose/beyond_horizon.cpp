@@ -46,6 +46,11 @@ void mark_undecidable(DiagnoseResult& result, const std::string& name) {
     result.undecidable.push_back(name);
 }
 
+/// Whether `e` was tried on the outcomes (one of `hypotheses`).
+bool tried_in(const std::vector<EnsembleHypothesis>& hypotheses, Effect e) {
+  return std::any_of(hypotheses.begin(), hypotheses.end(), [&](const EnsembleHypothesis& h) { return h.effect == e; });
+}
+
 /// The experiment when the particle model has not converged on the finest clump tried.
 std::string finer_clumps_experiment(int spheres) {
   return fmt::format(
@@ -261,16 +266,12 @@ struct Coarse {
 std::vector<std::string> absences_on_explaining_clump(DiagnoseResult& result, const EnsembleResult& fine) {
   std::vector<std::string> taken_back;
   if (!result.ensemble) return taken_back;
-  const auto tried = [](const std::vector<EnsembleHypothesis>& hypotheses, Effect e) {
-    return std::any_of(hypotheses.begin(), hypotheses.end(),
-                       [&](const EnsembleHypothesis& h) { return h.effect == e; });
-  };
   for (Detectability& d : result.ensemble->detectability) {
-    if (d.advice != TrialsAdvice::Decided || !tried(result.ensemble->hypotheses, d.effect) || !d.decides_absence())
+    if (d.advice != TrialsAdvice::Decided || !tried_in(result.ensemble->hypotheses, d.effect) || !d.decides_absence())
       continue;
     const auto there = std::find_if(fine.detectability.begin(), fine.detectability.end(),
                                     [&](const Detectability& x) { return x.effect == d.effect; });
-    if (tried(fine.hypotheses, d.effect) && there != fine.detectability.end() && there->decides_absence()) continue;
+    if (tried_in(fine.hypotheses, d.effect) && there != fine.detectability.end() && there->decides_absence()) continue;
     d.advice = TrialsAdvice::ParticleModelDecides;
     taken_back.push_back(effect_name(d.effect));
     mark_undecidable(result, taken_back.back());
@@ -605,8 +606,7 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
   std::vector<std::string> more_trials, no_more_trials;
   for (const auto& d : ens.detectability) {
     const std::string& name = effect_spec(library, d.effect).name;
-    const bool tried = std::any_of(ens.hypotheses.begin(), ens.hypotheses.end(),
-                                   [&](const EnsembleHypothesis& h) { return h.effect == d.effect; });
+    const bool tried = tried_in(ens.hypotheses, d.effect);
     // Tried and not named decides its absence only where its strong magnitude would have shown
     // and the recorded outcomes reject it: on the generated full set with 8 trials per set-up the
     // plastic substrate was tried at a fitted level, failed the margin, and was present (strong
