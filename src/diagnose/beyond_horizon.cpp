@@ -624,7 +624,8 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
         if (reported.effect == d.effect) reported.advice = advice;
     }
     switch (advice) {
-      case TrialsAdvice::NotJudged:  // trials_advice always judges
+      case TrialsAdvice::NotJudged:    // trials_advice always judges
+      case TrialsAdvice::Unexplained:  // said only once the verdict is (reconcile_advice)
         break;
       case TrialsAdvice::Decided:
         std::erase(result.undecidable, name);
@@ -676,6 +677,24 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
   if (!no_more_trials.empty())
     text += fmt::format("; more trials per set-up would not show these: {}", fmt::join(no_more_trials, ", "));
   result.experiment = std::move(text);
+}
+
+void reconcile_advice(DiagnoseResult& result) {
+  if (!result.ensemble) return;
+  EnsembleReport& e = *result.ensemble;
+  for (Detectability& d : e.detectability) {
+    const std::string name = effect_name(d.effect);
+    const bool listed =
+        std::find(result.undecidable.begin(), result.undecidable.end(), name) != result.undecidable.end();
+    if (d.advice == TrialsAdvice::NotJudged)
+      d.advice = trials_advice(d, tried_in(e.hypotheses, d.effect), listed, e.trials);
+    if (!listed) {
+      d.advice = TrialsAdvice::Decided;
+    } else if (d.advice == TrialsAdvice::Decided) {
+      d.advice =
+          result.basis == Basis::UnexplainedOutcomes ? TrialsAdvice::Unexplained : TrialsAdvice::ParticleModelDecides;
+    }
+  }
 }
 
 /// Beyond the release horizons: the recorded trials against replays from the release prior

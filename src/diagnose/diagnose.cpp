@@ -153,6 +153,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     run.report("ensembles", 0.9);
     if (auto ok = judge_ensembles(c, result, baseline, *full_base, effects, options); !ok)
       return std::unexpected(ok.error());
+    reconcile_advice(result);
   }
   ask_for_deciding_experiments(result);
   say_which_were_asked(result, options);

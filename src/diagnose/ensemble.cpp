@@ -50,6 +50,8 @@ std::string_view trials_advice_name(TrialsAdvice advice) {
       return "first_order_would_do";
     case TrialsAdvice::ParticleModelDecides:
       return "particle_model_decides";
+    case TrialsAdvice::Unexplained:
+      return "unexplained";
     case TrialsAdvice::MisfitLimited:
       return "misfit_limited";
     case TrialsAdvice::Floor:

@@ -197,7 +197,10 @@ enum class TrialsAdvice {
   MoreTrials,            ///< trials_needed trials per set-up, more than recorded, would show it
   FirstOrderWouldDo,     ///< the trials recorded would, to first order, yet it was never tried
   ParticleModelDecides,  ///< rejected by the margin, but within the null's misfit or the finer clump's move,
-                         ///< or only by a clump a finer one showed inadequate (absences_on_explaining_clump)
+                         ///< or only by a clump a finer one showed inadequate (absences_on_explaining_clump),
+                         ///< or under a verdict the particle model left undecidable (unconverged)
+  Unexplained,           ///< rejected on the outcomes, but the verdict is unexplained: no candidate leaves them
+                         ///< consistent, so no absence is decided there (reconcile_advice)
   MisfitLimited,         ///< the null's own misfit grows with the trials as its signal does
   Floor,                 ///< its response stays within the comparisons' floor
   ReplayNoise,           ///< its response is within the replays' own noise

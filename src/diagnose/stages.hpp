@@ -332,6 +332,16 @@ bool flights_rule_out_offset(DiagnoseResult& result);
 /// set-up the others need (each recording replayed once per trial from that count on), and apart
 /// those no count of trials would show.
 void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens);
+/// Once the verdict is final, each reported candidate's advice agrees with it: `decided` exactly
+/// when the candidate is not in `result.undecidable`. Stages after say_what_outcomes_decide list
+/// some again (an unexplained mismatch, an unconverged particle model, an absence only a clump
+/// shown inadequate decided), and a verdict reached on a finer clump reports that clump's
+/// comparison, not yet judged: of 241 stored reports of generated sets (46e5433, 8808645) with
+/// an ensemble, 3 said `decided` of a candidate their verdict listed undecidable (each under
+/// `unexplained`), and 8 named or ambiguous on a finer clump said `not_judged` of every one. A
+/// candidate listed undecidable whose absence the outcomes had decided becomes `unexplained` under
+/// that verdict, else `particle_model_decides`.
+void reconcile_advice(DiagnoseResult& result);
 Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& baseline,
                              const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
                              const DiagnoseOptions& options);

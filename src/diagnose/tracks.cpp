@@ -69,7 +69,7 @@ Weights weights_for(const std::vector<ReplaySample>& replay, double sigma, doubl
   if (impact_accuracy <= 0.0 || replay.empty()) return w;
   // Each separation (contacts to none) starts an error that grows with the speed it left
   // with, frozen when the next contact begins; independent impacts add in quadrature.
-  w.growth.assign(replay.size(), 0.0);
+  std::vector<double> growth(replay.size(), 0.0);
   double frozen = 0.0;  // squared errors of the impacts whose flights have ended [m^2]
   double left_at = 0.0, left_speed = 0.0;
   bool flying = false;
@@ -83,30 +83,40 @@ Weights weights_for(const std::vector<ReplaySample>& replay, double sigma, doubl
     if (flying && replay[k].contacts > 0) {
       frozen += open * open;
       flying = false;
-      w.growth[k] = std::sqrt(frozen);
+      growth[k] = std::sqrt(frozen);
       continue;
     }
-    w.growth[k] = std::sqrt(frozen + open * open);
+    growth[k] = std::sqrt(frozen + open * open);
   }
+  w.scale.reserve(growth.size());
+  for (double g : growth) w.scale.push_back(std::hypot(sigma, g));
   return w;
 }
 
-Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, double shift,
-                   double x_offset, double z_offset, double cutoff) {
-  Alignment a;
-  a.shift = shift;
-  a.x_offset = x_offset;
-  a.z_offset = z_offset;
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    if (track.t[i] > cutoff) break;
-    const ReplayPoint p = interpolate(replay, track.t[i] - shift);
+namespace {
+
+/// The replay, linearly interpolated, at each recorded frame up to `cutoff` (recorded time).
+std::vector<ReplayPoint> points_until(const Track& track, const std::vector<ReplaySample>& replay, double shift,
+                                      double cutoff) {
+  std::vector<ReplayPoint> points;
+  points.reserve(track.size());
+  for (std::size_t i = 0; i < track.size() && track.t[i] <= cutoff; ++i)
+    points.push_back(interpolate(replay, track.t[i] - shift));
+  return points;
+}
+
+/// `a` with the chi^2 of the first points.size() frames against `points` at its offsets.
+Alignment chi2_against(const Track& track, const std::vector<ReplayPoint>& points, const Weights& sigma, Alignment a) {
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const ReplayPoint& p = points[i];
+    const double s = sigma.at(p.index);
     if (std::isfinite(track.x[i])) {
-      const double r = (track.x[i] - p.x - x_offset) / sigma.at(p.index);
+      const double r = (track.x[i] - p.x - a.x_offset) / s;
       a.chi_squared += r * r;
       ++a.values;
     }
     if (std::isfinite(track.z[i])) {
-      const double r = (track.z[i] - p.z - z_offset) / sigma.at(p.index);
+      const double r = (track.z[i] - p.z - a.z_offset) / s;
       a.chi_squared += r * r;
       ++a.values;
     }
@@ -114,27 +124,35 @@ Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, 
   return a;
 }
 
+}  // namespace
+
+Alignment score_at(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, double shift,
+                   double x_offset, double z_offset, double cutoff) {
+  return chi2_against(track, points_until(track, replay, shift, cutoff), sigma,
+                      Alignment{.shift = shift, .x_offset = x_offset, .z_offset = z_offset});
+}
+
 Alignment score(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, double shift,
                 OriginFit origins, double cutoff) {
-  // Each fitted origin is the mean residual of its axis (least squares).
+  // Each fitted origin is the mean residual of its axis (least squares); the replay is
+  // interpolated once for both.
+  const std::vector<ReplayPoint> points = points_until(track, replay, shift, cutoff);
   double sum_x = 0.0, sum_z = 0.0;
   int count_x = 0, count_z = 0;
-  if (origins.x || origins.z) {
-    for (std::size_t i = 0; i < track.size(); ++i) {
-      if (track.t[i] > cutoff) break;
-      const ReplayPoint p = interpolate(replay, track.t[i] - shift);
-      if (origins.x && std::isfinite(track.x[i])) {
-        sum_x += track.x[i] - p.x;
-        ++count_x;
-      }
-      if (origins.z && std::isfinite(track.z[i])) {
-        sum_z += track.z[i] - p.z;
-        ++count_z;
-      }
+  for (std::size_t i = 0; i < points.size() && (origins.x || origins.z); ++i) {
+    if (origins.x && std::isfinite(track.x[i])) {
+      sum_x += track.x[i] - points[i].x;
+      ++count_x;
+    }
+    if (origins.z && std::isfinite(track.z[i])) {
+      sum_z += track.z[i] - points[i].z;
+      ++count_z;
     }
   }
-  return score_at(track, replay, sigma, shift, count_x > 0 ? sum_x / count_x : 0.0, count_z > 0 ? sum_z / count_z : 0.0,
-                  cutoff);
+  return chi2_against(track, points, sigma,
+                      Alignment{.shift = shift,
+                                .x_offset = count_x > 0 ? sum_x / count_x : 0.0,
+                                .z_offset = count_z > 0 ? sum_z / count_z : 0.0});
 }
 
 Alignment align(const Track& track, const std::vector<ReplaySample>& replay, const Weights& sigma, OriginFit origins,

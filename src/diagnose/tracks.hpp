@@ -56,9 +56,11 @@ Track in_replay_frame(const Track& track, const Alignment& alignment);
 /// the next contact. Without impacts (a free flight, a roll, a slide) it is `sigma`.
 struct Weights {
   double sigma = 1.0;
-  std::vector<double> growth;      ///< per replay sample [m]; empty: none
+  /// Per replay sample: hypot(sigma, the growth there) [m], worked out once (weights_for): an
+  /// alignment asks for it twice per frame at each of some 25 shifts. Empty: sigma throughout.
+  std::vector<double> scale;
   Weights(double s) : sigma(s) {}  // NOLINT(google-explicit-constructor): a bare sigma is the common case
-  double at(std::size_t sample) const { return sample < growth.size() ? std::hypot(sigma, growth[sample]) : sigma; }
+  double at(std::size_t sample) const { return sample < scale.size() ? scale[sample] : sigma; }
 };
 Weights weights_for(const std::vector<ReplaySample>& replay, double sigma, double impact_accuracy);
 

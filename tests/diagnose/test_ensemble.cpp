@@ -681,6 +681,61 @@ TEST(EnsembleDecided, AnAbsenceDecidedOnlyOnAClumpAFinerOneShowedInadequateIsUnd
   }
 }
 
+TEST(EnsembleDecided, TheReportedAdviceAgreesWithTheFinalVerdict) {
+  // Advice `decided` exactly when the verdict leaves the candidate out of `undecidable`, whatever
+  // stage listed it last; a finer clump's comparison the report took over is judged too.
+  constexpr double kNotReplayed = std::numeric_limits<double>::quiet_NaN();
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  // Rejected by the margin on the outcomes (an absence they decide), and never shown (no response).
+  const Detectability rejected{Effect::Adhesion, 40.0, 1.0, 13.5, 4.0, 30.0, kNotReplayed, 1.0};
+  const Detectability silent{Effect::ViscousRolling, 0.0, 0.0, 13.5, kNone, 0.0, kNotReplayed, 1.0};
+  const auto report = [&](TrialsAdvice advice) {
+    EnsembleReport e;
+    e.trials = 4.0;
+    e.detectability = {rejected, silent};
+    e.detectability[0].advice = advice;
+    e.detectability[1].advice = advice == TrialsAdvice::NotJudged ? advice : TrialsAdvice::NoResponse;
+    EnsembleHypothesis h;
+    h.effect = Effect::Adhesion;
+    e.hypotheses.push_back(h);
+    return e;
+  };
+  struct Case {
+    Verdict verdict;
+    Basis basis;
+    TrialsAdvice before;
+    bool adhesion_listed;
+    TrialsAdvice after;
+  };
+  for (const Case& k : {
+           // Decided on the outcomes, then listed again by the verdict: not decided after all.
+           Case{Verdict::Unexplained, Basis::UnexplainedOutcomes, TrialsAdvice::Decided, true,
+                TrialsAdvice::Unexplained},
+           Case{Verdict::Undecidable, Basis::UnconvergedParticleModel, TrialsAdvice::Decided, true,
+                TrialsAdvice::ParticleModelDecides},
+           // Decided and not listed: unchanged.
+           Case{Verdict::None, Basis::Ensemble, TrialsAdvice::Decided, false, TrialsAdvice::Decided},
+           // The report took over a finer clump's comparison (not judged): judged on it.
+           Case{Verdict::Named, Basis::Ensemble, TrialsAdvice::NotJudged, false, TrialsAdvice::Decided},
+       }) {
+    SCOPED_TRACE(static_cast<int>(k.basis));
+    DiagnoseResult result;
+    result.verdict = k.verdict;
+    result.basis = k.basis;
+    result.undecidable = {"viscous_rolling"};
+    if (k.adhesion_listed) result.undecidable.push_back("adhesion");
+    result.ensemble = report(k.before);
+    diagnosis::reconcile_advice(result);
+    EXPECT_EQ(result.ensemble->detectability[0].advice, k.after);
+    EXPECT_EQ(result.ensemble->detectability[1].advice, TrialsAdvice::NoResponse);
+  }
+  EXPECT_EQ(trials_advice_name(TrialsAdvice::Unexplained), "unexplained");
+  // No ensemble, nothing to reconcile.
+  DiagnoseResult none;
+  diagnosis::reconcile_advice(none);
+  EXPECT_FALSE(none.ensemble);
+}
+
 // A ladder of clumps whose finest one leaves the recorded outcomes inconsistent: the candidates
 // are judged on it only when its outcomes agree with the previous clump's (converged); before
 // that the mismatch may still be the particle model's, and nothing is named. A candidate that
