@@ -40,10 +40,14 @@ void supersede(DiagnoseResult& result, Verdict verdict, Basis basis) {
   result.basis = basis;
 }
 
+/// Whether `name` is listed in the verdict's undecidable candidates.
+bool listed_undecidable(const DiagnoseResult& result, const std::string& name) {
+  return std::find(result.undecidable.begin(), result.undecidable.end(), name) != result.undecidable.end();
+}
+
 /// `name` listed in the verdict's undecidable candidates (once).
 void mark_undecidable(DiagnoseResult& result, const std::string& name) {
-  if (std::find(result.undecidable.begin(), result.undecidable.end(), name) == result.undecidable.end())
-    result.undecidable.push_back(name);
+  if (!listed_undecidable(result, name)) result.undecidable.push_back(name);
 }
 
 /// Whether `e` was tried on the outcomes (one of `hypotheses`).
@@ -616,8 +620,7 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
     // rejection beyond twice the next finer clump's move of the strong response, as frame by
     // frame: on that noisy:15 set the offset (2.5 and 1.2 mm on the 340-sphere body) was rejected
     // by 20.3 against 15 needed while the null's chi^2 was 3.4 times its degrees of freedom.
-    const bool listed =
-        std::find(result.undecidable.begin(), result.undecidable.end(), name) != result.undecidable.end();
+    const bool listed = listed_undecidable(result, name);
     const TrialsAdvice advice = trials_advice(d, tried, listed, ens.trials);
     if (result.ensemble) {
       for (auto& reported : result.ensemble->detectability)
@@ -684,8 +687,7 @@ void reconcile_advice(DiagnoseResult& result) {
   EnsembleReport& e = *result.ensemble;
   for (Detectability& d : e.detectability) {
     const std::string name = effect_name(d.effect);
-    const bool listed =
-        std::find(result.undecidable.begin(), result.undecidable.end(), name) != result.undecidable.end();
+    const bool listed = listed_undecidable(result, name);
     if (d.advice == TrialsAdvice::NotJudged)
       d.advice = trials_advice(d, tried_in(e.hypotheses, d.effect), listed, e.trials);
     if (!listed) {

@@ -139,7 +139,7 @@ Alignment score(const Track& track, const std::vector<ReplaySample>& replay, con
   const std::vector<ReplayPoint> points = points_until(track, replay, shift, cutoff);
   double sum_x = 0.0, sum_z = 0.0;
   int count_x = 0, count_z = 0;
-  for (std::size_t i = 0; i < points.size() && (origins.x || origins.z); ++i) {
+  for (std::size_t i = 0; i < points.size(); ++i) {
     if (origins.x && std::isfinite(track.x[i])) {
       sum_x += track.x[i] - points[i].x;
       ++count_x;

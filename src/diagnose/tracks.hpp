@@ -57,7 +57,7 @@ Track in_replay_frame(const Track& track, const Alignment& alignment);
 struct Weights {
   double sigma = 1.0;
   /// Per replay sample: hypot(sigma, the growth there) [m], worked out once (weights_for): an
-  /// alignment asks for it twice per frame at each of some 25 shifts. Empty: sigma throughout.
+  /// alignment asks for it at every frame at each of some 25 shifts. Empty: sigma throughout.
   std::vector<double> scale;
   Weights(double s) : sigma(s) {}  // NOLINT(google-explicit-constructor): a bare sigma is the common case
   double at(std::size_t sample) const { return sample < scale.size() ? scale[sample] : sigma; }
