@@ -105,6 +105,41 @@ bool calls_decided(const nlohmann::json& report, const std::vector<std::string>&
   return !listed("undecidable") && !listed("candidates");
 }
 
+/// Whether a report's advice contradicts its final verdict (nullopt: no candidate was judged on the
+/// outcomes): its advice must say `decided` of exactly the effects it leaves out of `undecidable`, and
+/// `not_judged` of none (the verdict took each candidate's judgement over). Before reconcile_advice
+/// (0dea44d) advice was set ahead of the later stages that list candidates undecidable again.
+std::optional<bool> advice_contradicts_verdict(const nlohmann::json& report) {
+  if (!report.contains("ensemble") || !report["ensemble"].is_object() ||
+      !report["ensemble"].contains("detectability") || !report["ensemble"]["detectability"].is_array() ||
+      report["ensemble"]["detectability"].empty() || !report.contains("undecidable") ||
+      !report["undecidable"].is_array())
+    return std::nullopt;
+  const auto& undecidable = report["undecidable"];
+  return std::any_of(report["ensemble"]["detectability"].begin(), report["ensemble"]["detectability"].end(),
+                     [&](const nlohmann::json& d) {
+                       const std::string advice = d.value("advice", "not_judged");
+                       const bool listed = std::find(undecidable.begin(), undecidable.end(),
+                                                     nlohmann::json(d.value("name", ""))) != undecidable.end();
+                       return advice == "not_judged" || (advice == "decided") == listed;
+                     });
+}
+
+/// "k/n" of the reports (nullopt entries left out) whose advice contradicts their verdict, as a
+/// markdown line, and summary["advice_contradicts_verdict"].
+std::string contradiction_line(const std::vector<std::optional<bool>>& contradicts, nlohmann::json& summary) {
+  int judged = 0, contradicting = 0;
+  for (const auto& c : contradicts) {
+    judged += c.has_value();
+    contradicting += c.value_or(false);
+  }
+  summary["advice_contradicts_verdict"] = {{"reports", contradicting}, {"of", judged}};
+  return fmt::format(
+      "reports whose advice contradicts their verdict (`decided` said of an effect listed undecidable, or not of "
+      "one left out, or `not_judged`), of those that judged candidates on the outcomes: {}/{}\n",
+      contradicting, judged);
+}
+
 /// The missed effects' advice counted (advice_for, the trials count left off): a markdown line,
 /// and summary["missed_advice"].
 std::string advice_tally(const std::vector<std::vector<std::string>>& missed, nlohmann::json& summary) {
@@ -220,6 +255,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   std::vector<double> seconds, improvements;
   std::vector<std::vector<std::string>> missed_advice;
   std::vector<std::string> missed_called_decided;
+  std::vector<std::optional<bool>> contradicts;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
     const fs::path report = out / id / "report.json";
@@ -252,6 +288,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       if (missed && calls_decided(j, right)) missed_called_decided.push_back(id);
     }
     seconds.push_back(j.value("seconds", NAN));
+    contradicts.push_back(advice_contradicts_verdict(j));
     table += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} |\n", id,
                          answer.value("particle", "?"), answer.value("label", effect), verdict, j.value("basis", "?"),
                          is_right ? "yes" : "no", before, after, 100.0 * gain, j.value("seconds", NAN));
@@ -281,6 +318,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   nlohmann::json summary;
   summary["missed_called_decided"] = missed_called_decided;
   table += advice_tally(missed_advice, summary);
+  table += contradiction_line(contradicts, summary);
   std::cout << "\n" << table;
   summary.update(nlohmann::json{{"set", set.string()},
                                 {"effects", effects},
@@ -320,7 +358,8 @@ struct CaseScore {
   }
   std::vector<std::pair<std::string, double>> ensemble_z;  ///< (outcome, z) of the calibrated null
   std::vector<std::pair<std::string, double>> stages;      ///< the report's stage_seconds, in order
-  std::vector<std::string> advice;  ///< what the report says more trials would do for the truth (advice_for)
+  std::vector<std::string> advice;         ///< what the report says more trials would do for the truth (advice_for)
+  std::optional<bool> advice_contradicts;  ///< advice_contradicts_verdict
 };
 
 /// A case's report.json read for the score (nullopt when it is not JSON).
@@ -349,6 +388,7 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
         o.smallest_detectable = h["smallest_detectable"].get<double>();
   }
   if (truth != "none") o.advice = advice_for(j, {truth});
+  o.advice_contradicts = advice_contradicts_verdict(j);
   if (j.contains("stage_seconds") && j["stage_seconds"].is_array()) {
     for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", NAN));
   }
@@ -489,6 +529,9 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
   md += time_summary(outcomes, summary);
   md += missed_summary(outcomes, summary);
+  std::vector<std::optional<bool>> contradicts;
+  for (const auto& o : outcomes) contradicts.push_back(o.advice_contradicts);
+  md += contradiction_line(contradicts, summary);
   // On the controls the calibrated null's replays should sit on the recorded outcomes within
   // their standard errors (z about 0 +- 1): a mean z away from 0 is a bias of the diagnosed
   // particle model against the generator's, which the ensemble stage may blame on an effect.
