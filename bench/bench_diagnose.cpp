@@ -72,14 +72,29 @@ std::vector<std::string> right_verdicts(const std::string& effect) {
   return {effect};
 }
 
+/// A report's ensemble.detectability entries (null when the outcomes were not compared).
+const nlohmann::json* detectability_of(const nlohmann::json& report) {
+  if (!report.contains("ensemble") || !report["ensemble"].is_object() ||
+      !report["ensemble"].contains("detectability") || !report["ensemble"]["detectability"].is_array())
+    return nullptr;
+  return &report["ensemble"]["detectability"];
+}
+
+/// Whether the report's array `key` (undecidable, candidates) holds any of `names`.
+bool lists_any(const nlohmann::json& report, const char* key, const std::vector<std::string>& names) {
+  if (!report.contains(key) || !report[key].is_array()) return false;
+  return std::any_of(report[key].begin(), report[key].end(), [&](const nlohmann::json& v) {
+    return v.is_string() && std::find(names.begin(), names.end(), v.get<std::string>()) != names.end();
+  });
+}
+
 /// What a report's experiment says more trials per set-up would do for the effects in `names`
 /// (the concealed effect's candidates): each one's `advice` from ensemble.detectability, with its
 /// trials per set-up when more would show it; "not_compared" when the outcomes were not compared.
 std::vector<std::string> advice_for(const nlohmann::json& report, const std::vector<std::string>& names) {
   std::vector<std::string> out;
-  if (report.contains("ensemble") && report["ensemble"].is_object() && report["ensemble"].contains("detectability") &&
-      report["ensemble"]["detectability"].is_array()) {
-    for (const auto& d : report["ensemble"]["detectability"]) {
+  if (const nlohmann::json* detectability = detectability_of(report)) {
+    for (const auto& d : *detectability) {
       if (std::find(names.begin(), names.end(), d.value("name", "")) == names.end()) continue;
       std::string advice = d.value("advice", "not_judged");
       if (advice == "more_trials" && d.contains("trials_needed") && d["trials_needed"].is_number())
@@ -96,13 +111,7 @@ std::vector<std::string> advice_for(const nlohmann::json& report, const std::vec
 /// not call it absent either). False when the report has no undecidable list.
 bool calls_decided(const nlohmann::json& report, const std::vector<std::string>& names) {
   if (!report.contains("undecidable") || !report["undecidable"].is_array()) return false;
-  const auto listed = [&](const char* key) {
-    if (!report.contains(key) || !report[key].is_array()) return false;
-    return std::any_of(report[key].begin(), report[key].end(), [&](const nlohmann::json& v) {
-      return v.is_string() && std::find(names.begin(), names.end(), v.get<std::string>()) != names.end();
-    });
-  };
-  return !listed("undecidable") && !listed("candidates");
+  return !lists_any(report, "undecidable", names) && !lists_any(report, "candidates", names);
 }
 
 /// Whether a report's advice contradicts its final verdict (nullopt: no candidate was judged on the
@@ -110,19 +119,14 @@ bool calls_decided(const nlohmann::json& report, const std::vector<std::string>&
 /// `not_judged` of none (the verdict took each candidate's judgement over). Before reconcile_advice
 /// (0dea44d) advice was set ahead of the later stages that list candidates undecidable again.
 std::optional<bool> advice_contradicts_verdict(const nlohmann::json& report) {
-  if (!report.contains("ensemble") || !report["ensemble"].is_object() ||
-      !report["ensemble"].contains("detectability") || !report["ensemble"]["detectability"].is_array() ||
-      report["ensemble"]["detectability"].empty() || !report.contains("undecidable") ||
-      !report["undecidable"].is_array())
+  const nlohmann::json* detectability = detectability_of(report);
+  if (!detectability || detectability->empty() || !report.contains("undecidable") || !report["undecidable"].is_array())
     return std::nullopt;
-  const auto& undecidable = report["undecidable"];
-  return std::any_of(report["ensemble"]["detectability"].begin(), report["ensemble"]["detectability"].end(),
-                     [&](const nlohmann::json& d) {
-                       const std::string advice = d.value("advice", "not_judged");
-                       const bool listed = std::find(undecidable.begin(), undecidable.end(),
-                                                     nlohmann::json(d.value("name", ""))) != undecidable.end();
-                       return advice == "not_judged" || (advice == "decided") == listed;
-                     });
+  return std::any_of(detectability->begin(), detectability->end(), [&](const nlohmann::json& d) {
+    const std::string advice = d.value("advice", "not_judged");
+    const bool listed = lists_any(report, "undecidable", {d.value("name", "")});
+    return advice == "not_judged" || (advice == "decided") == listed;
+  });
 }
 
 /// "k/n" of the reports (nullopt entries left out) whose advice contradicts their verdict, as a
