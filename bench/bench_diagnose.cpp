@@ -34,6 +34,7 @@
 #include "io/clump_library.hpp"
 #include "io/recording_io.hpp"
 #include "parallel/team.hpp"
+#include "twin_shift.hpp"
 
 namespace fs = std::filesystem;
 using namespace clumpforge;
@@ -220,6 +221,53 @@ bool run_missing(const Team& team, const std::vector<std::string>& ids, const st
   return static_cast<bool>(shared);
 }
 
+/// A case's twin shift (bench/twin_shift.hpp) as a table cell: "chi^2 noncentrality / recordings
+/// (expected p)", the recordings whose trials do not vary counted apart; "-" without twins.
+std::string twin_cell(const std::optional<bench::TwinShift>& t) {
+  if (!t) return "-";
+  std::vector<std::string> parts;
+  if (t->recordings)
+    parts.push_back(fmt::format("{:.1f} / {} (p {:.2g})", t->noncentrality, t->recordings, t->expected_p));
+  if (t->fixed) parts.push_back(fmt::format("{} fixed", t->fixed));
+  return fmt::format("{}", fmt::join(parts, "; "));
+}
+
+/// A case's twin shift for summary.json (null without twins).
+nlohmann::json twin_json(const std::optional<bench::TwinShift>& t) {
+  if (!t) return nlohmann::json();
+  return {{"noncentrality", t->noncentrality},
+          {"recordings", t->recordings},
+          {"fixed", t->fixed},
+          {"expected_p", t->expected_p}};
+}
+
+/// The missed effects sorted by their twin shift: those whose summary means a test knowing the
+/// effect-free outcomes would expect to show at p < 0.01, those it would not, those whose
+/// trials do not vary (only the coefficients hide a shift there), and those without twins; a
+/// markdown line, and summary["missed_twin_shift"].
+std::string twin_line(const std::vector<std::pair<std::string, std::optional<bench::TwinShift>>>& missed,
+                      nlohmann::json& summary) {
+  std::vector<std::string> shown, hidden, fixed, unknown;
+  for (const auto& [id, t] : missed) {
+    if (!t) {
+      unknown.push_back(id);
+    } else if (!t->recordings) {
+      fixed.push_back(id);
+    } else {
+      (t->expected_p < 0.01 ? shown : hidden).push_back(id);
+    }
+    summary["missed_twin_shift"][id] = twin_json(t);
+  }
+  auto list = [](const std::vector<std::string>& ids) {
+    return ids.empty() ? std::string("-") : fmt::format("{}", fmt::join(ids, ", "));
+  };
+  return fmt::format(
+      "missed effects by how far they move the summary means (answers' twins: the same releases without the "
+      "effect; to a test that knew the effect-free outcomes, expected p): shown at p < 0.01: {}; not: {}; trials that "
+      "do not vary, only the coefficients hide it: {}; no twins: {}\n",
+      list(shown), list(hidden), list(fixed), list(unknown));
+}
+
 /// Diagnoses every case of a recording set made elsewhere (case-NN/ with recordings, the
 /// particle named in their manifests) in process, blind, then scores the
 /// verdicts against the set's ANSWERS.json, read only here.
@@ -254,12 +302,13 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   if (!ran) return 1;
   std::string table =
       "| case | particle | truth | verdict | basis | right | held-out RMS before -> after [mm] | improvement | time "
-      "[s] |\n|---|---|---|---|---|---|---|---:|---:|\n";
+      "[s] | summary shift chi^2 / recordings |\n|---|---|---|---|---|---|---|---:|---:|---|\n";
   int effects = 0, effects_right = 0, controls = 0, controls_none = 0, controls_named = 0;
   std::vector<double> seconds, improvements;
   std::vector<std::vector<std::string>> missed_advice;
   std::vector<std::string> missed_called_decided;
   std::vector<std::optional<bool>> contradicts;
+  std::vector<std::pair<std::string, std::optional<bench::TwinShift>>> missed_twins;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
     const fs::path report = out / id / "report.json";
@@ -280,6 +329,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
     const double gain = before > 0.0 ? (before - after) / before : NAN;
     const bool missed = effect != "none" && !is_right;
     const std::vector<std::string> advice = missed ? advice_for(j, right) : std::vector<std::string>{};
+    const auto twin = bench::twin_shift(answer);
     if (effect == "none") {
       ++controls;
       controls_none += verdict == "none";
@@ -290,12 +340,14 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       if (is_right) improvements.push_back(gain);
       if (missed) missed_advice.push_back(advice);
       if (missed && calls_decided(j, right)) missed_called_decided.push_back(id);
+      if (missed) missed_twins.emplace_back(id, twin);
     }
     seconds.push_back(j.value("seconds", NAN));
     contradicts.push_back(advice_contradicts_verdict(j));
-    table += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} |\n", id,
-                         answer.value("particle", "?"), answer.value("label", effect), verdict, j.value("basis", "?"),
-                         is_right ? "yes" : "no", before, after, 100.0 * gain, j.value("seconds", NAN));
+    table +=
+        fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} | {} |\n", id,
+                    answer.value("particle", "?"), answer.value("label", effect), verdict, j.value("basis", "?"),
+                    is_right ? "yes" : "no", before, after, 100.0 * gain, j.value("seconds", NAN), twin_cell(twin));
     rows.push_back({{"case", id},
                     {"truth", effect},
                     {"verdict", verdict},
@@ -304,6 +356,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
                     {"heldout_rms_before_mm", before},
                     {"heldout_rms_after_mm", after},
                     {"seconds", j.value("seconds", NAN)},
+                    {"summary_shift", twin_json(twin)},
                     {"advice", missed ? nlohmann::json(advice) : nlohmann::json()}});
     std::cout << fmt::format("{}  truth {:18s} verdict {:28s} {}  {:.0f} s\n", id, effect, verdict,
                              is_right ? "right" : "WRONG", j.value("seconds", NAN))
@@ -322,6 +375,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   nlohmann::json summary;
   summary["missed_called_decided"] = missed_called_decided;
   table += advice_tally(missed_advice, summary);
+  table += twin_line(missed_twins, summary);
   table += contradiction_line(contradicts, summary);
   std::cout << "\n" << table;
   summary.update(nlohmann::json{{"set", set.string()},
