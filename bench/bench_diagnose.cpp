@@ -222,13 +222,16 @@ bool run_missing(const Team& team, const std::vector<std::string>& ids, const st
 }
 
 /// A case's twin shift (bench/twin_shift.hpp) as a table cell: "chi^2 noncentrality / recordings
-/// (expected p)", the recordings whose trials do not vary counted apart; "-" without twins.
+/// (expected p)", then with each (surface, test) at its own level; the recordings whose trials
+/// do not vary apart, with the largest relative shift the levels leave; "-" without twins.
 std::string twin_cell(const std::optional<bench::TwinShift>& t) {
   if (!t) return "-";
   std::vector<std::string> parts;
   if (t->recordings)
-    parts.push_back(fmt::format("{:.1f} / {} (p {:.2g})", t->noncentrality, t->recordings, t->expected_p));
-  if (t->fixed) parts.push_back(fmt::format("{} fixed", t->fixed));
+    parts.push_back(fmt::format("{:.1f} / {} (p {:.2g}); levels off {:.1f} / {} (p {:.2g})", t->noncentrality,
+                                t->recordings, t->expected_p, t->absorbed_noncentrality, t->absorbed_dof,
+                                t->absorbed_expected_p));
+  if (t->fixed) parts.push_back(fmt::format("{} fixed, {:.2g} % left", t->fixed, 100.0 * t->fixed_residual));
   return fmt::format("{}", fmt::join(parts, "; "));
 }
 
@@ -237,35 +240,43 @@ nlohmann::json twin_json(const std::optional<bench::TwinShift>& t) {
   if (!t) return nlohmann::json();
   return {{"noncentrality", t->noncentrality},
           {"recordings", t->recordings},
+          {"expected_p", t->expected_p},
+          {"absorbed_noncentrality", t->absorbed_noncentrality},
+          {"absorbed_dof", t->absorbed_dof},
+          {"absorbed_expected_p", t->absorbed_expected_p},
           {"fixed", t->fixed},
-          {"expected_p", t->expected_p}};
+          {"fixed_residual", t->fixed_residual}};
 }
 
 /// The missed effects sorted by their twin shift: those whose summary means a test knowing the
-/// effect-free outcomes would expect to show at p < 0.01, those it would not, those whose
-/// trials do not vary (only the coefficients hide a shift there), and those without twins; a
-/// markdown line, and summary["missed_twin_shift"].
+/// effect-free outcomes would expect to show at p < 0.01 with each (surface, test) at its own
+/// level, those it would show only without the levels, those it would not, those whose trials do
+/// not vary (with the relative shift the levels leave), and those without twins; a markdown
+/// line, and summary["missed_twin_shift"].
 std::string twin_line(const std::vector<std::pair<std::string, std::optional<bench::TwinShift>>>& missed,
                       nlohmann::json& summary) {
-  std::vector<std::string> shown, hidden, fixed, unknown;
+  std::vector<std::string> shown, before_levels, hidden, fixed, unknown;
   for (const auto& [id, t] : missed) {
+    summary["missed_twin_shift"][id] = twin_json(t);
     if (!t) {
       unknown.push_back(id);
     } else if (!t->recordings) {
-      fixed.push_back(id);
+      fixed.push_back(fmt::format("{} {:.2g} %", id, 100.0 * t->fixed_residual));
+    } else if (t->absorbed_expected_p < 0.01) {
+      shown.push_back(id);
     } else {
-      (t->expected_p < 0.01 ? shown : hidden).push_back(id);
+      (t->expected_p < 0.01 ? before_levels : hidden).push_back(id);
     }
-    summary["missed_twin_shift"][id] = twin_json(t);
   }
   auto list = [](const std::vector<std::string>& ids) {
     return ids.empty() ? std::string("-") : fmt::format("{}", fmt::join(ids, ", "));
   };
   return fmt::format(
-      "missed effects by how far they move the summary means (answers' twins: the same releases without the "
-      "effect; to a test that knew the effect-free outcomes, expected p): shown at p < 0.01: {}; not: {}; trials that "
-      "do not vary, only the coefficients hide it: {}; no twins: {}\n",
-      list(shown), list(hidden), list(fixed), list(unknown));
+      "missed effects by how far they move the summary means (the answers' twins: the same releases without the "
+      "effect; expected p to a test that knew the effect-free outcomes): shown at p < 0.01 with each test on each "
+      "surface at its own level: {}; only without those levels: {}; not: {}; trials that do not vary (relative "
+      "shift the levels leave): {}; no twins: {}\n",
+      list(shown), list(before_levels), list(hidden), list(fixed), list(unknown));
 }
 
 /// Diagnoses every case of a recording set made elsewhere (case-NN/ with recordings, the

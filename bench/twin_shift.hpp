@@ -21,11 +21,22 @@ struct TwinShift {
   /// The upper chi^2 tail at the statistic's expected value (noncentrality + recordings) with
   /// `recordings` degrees of freedom; 1 when no recording varies.
   double expected_p = 1.0;
+  /// The same once each test on each surface takes its own level: to first order a coefficient
+  /// (a surface's restitution, rolling or static friction) scales its test's summaries there by
+  /// one factor, fitted (weighted least squares through the origin) and taken off the shifts.
+  /// Degrees of freedom: the varying recordings less one per (surface, test) they make up.
+  double absorbed_noncentrality = 0.0;
+  int absorbed_dof = 0;
+  double absorbed_expected_p = 1.0;
+  /// Over the recordings that do not vary: the largest relative shift left once each (surface,
+  /// test) takes its mean relative shift (0 when none; a shift of 0.001 is 0.1 % of the mean).
+  double fixed_residual = 0.0;
 };
 
 /// The case's twin shift from its answer (ANSWERS.json's cases.<id>): each recording's trials'
 /// `value` (with the effect) against `value_without_effect` (the same case and releases without
-/// it). Nullopt when no recording holds two trials with both (a control, or answers without twins).
+/// it), grouped by the recording's `surface` and `test`. Nullopt when no recording holds two
+/// trials with both (a control, or answers without twins).
 std::optional<TwinShift> twin_shift(const nlohmann::json& answer);
 
 }  // namespace clumpforge::bench

@@ -1,10 +1,12 @@
 #!/bin/bash
 # bench_diagnose --recordings-set scores how far each missed effect moves the summary means,
 # from the answers' twins (each trial's value with the effect and without it, same release), on
-# stored reports (--existing-only). Analytic: effect-free trials 1..6 have a standard error of
-# sd/sqrt(6) = 0.76376; a shift of 3 standard errors gives a noncentrality of 9 (to 1e-6), and
-# 10 over 1 degree of freedom lies beyond p = 0.01; half a standard error (0.25) does not;
-# trials that do not vary are counted apart; a control has no twins.
+# stored reports (--existing-only). Analytic, to 1e-6: effect-free trials 1..6 have a standard
+# error s = sqrt(3.5/6); two drops on one surface shifted by +3s and -3s give a noncentrality of
+# 18, and no common level takes any of it off (18 over 1 degree of freedom is shown); shifts of
+# 3s on trials 1..6 and 6s on trials 2,4..12 (the same relative shift) give 18 that one level
+# takes off entirely; +0.5s twice gives 0.5, not shown; fixed trials shifted by 1 % and 3 % leave
+# 1 % about their common level; a control has no twins.
 set -u
 bench=$1
 dir=$(mktemp -d)
@@ -12,20 +14,23 @@ trap 'rm -rf "$dir"' EXIT
 python3 - "$dir" <<'PY'
 import json, math, os, sys
 d = sys.argv[1]
-se = math.sqrt(3.5) / math.sqrt(6)  # sd of 1..6 is sqrt(3.5)
-def rec(shift, vary=True):
-    w = [1.0 + i if vary else 2.0 for i in range(6)]
-    return {"trials": [{"value": x + shift, "value_without_effect": x} for x in w]}
+s = math.sqrt(3.5 / 6)
+def rec(shift, scale=1.0, vary=True, relative=False):
+    w = [scale * (1.0 + i) if vary else 2.0 for i in range(6)]
+    return {"surface": "Q235", "test": "drop",
+            "trials": [{"value": x * (1 + shift) if relative else x + shift, "value_without_effect": x} for x in w]}
 cases = {
-    "case-a": {"particle": "tuber", "effect": "adhesion", "recordings": {"drop": rec(3 * se)}},
-    "case-b": {"particle": "tuber", "effect": "adhesion", "recordings": {"drop": rec(0.5 * se)}},
-    "case-c": {"particle": "sphere", "effect": "adhesion", "recordings": {"drop": rec(0.1, vary=False)}},
-    "case-d": {"particle": "tuber", "effect": "none",
-               "recordings": {"drop": {"trials": [{"value": 1.0, "value_without_effect": None}] * 6}}},
+    "case-a": {"effect": "adhesion", "recordings": {"d1": rec(3 * s), "d2": rec(-3 * s)}},
+    "case-b": {"effect": "adhesion", "recordings": {"d1": rec(0.5 * s), "d2": rec(0.5 * s)}},
+    "case-c": {"effect": "adhesion", "recordings": {"d1": rec(0.01, vary=False, relative=True),
+                                                    "d2": rec(0.03, vary=False, relative=True)}},
+    "case-d": {"effect": "none",
+               "recordings": {"d1": {"trials": [{"value": 1.0, "value_without_effect": None}] * 6}}},
+    "case-e": {"effect": "adhesion", "recordings": {"d1": rec(3 * s), "d2": rec(6 * s, scale=2.0)}},
 }
 os.makedirs(f"{d}/set")
 json.dump({"cases": cases}, open(f"{d}/set/ANSWERS.json", "w"))
-for c, a in cases.items():
+for c in cases:
     os.makedirs(f"{d}/set/{c}")
     os.makedirs(f"{d}/out/{c}")
     json.dump({"verdict": "none", "undecidable": ["adhesion"], "seconds": 1,
@@ -35,17 +40,20 @@ PY
 "$bench" --recordings-set "$dir/set" -o "$dir/out" --existing-only >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }
 line=$(grep "missed effects by how far" "$dir/out/summary.md")
 case "$line" in
-  *"p < 0.01: case-a; not: case-b; trials that do not vary, only the coefficients hide it: case-c; no twins: -") ;;
+  *"own level: case-a; only without those levels: case-e; not: case-b; trials that do not vary (relative shift the levels leave): case-c 1 %; no twins: -") ;;
   *) echo "unexpected: $line"; exit 1 ;;
 esac
 python3 - "$dir/out/summary.json" <<'PY' || exit 1
 import json, sys
 s = json.load(open(sys.argv[1]))
 t = s["missed_twin_shift"]
-assert abs(t["case-a"]["noncentrality"] - 9.0) < 1e-6, t["case-a"]
-assert abs(t["case-b"]["noncentrality"] - 0.25) < 1e-6, t["case-b"]
-assert t["case-a"]["expected_p"] < 0.01 < t["case-b"]["expected_p"], t
-assert t["case-c"]["recordings"] == 0 and t["case-c"]["fixed"] == 1, t["case-c"]
+near = lambda a, b: abs(a - b) < 1e-6
+assert near(t["case-a"]["noncentrality"], 18) and near(t["case-a"]["absorbed_noncentrality"], 18), t["case-a"]
+assert t["case-a"]["absorbed_dof"] == 1 and t["case-a"]["absorbed_expected_p"] < 0.01, t["case-a"]
+assert near(t["case-e"]["noncentrality"], 18) and near(t["case-e"]["absorbed_noncentrality"], 0), t["case-e"]
+assert near(t["case-b"]["noncentrality"], 0.5) and t["case-b"]["expected_p"] > 0.01, t["case-b"]
+assert t["case-c"]["recordings"] == 0 and t["case-c"]["fixed"] == 2, t["case-c"]
+assert near(t["case-c"]["fixed_residual"], 0.01), t["case-c"]
 rows = {r["case"]: r for r in s["cases"]}
 assert rows["case-d"]["summary_shift"] is None, rows["case-d"]
 PY
