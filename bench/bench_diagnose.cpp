@@ -429,6 +429,8 @@ struct CaseScore {
   std::vector<std::pair<std::string, double>> stages;      ///< the report's stage_seconds, in order
   std::vector<std::string> advice;         ///< what the report says more trials would do for the truth (advice_for)
   std::optional<bool> advice_contradicts;  ///< advice_contradicts_verdict
+  std::string id;                          ///< the case's folder
+  std::optional<bench::TwinShift> twin;    ///< from its answer's twins (nullopt: a control, or none stored)
 };
 
 /// A case's report.json read for the score (nullopt when it is not JSON).
@@ -598,6 +600,10 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
   md += time_summary(outcomes, summary);
   md += missed_summary(outcomes, summary);
+  std::vector<std::pair<std::string, std::optional<bench::TwinShift>>> missed_twins;
+  for (const auto& o : outcomes)
+    if (o.truth != "none" && !o.detected) missed_twins.emplace_back(o.id, o.twin);
+  md += twin_line(missed_twins, summary);
   std::vector<std::optional<bool>> contradicts;
   for (const auto& o : outcomes) contradicts.push_back(o.advice_contradicts);
   md += contradiction_line(contradicts, summary);
@@ -859,6 +865,23 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
 }
 
 /// The leader's score of the cases diagnosed in --out: a line per case, then the summary.
+/// A generated case's answer with its recordings' twins under one "recordings" key: a
+/// one-surface answer as stored, a two-surface one's gathered from its surfaces (null when the
+/// file is missing or not JSON).
+nlohmann::json answer_recordings(const fs::path& file) {
+  std::ifstream in(file);
+  auto answer = nlohmann::json::parse(in, nullptr, false);
+  if (answer.is_discarded() || !answer.is_object()) return nlohmann::json();
+  if (answer.contains("surfaces") && answer["surfaces"].is_array()) {
+    nlohmann::json all = nlohmann::json::object();
+    for (const auto& part : answer["surfaces"])
+      if (part.is_object() && part.contains("recordings") && part["recordings"].is_object())
+        all.update(part["recordings"]);
+    answer["recordings"] = all;
+  }
+  return answer;
+}
+
 int score_generated(const std::vector<Case>& cases, const std::string& out) {
   const auto library = effect_library();
   std::vector<CaseScore> outcomes;
@@ -871,9 +894,11 @@ int score_generated(const std::vector<Case>& cases, const std::string& out) {
       std::cerr << c.id << ": unreadable report\n";
       return 1;
     }
+    o->id = c.id;
     if (c.effect) {
       o->concealed = effect_part(c).values.at(0);
       o->null_value = effect_off(effect_spec(library, *c.effect))[0];
+      o->twin = bench::twin_shift(answer_recordings(fs::path(out) / c.id / "answer.json"));
     }
     std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id,
                              truth, o->verdict, o->heldout_before, o->heldout_after, o->seconds)

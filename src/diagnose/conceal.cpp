@@ -453,6 +453,11 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
   for (std::size_t r = 0; r < all.size(); ++r) {
     auto g = run_setup(clump, table, all[r].recording, with(result.truth, true), orientations[r], true);
     if (!g) return std::unexpected(g.error());
+    if (options.effect) {
+      auto twin = run_setup(clump, table, all[r].recording, with(result.truth, false), orientations[r], false);
+      if (!twin) return std::unexpected(twin.error());
+      result.twin_summaries.push_back(std::move(twin->summaries));
+    }
     Recording rec = all[r].recording;
     rec.frame_rate_hz = options.frame_rate_hz;
     Rng rng(options.seed, 2000 + r);
@@ -473,6 +478,32 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
   }
   return result;
 }
+
+namespace {
+
+/// A number as JSON: null when it is not finite.
+std::string json_number(double v) {
+  return std::isfinite(v) ? fmt::format("{:.9g}", v) : std::string("null");
+}
+
+/// Each recording's trials' summaries with the effect and without it (its twin), under the keys
+/// an independent simulator's answers use (value, value_without_effect); {} for a control.
+std::string twins_json(const ConcealOptions& options, const ConcealResult& result) {
+  std::string out = "{";
+  for (std::size_t r = 0; r < result.twin_summaries.size() && r < result.recordings.size(); ++r) {
+    const Recording& rec = result.recordings[r];
+    std::string trials;
+    for (std::size_t i = 0; i < rec.trials.size() && i < result.twin_summaries[r].size(); ++i) {
+      trials += fmt::format("{}{{\"value\": {}, \"value_without_effect\": {}}}", i ? ", " : "",
+                            json_number(rec.trials[i].summary.value_or(NAN)), json_number(result.twin_summaries[r][i]));
+    }
+    out += fmt::format("{}\"{}\": {{\"surface\": \"{}\", \"test\": \"{}\", \"trials\": [{}]}}", r ? ", " : "",
+                       result.names[r], options.surface, to_string(rec.test), trials);
+  }
+  return out + "}";
+}
+
+}  // namespace
 
 std::string answer_json(const ConcealOptions& options, const ConcealResult& result) {
   const auto library = effect_library();
@@ -498,9 +529,9 @@ std::string answer_json(const ConcealOptions& options, const ConcealResult& resu
   return fmt::format(
       "{{\n  \"format\": \"clumpforge-concealed-answer/1\",\n  \"effect\": \"{}\",\n  \"effect_parameters\": {},\n  "
       "\"surface\": \"{}\",\n"
-      "  \"seed\": {},\n  \"baseline\": {},\n  \"truth\": {},\n  \"summary_means\": {}\n}}\n",
+      "  \"seed\": {},\n  \"baseline\": {},\n  \"truth\": {},\n  \"summary_means\": {},\n  \"recordings\": {}\n}}\n",
       options.effect ? effect_spec(library, *options.effect).name : std::string("none"), values, options.surface,
-      options.seed, coefficients(result.baseline), coefficients(result.truth), summaries);
+      options.seed, coefficients(result.baseline), coefficients(result.truth), summaries, twins_json(options, result));
 }
 
 }  // namespace clumpforge

@@ -80,6 +80,9 @@ struct ConcealResult {
   Interaction truth;                    ///< coefficients used with the effect (after concealment)
   std::vector<double> values;           ///< the effect's parameters used
   std::vector<SummaryMatch> summaries;  ///< study set-ups: baseline vs concealed effect
+  /// Per recording, per trial: its summary with the effect switched off, at the same
+  /// coefficients and release (the effect's twin, for the scorer; empty for a control).
+  std::vector<std::vector<double>> twin_summaries;
 };
 
 /// Reads what the camera tracks: "silhouette" (its centroid, with rows `pixel_mm` apart) or
