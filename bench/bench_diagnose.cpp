@@ -8,7 +8,7 @@
 // held-out improvement; writes summary.json and summary.md into --out. Resumable: a case
 // whose report.json exists is not run again, and one whose recordings are stored (with its
 // answer.json) is not made again, so deleting a run's reports diagnoses the same recordings
-// with another build.
+// with another build. --generate-only makes the recordings and answers alone.
 //   bench_diagnose --library clumps/tuber-default-diagnosis.h5 -o bench-out/diagnose
 //   mpirun -np 4 bench_diagnose --recordings-set ../shared/data/lab-like -o bench-out/lab-like
 #include <fmt/format.h>
@@ -654,7 +654,7 @@ struct BenchOptions {
   int controls = 50, trials = 4;
   std::uint64_t seed = 1;
   std::vector<std::string> only;
-  bool full_set = false, nine_set_ups = false, existing_only = false;
+  bool full_set = false, nine_set_ups = false, existing_only = false, generate_only = false;
   // The recordings come from a finer clump of the same scan than the one diagnosed (340 spheres
   // against the diagnosis's 32), as real data never comes from the diagnoser's own model.
   std::string recordings_set, orientation = "none",
@@ -687,8 +687,12 @@ void add_options(CLI::App& app, BenchOptions& o) {
                "Nine recordings per case on two surfaces, a lab's whole programme: drops 0.2/0.5/1 m, rolls "
                "35/70 mm and a tilt on steel (Q235); drops 0.2/0.5 m and a 35 mm roll on soil")
       ->excludes("--full-set");
-  app.add_flag("--existing-only", o.existing_only,
-               "Score only the cases already diagnosed in --out (a partial run's figures), run none");
+  auto* existing = app.add_flag("--existing-only", o.existing_only,
+                                "Score only the cases already diagnosed in --out (a partial run's figures), run none");
+  app.add_flag("--generate-only", o.generate_only,
+               "Make the recordings and answer of each case that has none in --out, diagnose none (diagnose or "
+               "share them later; a later run without this flag diagnoses them as they are)")
+      ->excludes(existing);
   app.add_option("--orientation", o.orientation,
                  "What each generated trial records of its release orientation: none (default), noisy:DEG, exact");
   app.add_option("--fps", o.fps, "Camera frame rate of the generated tracks [Hz] (labs: 1000, 240)");
@@ -703,7 +707,8 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--generator-clump", o.generator_name, "Which clump of the generator's library (a name)");
   app.add_option("--recordings-set", o.recordings_set,
                  "Score a recording set made elsewhere (case-NN/ folders and ANSWERS.json, e.g. "
-                 "../shared/data/lab-like) instead of generating one");
+                 "../shared/data/lab-like) instead of generating one")
+      ->excludes("--generate-only");
   app.add_option("--spheres", o.spheres,
                  "With --recordings-set: spheres of the adaptive clump each case's mesh is filled with (0: by "
                  "convergence to the scan, as diagnose does)");
@@ -839,7 +844,7 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
   // Recordings already made (their answer is written last) are diagnosed as they are: delete a
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
-    return diagnose_case(c.id, job, dir / "report.json");
+    return o.generate_only || diagnose_case(c.id, job, dir / "report.json");
   std::vector<ConcealResult> made;
   for (const auto& part : c.parts) {
     auto one = make_concealed_recordings(generator, table, part);
@@ -861,10 +866,13 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
     }
   }
   std::ofstream(dir / "answer.json") << case_answer(c, made);
+  if (o.generate_only) {
+    std::cout << fmt::format("{}: made\n", c.id) << std::flush;
+    return true;
+  }
   return diagnose_case(c.id, job, dir / "report.json");
 }
 
-/// The leader's score of the cases diagnosed in --out: a line per case, then the summary.
 /// A generated case's answer with its recordings' twins under one "recordings" key: a
 /// one-surface answer as stored, a two-surface one's gathered from its surfaces (null when the
 /// file is missing or not JSON).
@@ -882,6 +890,7 @@ nlohmann::json answer_recordings(const fs::path& file) {
   return answer;
 }
 
+/// The leader's score of the cases diagnosed in --out: a line per case, then the summary.
 int score_generated(const std::vector<Case>& cases, const std::string& out) {
   const auto library = effect_library();
   std::vector<CaseScore> outcomes;
@@ -936,11 +945,13 @@ int main(int argc, char** argv) {
   fs::create_directories(o.out);
   std::vector<std::string> ids;
   for (const auto& c : *cases) ids.push_back(c.id);
-  const bool ran = o.existing_only ||
-                   run_missing(
-                       *team, ids, [&](std::size_t i) { return !fs::exists(fs::path(o.out) / ids[i] / "report.json"); },
-                       [&](std::size_t i) { return make_and_diagnose((*cases)[i], *generator, table, o); });
-  if (!team->leader()) return ran ? 0 : 1;
+  // With --generate-only a case is missing until its answer (written last) is stored.
+  const char* stored = o.generate_only ? "answer.json" : "report.json";
+  const bool ran =
+      o.existing_only || run_missing(
+                             *team, ids, [&](std::size_t i) { return !fs::exists(fs::path(o.out) / ids[i] / stored); },
+                             [&](std::size_t i) { return make_and_diagnose((*cases)[i], *generator, table, o); });
+  if (!team->leader() || o.generate_only) return ran ? 0 : 1;
   if (!ran) return 1;
   return score_generated(*cases, o.out);
 }
