@@ -874,17 +874,20 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
 }
 
 /// A generated case's answer with its recordings' twins under one "recordings" key: a
-/// one-surface answer as stored, a two-surface one's gathered from its surfaces (null when the
-/// file is missing or not JSON).
+/// one-surface answer as stored, a two-surface one's gathered from its surfaces, each named as
+/// its folder is (`Q235-drop-0.2m`: both surfaces have a `drop-0.2m`). Null when the file is
+/// missing or not JSON.
 nlohmann::json answer_recordings(const fs::path& file) {
   std::ifstream in(file);
   auto answer = nlohmann::json::parse(in, nullptr, false);
   if (answer.is_discarded() || !answer.is_object()) return nlohmann::json();
   if (answer.contains("surfaces") && answer["surfaces"].is_array()) {
     nlohmann::json all = nlohmann::json::object();
-    for (const auto& part : answer["surfaces"])
-      if (part.is_object() && part.contains("recordings") && part["recordings"].is_object())
-        all.update(part["recordings"]);
+    for (const auto& part : answer["surfaces"]) {
+      if (!part.is_object() || !part.contains("recordings") || !part["recordings"].is_object()) continue;
+      for (const auto& [name, recording] : part["recordings"].items())
+        all[part.value("surface", "?") + "-" + name] = recording;
+    }
     answer["recordings"] = all;
   }
   return answer;

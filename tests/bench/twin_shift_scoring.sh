@@ -6,7 +6,8 @@
 # 18, and no common level takes any of it off (18 over 1 degree of freedom is shown); shifts of
 # 3s on trials 1..6 and 6s on trials 2,4..12 (the same relative shift) give 18 that one level
 # takes off entirely; +0.5s twice gives 0.5, not shown; fixed trials shifted by 1 % and 3 % leave
-# 1 % about their common level; a control has no twins.
+# 1 % about their common level; a control has no twins. A generated two-surface answer keeps
+# each surface's recordings apart.
 set -u
 bench=$1
 dir=$(mktemp -d)
@@ -56,5 +57,30 @@ assert t["case-c"]["recordings"] == 0 and t["case-c"]["fixed"] == 2, t["case-c"]
 assert near(t["case-c"]["fixed_residual"], 0.01), t["case-c"]
 rows = {r["case"]: r for r in s["cases"]}
 assert rows["case-d"]["summary_shift"] is None, rows["case-d"]
+PY
+# A generated two-surface answer: each surface's drop-0.2m is kept (as its folder names it),
+# shifted by +3s and -3s on one level each: 9 + 9 before the levels, 0 after (two levels).
+python3 - "$dir" <<'PY'
+import json, math, os, sys
+d = sys.argv[1]
+s = math.sqrt(3.5 / 6)
+def part(surface, shift):
+    w = [1.0 + i for i in range(6)]
+    return {"surface": surface, "recordings": {"drop-0.2m": {"surface": surface, "test": "drop",
+            "trials": [{"value": x + shift, "value_without_effect": x} for x in w]}}}
+os.makedirs(f"{d}/gen/adhesion-strong")
+json.dump({"effect": "adhesion", "surfaces": [part("Q235", 3 * s), part("soil", -3 * s)]},
+          open(f"{d}/gen/adhesion-strong/answer.json", "w"))
+json.dump({"verdict": "none", "undecidable": ["adhesion"], "seconds": 1,
+           "fit": {"before": {"heldout_rms_mm": 0.1}, "after": {"heldout_rms_mm": 0.1}}},
+          open(f"{d}/gen/adhesion-strong/report.json", "w"))
+PY
+"$bench" --nine-set-ups --effects adhesion --controls 0 --existing-only -o "$dir/gen" >"$dir/log" 2>&1 ||
+  { cat "$dir/log"; exit 1; }
+python3 - "$dir/gen/summary.json" <<'PY' || exit 1
+import json, sys
+t = json.load(open(sys.argv[1]))["missed_twin_shift"]["adhesion-strong"]
+assert t["recordings"] == 2 and abs(t["noncentrality"] - 18) < 1e-6, t
+assert t["absorbed_dof"] == 0 and abs(t["absorbed_noncentrality"]) < 1e-6, t
 PY
 echo ok
