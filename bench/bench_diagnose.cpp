@@ -886,7 +886,8 @@ nlohmann::json answer_recordings(const fs::path& file) {
     for (const auto& part : answer["surfaces"]) {
       if (!part.is_object() || !part.contains("recordings") || !part["recordings"].is_object()) continue;
       for (const auto& [name, recording] : part["recordings"].items())
-        all[part.value("surface", "?") + "-" + name] = recording;
+        all[(part.contains("surface") && part["surface"].is_string() ? part["surface"].get<std::string>() : "?") + "-" +
+            name] = recording;
     }
     answer["recordings"] = all;
   }

@@ -39,6 +39,12 @@ std::optional<Shift> recording_shift(const nlohmann::json& recording) {
   return s;
 }
 
+/// The string at `key`, or `fallback` when it is missing or not a string (answers are read, not
+/// trusted: a malformed one must not throw).
+std::string string_or(const nlohmann::json& object, const char* key, const std::string& fallback) {
+  return object.contains(key) && object[key].is_string() ? object[key].get<std::string>() : fallback;
+}
+
 /// One (surface, test)'s varying recordings with their level taken off: the chi^2 left.
 double absorbed_chi2(const std::vector<Shift>& group) {
   double num = 0.0, den = 0.0;
@@ -70,7 +76,7 @@ std::optional<TwinShift> twin_shift(const nlohmann::json& answer) {
   for (const auto& [name, recording] : answer["recordings"].items()) {
     const auto s = recording_shift(recording);
     if (!s) continue;
-    const std::string group = recording.value("surface", name) + "/" + recording.value("test", name);
+    const std::string group = string_or(recording, "surface", name) + "/" + string_or(recording, "test", name);
     (s->fixed ? fixed : varying)[group].push_back(*s);
   }
   if (varying.empty() && fixed.empty()) return std::nullopt;

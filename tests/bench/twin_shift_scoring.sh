@@ -6,8 +6,9 @@
 # 18, and no common level takes any of it off (18 over 1 degree of freedom is shown); shifts of
 # 3s on trials 1..6 and 6s on trials 2,4..12 (the same relative shift) give 18 that one level
 # takes off entirely; +0.5s twice gives 0.5, not shown; fixed trials shifted by 1 % and 3 % leave
-# 1 % about their common level; a control has no twins. A generated two-surface answer keeps
-# each surface's recordings apart.
+# 1 % about their common level; a control has no twins, nor does a case whose twins are
+# malformed (skipped, not thrown on). A generated two-surface answer keeps each surface's
+# recordings apart.
 set -u
 bench=$1
 dir=$(mktemp -d)
@@ -28,6 +29,10 @@ cases = {
     "case-d": {"effect": "none",
                "recordings": {"d1": {"trials": [{"value": 1.0, "value_without_effect": None}] * 6}}},
     "case-e": {"effect": "adhesion", "recordings": {"d1": rec(3 * s), "d2": rec(6 * s, scale=2.0)}},
+    # Malformed twins are skipped, not thrown on.
+    "case-f": {"effect": "adhesion", "recordings": {
+        "d1": {"surface": 5, "test": None, "trials": [{"value": "x", "value_without_effect": 1}] * 6},
+        "d2": "not an object"}},
 }
 os.makedirs(f"{d}/set")
 json.dump({"cases": cases}, open(f"{d}/set/ANSWERS.json", "w"))
@@ -41,7 +46,7 @@ PY
 "$bench" --recordings-set "$dir/set" -o "$dir/out" --existing-only >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }
 line=$(grep "missed effects by how far" "$dir/out/summary.md")
 case "$line" in
-  *"own level: case-a; only without those levels: case-e; not: case-b; trials that do not vary (relative shift the levels leave): case-c 1 %; no twins: -") ;;
+  *"own level: case-a; only without those levels: case-e; not: case-b; trials that do not vary (relative shift the levels leave): case-c 1 %; no twins: case-f") ;;
   *) echo "unexpected: $line"; exit 1 ;;
 esac
 python3 - "$dir/out/summary.json" <<'PY' || exit 1
