@@ -832,6 +832,12 @@ std::string case_answer(const Case& c, const std::vector<ConcealResult>& made) {
   return answer.dump(2) + "\n";
 }
 
+/// The folder of a two-surface case's recording: both surfaces make the same set-ups' names
+/// (`drop-0.2m`), so the surface tells them apart (`Q235-drop-0.2m`).
+std::string surface_folder(const std::string& surface, const std::string& name) {
+  return surface + "-" + name;
+}
+
 /// One generated case: its recordings and answer written into `dir` (unless stored there
 /// already), then diagnosed blind
 /// (the diagnosis sees the recordings directory and the clump, nothing else).
@@ -857,15 +863,19 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
   fs::remove_all(dir);
   for (std::size_t p = 0; p < c.parts.size(); ++p) {
     for (std::size_t r = 0; r < made[p].recordings.size(); ++r) {
-      // Two surfaces make the same set-ups' names: the surface tells them apart.
-      const std::string name = c.parts.size() > 1 ? c.parts[p].surface + "-" + made[p].names[r] : made[p].names[r];
+      const std::string name =
+          c.parts.size() > 1 ? surface_folder(c.parts[p].surface, made[p].names[r]) : made[p].names[r];
       if (auto ok = write_recording(dir / "recordings" / name, made[p].recordings[r]); !ok) {
         std::cerr << ok.error().message << "\n";
         return false;
       }
     }
   }
-  std::ofstream(dir / "answer.json") << case_answer(c, made);
+  // Written last and atomically: a stored answer.json marks the case's recordings complete.
+  if (auto ok = write_files_atomically({{dir / "answer.json", case_answer(c, made)}}); !ok) {
+    std::cerr << c.id << ": " << ok.error().message << "\n";
+    return false;
+  }
   if (o.generate_only) {
     std::cout << fmt::format("{}: made\n", c.id) << std::flush;
     return true;
@@ -875,8 +885,7 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
 
 /// A generated case's answer with its recordings' twins under one "recordings" key: a
 /// one-surface answer as stored, a two-surface one's gathered from its surfaces, each named as
-/// its folder is (`Q235-drop-0.2m`: both surfaces have a `drop-0.2m`). Null when the file is
-/// missing or not JSON.
+/// its folder is (surface_folder). Null when the file is missing or not JSON.
 nlohmann::json answer_recordings(const fs::path& file) {
   std::ifstream in(file);
   auto answer = nlohmann::json::parse(in, nullptr, false);
@@ -886,8 +895,9 @@ nlohmann::json answer_recordings(const fs::path& file) {
     for (const auto& part : answer["surfaces"]) {
       if (!part.is_object() || !part.contains("recordings") || !part["recordings"].is_object()) continue;
       for (const auto& [name, recording] : part["recordings"].items())
-        all[(part.contains("surface") && part["surface"].is_string() ? part["surface"].get<std::string>() : "?") + "-" +
-            name] = recording;
+        all[surface_folder(
+            part.contains("surface") && part["surface"].is_string() ? part["surface"].get<std::string>() : "?", name)] =
+            recording;
     }
     answer["recordings"] = all;
   }
