@@ -168,6 +168,25 @@ std::string advice_tally(const std::vector<std::vector<std::string>>& missed, nl
 }
 
 /// The particle a case's recordings name: the first manifest's mesh (relative to it) and density.
+/// A verdict that names one effect (not none, ambiguous, unexplained or undecidable).
+bool names_an_effect(const std::string& verdict) {
+  return verdict != "none" && verdict != "ambiguous" && verdict != "unexplained" && verdict != "undecidable";
+}
+
+/// The effects named as another effect: the worst miss, a user told a wrong cause. Each entry is
+/// (the case, the name given).
+std::string misnamed_line(const std::vector<std::pair<std::string, std::string>>& misnamed, int effects,
+                          nlohmann::json& summary) {
+  std::vector<std::string> shown;
+  summary["effects_named_as_another"] = nlohmann::json::array();
+  for (const auto& [id, verdict] : misnamed) {
+    shown.push_back(fmt::format("{} as {}", id, verdict));
+    summary["effects_named_as_another"].push_back({{"case", id}, {"verdict", verdict}});
+  }
+  return fmt::format("effects named as another effect (a wrong name): {}/{}{}\n", misnamed.size(), effects,
+                     shown.empty() ? std::string() : fmt::format(" ({})", fmt::join(shown, ", ")));
+}
+
 std::optional<std::pair<fs::path, double>> case_particle(const fs::path& case_dir) {
   std::vector<fs::path> manifests;
   for (const auto& entry : fs::directory_iterator(case_dir)) {
@@ -318,6 +337,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   std::vector<double> seconds, improvements;
   std::vector<std::vector<std::string>> missed_advice;
   std::vector<std::string> missed_called_decided;
+  std::vector<std::pair<std::string, std::string>> misnamed;
   std::vector<std::optional<bool>> contradicts;
   std::vector<std::pair<std::string, std::optional<bench::TwinShift>>> missed_twins;
   nlohmann::json rows = nlohmann::json::array();
@@ -333,8 +353,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
     const std::string effect = answer.value("effect", "none"), verdict = j.value("verdict", "?");
     const auto right = right_verdicts(effect);
     const bool is_right = std::find(right.begin(), right.end(), verdict) != right.end();
-    const bool named_effect =
-        verdict != "none" && verdict != "ambiguous" && verdict != "unexplained" && verdict != "undecidable";
+    const bool named_effect = names_an_effect(verdict);
     const double before = j["fit"]["before"].value("heldout_rms_mm", NAN),
                  after = j["fit"]["after"].value("heldout_rms_mm", NAN);
     const double gain = before > 0.0 ? (before - after) / before : NAN;
@@ -351,6 +370,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       if (is_right) improvements.push_back(gain);
       if (missed) missed_advice.push_back(advice);
       if (missed && calls_decided(j, right)) missed_called_decided.push_back(id);
+      if (missed && named_effect) misnamed.emplace_back(id, verdict);
       if (missed) missed_twins.emplace_back(id, twin);
     }
     seconds.push_back(j.value("seconds", NAN));
@@ -384,6 +404,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       missed_called_decided.size(), missed_advice.size(),
       missed_called_decided.empty() ? std::string() : fmt::format(" ({})", fmt::join(missed_called_decided, ", ")));
   nlohmann::json summary;
+  table += misnamed_line(misnamed, effects, summary);
   summary["missed_called_decided"] = missed_called_decided;
   table += advice_tally(missed_advice, summary);
   table += twin_line(missed_twins, summary);
@@ -584,6 +605,11 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   md += fmt::format("\nfalse-positive rate on {} controls (any verdict but none): {}/{} = {:.1f} %\n", control_count,
                     false_positives, control_count, 100.0 * fpr);
   md += fmt::format("controls blamed on an effect (named or ambiguous): {}/{}\n", named_controls, control_count);
+  std::vector<std::pair<std::string, std::string>> misnamed;
+  for (const auto& o : outcomes)
+    if (o.truth != "none" && !o.detected && names_an_effect(o.verdict))
+      misnamed.emplace_back(fmt::format("{} ({})", o.truth, o.magnitude), o.verdict);
+  md += misnamed_line(misnamed, static_cast<int>(outcomes.size()) - control_count, summary);
   md += fmt::format(
       "strong effects missed that the report called decided (neither in its undecidable list nor an ambiguous "
       "candidate): {}/{}\n",
