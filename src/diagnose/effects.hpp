@@ -44,7 +44,9 @@ struct EffectSpec {
   /// Where it moves the recorded outcomes beyond the release horizon (rebound heights, drifts,
   /// roll distances), when more than `tests`: a flattened tuber rolling on its rim drops onto
   /// the incline at every turn, so a speed-dependent restitution acts on its rolls' outcomes,
-  /// while a sphere's rolling track shows no impact to fit. Empty: `tests`.
+  /// while a sphere's rolling track shows no impact to fit; and a restitution law acts on the
+  /// resting contacts of a tilt (an elastic-plastic one, elastic below its yield speed, leaves a
+  /// clump of 128 or more spheres chattering, and it slips degrees earlier). Empty: `tests`.
   std::vector<LabTest> outcome_tests_beyond_horizon = {};
   const std::vector<LabTest>& outcome_tests() const {
     return outcome_tests_beyond_horizon.empty() ? tests : outcome_tests_beyond_horizon;
