@@ -167,7 +167,6 @@ std::string advice_tally(const std::vector<std::vector<std::string>>& missed, nl
                      missed.size(), each, parts.empty() ? std::string("-") : fmt::format("{}", fmt::join(parts, ", ")));
 }
 
-/// The particle a case's recordings name: the first manifest's mesh (relative to it) and density.
 /// A verdict that names one effect (not none, ambiguous, unexplained or undecidable).
 bool names_an_effect(const std::string& verdict) {
   return verdict != "none" && verdict != "ambiguous" && verdict != "unexplained" && verdict != "undecidable";
@@ -187,6 +186,7 @@ std::string misnamed_line(const std::vector<std::pair<std::string, std::string>>
                      shown.empty() ? std::string() : fmt::format(" ({})", fmt::join(shown, ", ")));
 }
 
+/// The particle a case's recordings name: the first manifest's mesh (relative to it) and density.
 std::optional<std::pair<fs::path, double>> case_particle(const fs::path& case_dir) {
   std::vector<fs::path> manifests;
   for (const auto& entry : fs::directory_iterator(case_dir)) {
@@ -563,6 +563,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   }
   int control_count = 0, false_positives = 0, named_controls = 0, strong_count = 0, missed_decided = 0;
   int missed = 0, overclaimed = 0, ambiguous_right = 0;
+  std::vector<std::pair<std::string, std::string>> misnamed;  ///< (truth and magnitude, the wrong name)
   std::vector<double> improvements, seconds, decided_absent;
   nlohmann::json summary;
   for (const auto& o : outcomes) {
@@ -571,7 +572,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
       ++control_count;
       false_positives += o.verdict != "none";
       // Blamed on an effect: a name, or an ambiguous pair (unexplained and undecidable blame none).
-      named_controls += o.verdict != "none" && o.verdict != "unexplained" && o.verdict != "undecidable";
+      named_controls += names_an_effect(o.verdict) || o.verdict == "ambiguous";
       // What a `none` on a control rules out: the effects it does not call undecidable.
       if (o.verdict == "none") decided_absent.push_back(static_cast<double>(library.size()) - o.undecidable);
     } else {
@@ -583,6 +584,8 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
       missed += !o.detected;
       overclaimed += o.overclaimed();
       ambiguous_right += o.ambiguous_with_truth;
+      if (!o.detected && names_an_effect(o.verdict))
+        misnamed.emplace_back(fmt::format("{} ({})", o.truth, o.magnitude), o.verdict);
     }
   }
   md += "\n| effect | realistic | strong |\n|---|---:|---:|\n";
@@ -605,10 +608,6 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
   md += fmt::format("\nfalse-positive rate on {} controls (any verdict but none): {}/{} = {:.1f} %\n", control_count,
                     false_positives, control_count, 100.0 * fpr);
   md += fmt::format("controls blamed on an effect (named or ambiguous): {}/{}\n", named_controls, control_count);
-  std::vector<std::pair<std::string, std::string>> misnamed;
-  for (const auto& o : outcomes)
-    if (o.truth != "none" && !o.detected && names_an_effect(o.verdict))
-      misnamed.emplace_back(fmt::format("{} ({})", o.truth, o.magnitude), o.verdict);
   md += misnamed_line(misnamed, static_cast<int>(outcomes.size()) - control_count, summary);
   md += fmt::format(
       "strong effects missed that the report called decided (neither in its undecidable list nor an ambiguous "
@@ -921,9 +920,7 @@ nlohmann::json answer_recordings(const fs::path& file) {
     for (const auto& part : answer["surfaces"]) {
       if (!part.is_object() || !part.contains("recordings") || !part["recordings"].is_object()) continue;
       for (const auto& [name, recording] : part["recordings"].items())
-        all[surface_folder(
-            part.contains("surface") && part["surface"].is_string() ? part["surface"].get<std::string>() : "?", name)] =
-            recording;
+        all[surface_folder(bench::string_or(part, "surface", "?"), name)] = recording;
     }
     answer["recordings"] = all;
   }

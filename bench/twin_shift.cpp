@@ -39,12 +39,6 @@ std::optional<Shift> recording_shift(const nlohmann::json& recording) {
   return s;
 }
 
-/// The string at `key`, or `fallback` when it is missing or not a string (answers are read, not
-/// trusted: a malformed one must not throw).
-std::string string_or(const nlohmann::json& object, const char* key, const std::string& fallback) {
-  return object.contains(key) && object[key].is_string() ? object[key].get<std::string>() : fallback;
-}
-
 /// One (surface, test)'s varying recordings with their level taken off: the chi^2 left.
 double absorbed_chi2(const std::vector<Shift>& group) {
   double num = 0.0, den = 0.0;
@@ -69,6 +63,11 @@ double fixed_residual(const std::vector<Shift>& group) {
 }
 
 }  // namespace
+
+std::string string_or(const nlohmann::json& object, const char* key, const std::string& fallback) {
+  return object.is_object() && object.contains(key) && object[key].is_string() ? object[key].get<std::string>()
+                                                                               : fallback;
+}
 
 std::optional<TwinShift> twin_shift(const nlohmann::json& answer) {
   if (!answer.is_object() || !answer.contains("recordings") || !answer["recordings"].is_object()) return std::nullopt;

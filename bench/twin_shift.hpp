@@ -39,4 +39,8 @@ struct TwinShift {
 /// trials with both (a control, or answers without twins).
 std::optional<TwinShift> twin_shift(const nlohmann::json& answer);
 
+/// The string at `key`, or `fallback` when it is missing or not a string (answers are read, not
+/// trusted: a malformed one must not throw).
+std::string string_or(const nlohmann::json& object, const char* key, const std::string& fallback);
+
 }  // namespace clumpforge::bench
