@@ -72,8 +72,11 @@ def inside(folder, name, where):
 def refilm_track(path, shown, step, rate, added, rng):
     """The track's rows at the new frame rate, x_m and z_m with `added` noise (metres); `shown`
     is the path messages name (the user's file, not its copy)."""
-    with path.open(newline="") as f:
-        rows = list(csv.reader(f))
+    try:
+        with path.open(newline="") as f:
+            rows = list(csv.reader(f))
+    except (OSError, UnicodeDecodeError, csv.Error) as e:
+        raise Refusal(f"{shown}: cannot read the track ({e.__class__.__name__}: {getattr(e, 'strerror', None) or e})") from None
     if not rows or "t_s" not in rows[0]:
         raise Refusal(f"{shown}: no t_s column in the header")
     header = rows[0]
@@ -106,6 +109,13 @@ def refilm_recording(manifest, shown, fps, noise, rng):
         recording = json.loads(manifest.read_text())
     except (OSError, ValueError) as e:
         raise Refusal(f"{where}: {e}") from None
+    if not isinstance(recording, dict):
+        raise Refusal(f"{where}: not a JSON object")
+    trials = recording.get("trials", [])
+    if not isinstance(trials, list) or not all(isinstance(t, dict) for t in trials):
+        raise Refusal(f"{where}: trials must be a list of objects")
+    if any(not isinstance(t.get("summary", {}), dict) for t in trials):
+        raise Refusal(f"{where}: a trial's summary must be an object")
     test = recording.get("test")
     camera = recording.get("camera") or {}
     rate = camera.get("frame_rate_hz")
@@ -119,7 +129,7 @@ def refilm_recording(manifest, shown, fps, noise, rng):
     added = math.sqrt(noise * noise - recorded_noise * recorded_noise)
     folder = manifest.parent
     done = set()
-    for trial in recording.get("trials", []):
+    for trial in trials:
         if "track" in trial:
             path = inside(folder, str(trial["track"]), where)
             if path in done:

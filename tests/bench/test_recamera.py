@@ -126,6 +126,16 @@ def test_bad_options_and_recordings_are_refused_and_nothing_is_written(tmp_path)
     (tmp_path / "secret.csv").write_text("t_s,x_m,z_m\n0,0,0\n")
     refused(tmp_path, leaving, out, "--noise", "5e-4", message="track '../../../secret.csv' leaves its recording's folder")
     assert (tmp_path / "secret.csv").read_text() == "t_s,x_m,z_m\n0,0,0\n"
+    missing = tmp_path / "missing"
+    make_set(missing, track_name="trial-09.csv")
+    refused(tmp_path, missing, out, "--noise", "5e-4",
+            message=f"{missing / 'case-01' / 'drop-Q235-0.2' / 'trial-09.csv'}: cannot read the track")
+    for name, bad, what in (("listed", '{"trials": {"a": 1}}', "trials must be a list of objects"),
+                            ("summary", '{"trials": [{"id": "1", "summary": [1]}]}', "a trial's summary must be an object"),
+                            ("array", "[1, 2]", "not a JSON object")):
+        rec = make_set(tmp_path / name)
+        (rec / "recording.json").write_text(bad)
+        refused(tmp_path, tmp_path / name, out, "--noise", "5e-4", message=f"{rec / 'recording.json'}: {what}")
     broken = tmp_path / "broken"
     rec = make_set(broken)
     (rec / "recording.json").write_text("{ not json")
