@@ -27,6 +27,7 @@
 #include <optional>
 #include <sstream>
 
+#include "compare_runs.hpp"
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
 #include "diagnose/conceal.hpp"
@@ -56,11 +57,7 @@ const ConcealOptions& effect_part(const Case& c) {
   return c.parts.front();
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using bench::median;
 
 /// The verdicts that name a recording set's effect right: its answer file's vocabulary
 /// mapped onto the candidate library's (a speed-dependent restitution is right under
@@ -694,6 +691,8 @@ struct BenchOptions {
   bool no_pre_roll = false;
   std::string camera_target = "silhouette";
   double pixel_mm = 0.1;
+  /// Another run's --out whose reports are set beside this run's (compare.md, compare.json).
+  std::string compare;
 };
 
 void add_options(CLI::App& app, BenchOptions& o) {
@@ -743,6 +742,11 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "(default 3: 64, 128, 256); with --recordings-set, fills of the mesh with 2, 4, ... times the "
                  "spheres (default 2, as diagnose)")
       ->check(CLI::Range(0, 4));
+  app.add_option("--compare", o.compare,
+                 "Another run's --out (the same cases: the same recordings diagnosed by another build, or the set "
+                 "filmed another way): after scoring, each case's verdict, basis and time beside that run's, the "
+                 "verdicts and bases that changed and the per-case time ratios (compare.md, compare.json)")
+      ->excludes("--generate-only");
 }
 
 /// The clump the recordings are made with: a finer (or other) clump than the one diagnosed,
@@ -955,6 +959,26 @@ int score_generated(const std::vector<Case>& cases, const std::string& out) {
   return 0;
 }
 
+/// The leader's comparison of --out with another run's reports (bench/compare_runs.hpp), printed
+/// and written as compare.md and compare.json into --out.
+int write_comparison(const fs::path& out, const fs::path& other) {
+  auto comparison = bench::compare_runs(out, other);
+  if (!comparison) {
+    std::cerr << comparison.error().message << "\n";
+    return 1;
+  }
+  const std::string md = bench::comparison_markdown(*comparison, other.string());
+  std::cout << "\n" << md;
+  if (auto ok = write_files_atomically(
+          {{out / "compare.md", md},
+           {out / "compare.json", bench::comparison_json(*comparison, other.string()).dump(2) + "\n"}});
+      !ok) {
+    std::cerr << ok.error().message << "\n";
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -968,10 +992,14 @@ int main(int argc, char** argv) {
     std::cerr << team.error().message << "\n";
     return 1;
   }
+  // The comparison, when asked for, once the leader has scored the run.
+  auto compared = [&](int scored) {
+    return scored != 0 || !team->leader() || o.compare.empty() ? scored : write_comparison(o.out, o.compare);
+  };
   if (!o.recordings_set.empty())
-    return run_recordings_set(o.recordings_set, o.out,
-                              cli::DiagnoseJob{.spheres = o.spheres, .finer_clumps = o.finer_clumps.value_or(2)},
-                              o.existing_only, *team);
+    return compared(run_recordings_set(
+        o.recordings_set, o.out, cli::DiagnoseJob{.spheres = o.spheres, .finer_clumps = o.finer_clumps.value_or(2)},
+        o.existing_only, *team));
   const MaterialTable table = default_material_table();
   auto generator = generator_clump(o);
   auto cases = generator ? generated_cases(o, table) : Result<std::vector<Case>>(std::unexpected(generator.error()));
@@ -990,5 +1018,5 @@ int main(int argc, char** argv) {
                              [&](std::size_t i) { return make_and_diagnose((*cases)[i], *generator, table, o); });
   if (!team->leader() || o.generate_only) return ran ? 0 : 1;
   if (!ran) return 1;
-  return score_generated(*cases, o.out);
+  return compared(score_generated(*cases, o.out));
 }

@@ -1,0 +1,148 @@
+#include "compare_runs.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+
+namespace fs = std::filesystem;
+
+namespace clumpforge::bench {
+
+double median(std::vector<double> values) {
+  if (values.empty()) return NAN;
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+namespace {
+
+struct StoredReport {
+  std::string verdict, basis;
+  double seconds = NAN;
+};
+
+/// The reports stored in `run` (each case folder's report.json), by case name.
+Result<std::map<std::string, StoredReport>> stored_reports(const fs::path& run) {
+  if (!fs::is_directory(run)) return fail(ErrorCode::NotFound, run.string() + ": no such run folder");
+  std::map<std::string, StoredReport> out;
+  for (const auto& entry : fs::directory_iterator(run)) {
+    const fs::path file = entry.path() / "report.json";
+    if (!entry.is_directory() || !fs::is_regular_file(file)) continue;
+    std::ifstream in(file);
+    const auto j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.is_object())
+      return fail(ErrorCode::ParseError, file.string() + ": not a JSON object (a diagnose report)");
+    auto text = [&](const char* key) {
+      return j.contains(key) && j[key].is_string() ? j[key].get<std::string>() : std::string("?");
+    };
+    out[entry.path().filename().string()] = {
+        text("verdict"), text("basis"),
+        j.contains("seconds") && j["seconds"].is_number() ? j["seconds"].get<double>() : NAN};
+  }
+  return out;
+}
+
+/// The finite ratios this run's time over the other's, case by case.
+std::vector<double> time_ratios(const RunComparison& c) {
+  std::vector<double> ratios;
+  for (const auto& k : c.cases)
+    if (std::isfinite(k.seconds_before) && std::isfinite(k.seconds_after) && k.seconds_before > 0.0)
+      ratios.push_back(k.seconds_after / k.seconds_before);
+  return ratios;
+}
+
+std::vector<std::string> changed(const RunComparison& c, bool verdict) {
+  std::vector<std::string> ids;
+  for (const auto& k : c.cases)
+    if (verdict ? k.verdict_before != k.verdict_after : k.basis_before != k.basis_after) ids.push_back(k.id);
+  return ids;
+}
+
+std::vector<double> seconds_of(const RunComparison& c, bool after) {
+  std::vector<double> s;
+  for (const auto& k : c.cases)
+    if (const double t = after ? k.seconds_after : k.seconds_before; std::isfinite(t)) s.push_back(t);
+  return s;
+}
+
+std::string listed(const std::vector<std::string>& ids) {
+  return ids.empty() ? std::string() : fmt::format(" ({})", fmt::join(ids, ", "));
+}
+
+}  // namespace
+
+Result<RunComparison> compare_runs(const fs::path& here, const fs::path& there) {
+  auto mine = stored_reports(here);
+  if (!mine) return std::unexpected(mine.error());
+  auto theirs = stored_reports(there);
+  if (!theirs) return std::unexpected(theirs.error());
+  RunComparison out;
+  for (const auto& [id, r] : *mine) {
+    const auto other = theirs->find(id);
+    if (other == theirs->end()) {
+      out.only_here.push_back(id);
+      continue;
+    }
+    out.cases.push_back(
+        {id, other->second.verdict, r.verdict, other->second.basis, r.basis, other->second.seconds, r.seconds});
+  }
+  for (const auto& [id, r] : *theirs)
+    if (!mine->contains(id)) out.only_there.push_back(id);
+  return out;
+}
+
+std::string comparison_markdown(const RunComparison& c, const std::string& there_name) {
+  std::string md = fmt::format(
+      "compared with {}: {} cases diagnosed in both\n\n| case | verdict there -> here | basis there -> here | time "
+      "there -> here [s] | ratio |\n|---|---|---|---:|---:|\n",
+      there_name, c.cases.size());
+  for (const auto& k : c.cases) {
+    auto pair = [](const std::string& a, const std::string& b) { return a == b ? a : fmt::format("{} -> {}", a, b); };
+    const double ratio = k.seconds_after / k.seconds_before;
+    md += fmt::format("| {} | {} | {} | {:.1f} -> {:.1f} | {} |\n", k.id, pair(k.verdict_before, k.verdict_after),
+                      pair(k.basis_before, k.basis_after), k.seconds_before, k.seconds_after,
+                      std::isfinite(ratio) ? fmt::format("{:.2f}", ratio) : std::string("-"));
+  }
+  const auto ratios = time_ratios(c);
+  const auto verdicts = changed(c, true), bases = changed(c, false);
+  md += fmt::format("\nverdicts changed: {}/{}{}\nbases changed: {}/{}{}\n", verdicts.size(), c.cases.size(),
+                    listed(verdicts), bases.size(), c.cases.size(), listed(bases));
+  if (!ratios.empty())
+    md += fmt::format(
+        "time per case, here over there: {:.2f}-{:.2f}, median {:.2f}; median time there {:.1f} s, here {:.1f} s\n",
+        *std::min_element(ratios.begin(), ratios.end()), *std::max_element(ratios.begin(), ratios.end()),
+        median(ratios), median(seconds_of(c, false)), median(seconds_of(c, true)));
+  if (!c.only_here.empty() || !c.only_there.empty())
+    md += fmt::format("diagnosed here only: {}{}; there only: {}{}\n", c.only_here.size(), listed(c.only_here),
+                      c.only_there.size(), listed(c.only_there));
+  return md;
+}
+
+nlohmann::json comparison_json(const RunComparison& c, const std::string& there_name) {
+  nlohmann::json cases = nlohmann::json::array();
+  for (const auto& k : c.cases)
+    cases.push_back({{"case", k.id},
+                     {"verdict_there", k.verdict_before},
+                     {"verdict_here", k.verdict_after},
+                     {"basis_there", k.basis_before},
+                     {"basis_here", k.basis_after},
+                     {"seconds_there", k.seconds_before},
+                     {"seconds_here", k.seconds_after}});
+  const auto ratios = time_ratios(c);
+  return {{"there", there_name},
+          {"cases", cases},
+          {"verdicts_changed", changed(c, true)},
+          {"bases_changed", changed(c, false)},
+          {"median_time_ratio", ratios.empty() ? nlohmann::json() : nlohmann::json(median(ratios))},
+          {"median_seconds_there", median(seconds_of(c, false))},
+          {"median_seconds_here", median(seconds_of(c, true))},
+          {"only_here", c.only_here},
+          {"only_there", c.only_there}};
+}
+
+}  // namespace clumpforge::bench
