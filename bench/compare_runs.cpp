@@ -51,22 +51,22 @@ Result<std::map<std::string, StoredReport>> stored_reports(const fs::path& run) 
 std::vector<double> time_ratios(const RunComparison& c) {
   std::vector<double> ratios;
   for (const auto& k : c.cases)
-    if (std::isfinite(k.seconds_before) && std::isfinite(k.seconds_after) && k.seconds_before > 0.0)
-      ratios.push_back(k.seconds_after / k.seconds_before);
+    if (std::isfinite(k.seconds_there) && std::isfinite(k.seconds_here) && k.seconds_there > 0.0)
+      ratios.push_back(k.seconds_here / k.seconds_there);
   return ratios;
 }
 
 std::vector<std::string> changed(const RunComparison& c, bool verdict) {
   std::vector<std::string> ids;
   for (const auto& k : c.cases)
-    if (verdict ? k.verdict_before != k.verdict_after : k.basis_before != k.basis_after) ids.push_back(k.id);
+    if (verdict ? k.verdict_there != k.verdict_here : k.basis_there != k.basis_here) ids.push_back(k.id);
   return ids;
 }
 
-std::vector<double> seconds_of(const RunComparison& c, bool after) {
+std::vector<double> seconds_of(const RunComparison& c, bool here) {
   std::vector<double> s;
   for (const auto& k : c.cases)
-    if (const double t = after ? k.seconds_after : k.seconds_before; std::isfinite(t)) s.push_back(t);
+    if (const double t = here ? k.seconds_here : k.seconds_there; std::isfinite(t)) s.push_back(t);
   return s;
 }
 
@@ -103,9 +103,9 @@ std::string comparison_markdown(const RunComparison& c, const std::string& there
       there_name, c.cases.size());
   for (const auto& k : c.cases) {
     auto pair = [](const std::string& a, const std::string& b) { return a == b ? a : fmt::format("{} -> {}", a, b); };
-    const double ratio = k.seconds_after / k.seconds_before;
-    md += fmt::format("| {} | {} | {} | {:.1f} -> {:.1f} | {} |\n", k.id, pair(k.verdict_before, k.verdict_after),
-                      pair(k.basis_before, k.basis_after), k.seconds_before, k.seconds_after,
+    const double ratio = k.seconds_here / k.seconds_there;
+    md += fmt::format("| {} | {} | {} | {:.1f} -> {:.1f} | {} |\n", k.id, pair(k.verdict_there, k.verdict_here),
+                      pair(k.basis_there, k.basis_here), k.seconds_there, k.seconds_here,
                       std::isfinite(ratio) ? fmt::format("{:.2f}", ratio) : std::string("-"));
   }
   const auto ratios = time_ratios(c);
@@ -127,12 +127,12 @@ nlohmann::json comparison_json(const RunComparison& c, const std::string& there_
   nlohmann::json cases = nlohmann::json::array();
   for (const auto& k : c.cases)
     cases.push_back({{"case", k.id},
-                     {"verdict_there", k.verdict_before},
-                     {"verdict_here", k.verdict_after},
-                     {"basis_there", k.basis_before},
-                     {"basis_here", k.basis_after},
-                     {"seconds_there", k.seconds_before},
-                     {"seconds_here", k.seconds_after}});
+                     {"verdict_there", k.verdict_there},
+                     {"verdict_here", k.verdict_here},
+                     {"basis_there", k.basis_there},
+                     {"basis_here", k.basis_here},
+                     {"seconds_there", k.seconds_there},
+                     {"seconds_here", k.seconds_here}});
   const auto ratios = time_ratios(c);
   return {{"there", there_name},
           {"cases", cases},

@@ -18,11 +18,11 @@ namespace clumpforge::bench {
 /// summaries); NaN when empty.
 double median(std::vector<double> values);
 
-/// One case diagnosed in both runs: `before` is the other run's (--compare), `after` this run's.
+/// One case diagnosed in both runs: `there` is the other run (--compare), `here` this run (--out).
 struct CaseComparison {
   std::string id;
-  std::string verdict_before, verdict_after, basis_before, basis_after;
-  double seconds_before = 0.0, seconds_after = 0.0;
+  std::string verdict_there, verdict_here, basis_there, basis_here;
+  double seconds_there = 0.0, seconds_here = 0.0;
 };
 
 struct RunComparison {

@@ -298,7 +298,8 @@ void track_plots(const Context& c, DiagnoseResult& result, const std::vector<Tri
 double largest_z2(const std::vector<OutcomeComparison>& comparisons);
 std::vector<const EnsembleHypothesis*> passing_hypotheses(const EnsembleResult& ens, double min_delta_bic,
                                                           std::vector<std::string>& notes);
-/// A rival within the margin of the best passing hypothesis, on either of its draws (or null).
+/// A rival within the margin of the best passing hypothesis, on either of its draws, whether or
+/// not it reaches the margin over the null itself (or null).
 const EnsembleHypothesis* closest_rival(const EnsembleResult& ens, const EnsembleHypothesis& best,
                                         double min_delta_bic);
 void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
