@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <variant>
 
 #include "diagnose/release.hpp"
 #include "diagnose/tracks.hpp"
@@ -422,16 +423,6 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
   return plans;
 }
 
-/// Where a tilt's replay starts: the plate at 70 % of the friction angle atan(mu_s), the body
-/// settled on it. Below that angle nothing slides (a four-square block starts sliding at the
-/// friction angle; an adhesion or an offset centre of mass moves the onset up or not at all), so
-/// the replay's slip angle and slide time are those of a plate that started level, at a fifth
-/// of the cost (the onset takes 4-5 s of plate travel at 5 deg/s). A replay that slides within
-/// 2 degrees of its start is run again from level (`slid_near_start`).
-double tilt_start_deg(const Interaction& interaction) {
-  return 0.7 * std::atan(interaction.static_friction) * 180.0 / std::numbers::pi;
-}
-
 bool slid_near_start(const std::vector<std::pair<Outcome, double>>& measured, double start_deg) {
   if (!(start_deg > 0.0)) return false;
   const auto it =
@@ -477,7 +468,7 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
     auto world = make_lab_world(*ev.clump, *ev.table, rec, lab);
     if (!world) return std::unexpected(world.error());
     std::vector<std::vector<std::pair<Outcome, double>>> measured(plan.orientations.size());
-    const double tilt_start = rec.test == LabTest::Tilt ? tilt_start_deg(world->interaction) : 0.0;
+    const double tilt_start = rec.test == LabTest::Tilt ? tilt_start_deg(world->interaction, lab.terms) : 0.0;
     tbb::parallel_for(std::size_t{0}, plan.orientations.size(), [&](std::size_t k) {
       ReplayOptions replay;
       replay.duration = plan.duration;
@@ -1044,6 +1035,13 @@ Result<void> replay_afresh(const Evaluator& ev, const std::vector<TrialScore>& s
 }
 
 }  // namespace
+
+double tilt_start_deg(const Interaction& interaction, const std::vector<PhysicsTerm>& terms) {
+  const bool restitution_law = std::any_of(terms.begin(), terms.end(), [](const PhysicsTerm& t) {
+    return std::holds_alternative<ViscoelasticRestitution>(t) || std::holds_alternative<ElasticPlasticRestitution>(t);
+  });
+  return restitution_law ? 0.0 : 0.7 * std::atan(interaction.static_friction) * 180.0 / std::numbers::pi;
+}
 
 std::vector<Eigen::Quaterniond> ensemble_orientations(LabTest test, const std::vector<Eigen::Quaterniond>& recorded,
                                                       const EnsembleOptions& options, std::uint64_t stream) {

@@ -139,6 +139,17 @@ constexpr double kConsistentTail = 1e-4;
 /// means (at least one).
 double null_dof(int outcomes, std::size_t free);
 
+/// Where a tilt's replay starts: the plate at 70 % of the friction angle atan(mu_s), the body
+/// settled on it. Below that angle nothing slides (a four-square block starts sliding at the
+/// friction angle; an adhesion or an offset centre of mass moves the onset up or not at all), so
+/// the replay's slip angle and slide time are those of a plate that started level, at a fifth
+/// of the cost (the onset takes 4-5 s of plate travel at 5 deg/s). A replay that slides within
+/// 2 degrees of its start is run again from level. A model with a speed-dependent restitution
+/// starts level (0): its law leaves a contact that began slowly nearly undamped, and a body set
+/// on a plate already tilted does not settle as on a level one (test
+/// `EnsembleTilt.ARestitutionLawsTiltReplayStartsLevel`).
+double tilt_start_deg(const Interaction& interaction, const std::vector<PhysicsTerm>& terms);
+
 /// Whether replays of a model with `fitted` parameters calibrated on the outcomes are
 /// consistent with the recordings: the means' chi^2 (over their number less `fitted`, at
 /// least one) and the spreads' (over their number) each have an upper tail of

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -836,4 +837,14 @@ TEST(EnsembleRival, ACandidateWithinTheMarginOnEitherDrawMakesTheVerdictAmbiguou
       EXPECT_EQ(result.effect, Effect::ViscoelasticRestitution);
     }
   }
+}
+
+// A restitution candidate's tilt replays start from a level plate, as the generator's do; other
+// models start at 70 % of the friction angle (tests/dem/test_lab.cpp: why).
+TEST(EnsembleTilt, ARestitutionLawsTiltReplayStartsLevel) {
+  const Interaction steel{0.693, 0.41, 0.003566};
+  EXPECT_NEAR(tilt_start_deg(steel, {}), 0.7 * std::atan(0.41) * 180.0 / std::numbers::pi, 1e-12);
+  EXPECT_NEAR(tilt_start_deg(steel, {PhysicsTerm{QuadraticAirDrag{}}}), tilt_start_deg(steel, {}), 1e-12);
+  EXPECT_EQ(tilt_start_deg(steel, {PhysicsTerm{ViscoelasticRestitution{.exponent = 0.5}}}), 0.0);
+  EXPECT_EQ(tilt_start_deg(steel, {PhysicsTerm{ElasticPlasticRestitution{.yield_speed = 0.05}}}), 0.0);
 }
