@@ -8,6 +8,8 @@
 #include <fstream>
 #include <map>
 
+#include "twin_shift.hpp"
+
 namespace fs = std::filesystem;
 
 namespace clumpforge::bench {
@@ -37,11 +39,8 @@ Result<std::map<std::string, StoredReport>> stored_reports(const fs::path& run) 
     const auto j = nlohmann::json::parse(in, nullptr, false);
     if (j.is_discarded() || !j.is_object())
       return fail(ErrorCode::ParseError, file.string() + ": not a JSON object (a diagnose report)");
-    auto text = [&](const char* key) {
-      return j.contains(key) && j[key].is_string() ? j[key].get<std::string>() : std::string("?");
-    };
     out[entry.path().filename().string()] = {
-        text("verdict"), text("basis"),
+        string_or(j, "verdict", "?"), string_or(j, "basis", "?"),
         j.contains("seconds") && j["seconds"].is_number() ? j["seconds"].get<double>() : NAN};
   }
   return out;

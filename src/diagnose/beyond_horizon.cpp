@@ -99,9 +99,9 @@ std::vector<const EnsembleHypothesis*> passing_hypotheses(const EnsembleResult& 
 /// Chaotic replays move a candidate's delta-BIC by tens between draws: on the generated 8-trial
 /// realistic elastic-plastic case the two restitution laws had delta-BIC 14.6 and 15.3 on the
 /// first draw and 10.2 and 2.4 on the second, and naming the one the second draw favoured
-/// (viscoelastic) was a guess. Until 2d7f0d7 a rival also had to reach the
-/// margin itself: the 240 fps strong static-kinetic friction case named the viscoelastic law
-/// at delta-BIC 12.8 over the friction drop at 9.9993, a guess at a cliff.
+/// (viscoelastic) was a guess. Until 2d7f0d7 a rival also had to reach the margin itself: the
+/// 240 fps strong static-kinetic friction case named the viscoelastic law at delta-BIC 12.8 over
+/// the friction drop at 9.9993, a guess at a cliff.
 const EnsembleHypothesis* closest_rival(const EnsembleResult& ens, const EnsembleHypothesis& best,
                                         double min_delta_bic) {
   const EnsembleHypothesis* rival = nullptr;

@@ -8,7 +8,6 @@
 #include <limits>
 #include <numbers>
 #include <optional>
-#include <variant>
 
 #include "diagnose/release.hpp"
 #include "diagnose/tracks.hpp"
@@ -1037,10 +1036,8 @@ Result<void> replay_afresh(const Evaluator& ev, const std::vector<TrialScore>& s
 }  // namespace
 
 double tilt_start_deg(const Interaction& interaction, const std::vector<PhysicsTerm>& terms) {
-  const bool restitution_law = std::any_of(terms.begin(), terms.end(), [](const PhysicsTerm& t) {
-    return std::holds_alternative<ViscoelasticRestitution>(t) || std::holds_alternative<ElasticPlasticRestitution>(t);
-  });
-  return restitution_law ? 0.0 : 0.7 * std::atan(interaction.static_friction) * 180.0 / std::numbers::pi;
+  const bool unsettled = std::any_of(terms.begin(), terms.end(), damps_by_onset_speed);
+  return unsettled ? 0.0 : 0.7 * std::atan(interaction.static_friction) * 180.0 / std::numbers::pi;
 }
 
 std::vector<Eigen::Quaterniond> ensemble_orientations(LabTest test, const std::vector<Eigen::Quaterniond>& recorded,

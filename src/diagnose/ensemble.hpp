@@ -144,9 +144,9 @@ double null_dof(int outcomes, std::size_t free);
 /// friction angle; an adhesion or an offset centre of mass moves the onset up or not at all), so
 /// the replay's slip angle and slide time are those of a plate that started level, at a fifth
 /// of the cost (the onset takes 4-5 s of plate travel at 5 deg/s). A replay that slides within
-/// 2 degrees of its start is run again from level. A model with a speed-dependent restitution
-/// starts level (0): its law leaves a contact that began slowly nearly undamped, and a body set
-/// on a plate already tilted does not settle as on a level one (test
+/// 2 degrees of its start is run again from level. A model with a term that damps a contact by
+/// its onset speed (`damps_by_onset_speed`: the speed-dependent restitution laws) starts level
+/// (0): a body set on a plate already tilted does not settle there as on a level one (test
 /// `EnsembleTilt.ARestitutionLawsTiltReplayStartsLevel`).
 double tilt_start_deg(const Interaction& interaction, const std::vector<PhysicsTerm>& terms);
 
