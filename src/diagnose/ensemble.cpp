@@ -450,55 +450,80 @@ std::vector<std::pair<Outcome, double>> replay_and_measure(const LabWorld& world
   return measure_outcomes(rec.test, path, plan.moved, plan.tilt_rate_deg_per_s);
 }
 
+/// One plan's replays to run: its world, lab options and tilt start.
+struct PlanJob {
+  std::size_t plan = 0;
+  LabOptions lab;
+  LabWorld world;
+  double tilt_start = 0.0;
+};
+
+/// Replay `k` of a plan's orientations, measured.
+std::vector<std::pair<Outcome, double>> replay_for(const PlanJob& job, const Plan& plan, const Recording& rec,
+                                                   std::size_t k) {
+  ReplayOptions replay;
+  replay.duration = plan.duration;
+  replay.sample_interval = plan.frame;  // sampled as the camera samples
+  if (rec.test == LabTest::Tilt) {
+    // Until it has slid 10 mm, however late that is: a replay that stopped where the
+    // recorded tracks stop would leave out the replays that slide later.
+    replay.duration = 89.0 / plan.tilt_rate_deg_per_s;
+    replay.stop_after_slip = 0.0;
+    replay.tilt_start_deg = job.tilt_start;
+  }
+  auto measured = replay_and_measure(job.world, rec, plan, plan.orientations[k], job.lab, replay);
+  if (slid_near_start(measured, replay.tilt_start_deg)) {
+    replay.tilt_start_deg = 0.0;  // it may have been sliding already: from a level plate
+    measured = replay_and_measure(job.world, rec, plan, plan.orientations[k], job.lab, replay);
+  }
+  return measured;
+}
+
 /// The outcomes of every plan's replays under `model`; plans not in `run` keep `reuse`'s values.
+/// Every plan's replays run in one parallel loop: a loop per plan waited at each plan's end for
+/// its slowest replay (a roll's replays differ by up to a second of rolling).
 Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const std::vector<Plan>& plans,
                                const std::vector<bool>& run, const Sample* reuse, int& replays) {
   const auto& recs = *ev.recordings;
   Sample out(plans.size());
+  std::vector<PlanJob> jobs;
+  std::vector<std::pair<std::size_t, std::size_t>> tasks;  // (job, orientation)
+  if (auto ok = check_cancelled(ev); !ok) return std::unexpected(ok.error());
   for (std::size_t p = 0; p < plans.size(); ++p) {
-    const Plan& plan = plans[p];
     if (!run[p] && reuse != nullptr) {
       out[p] = (*reuse)[p];
       continue;
     }
-    if (auto ok = check_cancelled(ev); !ok) return std::unexpected(ok.error());
-    const Recording& rec = recs[plan.recording];
-    const LabOptions lab = lab_options_for(ev, model, rec);
-    auto world = make_lab_world(*ev.clump, *ev.table, rec, lab);
+    const Recording& rec = recs[plans[p].recording];
+    PlanJob job{p, lab_options_for(ev, model, rec), {}, 0.0};
+    auto world = make_lab_world(*ev.clump, *ev.table, rec, job.lab);
     if (!world) return std::unexpected(world.error());
-    std::vector<std::vector<std::pair<Outcome, double>>> measured(plan.orientations.size());
-    const double tilt_start = rec.test == LabTest::Tilt ? tilt_start_deg(world->interaction, lab.terms) : 0.0;
-    tbb::parallel_for(std::size_t{0}, plan.orientations.size(), [&](std::size_t k) {
-      ReplayOptions replay;
-      replay.duration = plan.duration;
-      replay.sample_interval = plan.frame;  // sampled as the camera samples
-      if (rec.test == LabTest::Tilt) {
-        // Until it has slid 10 mm, however late that is: a replay that stopped where the
-        // recorded tracks stop would leave out the replays that slide later.
-        replay.duration = 89.0 / plan.tilt_rate_deg_per_s;
-        replay.stop_after_slip = 0.0;
-        replay.tilt_start_deg = tilt_start;
-      }
-      measured[k] = replay_and_measure(*world, rec, plan, plan.orientations[k], lab, replay);
-      if (slid_near_start(measured[k], replay.tilt_start_deg)) {
-        replay.tilt_start_deg = 0.0;  // it may have been sliding already: from a level plate
-        measured[k] = replay_and_measure(*world, rec, plan, plan.orientations[k], lab, replay);
-      }
-    });
-    replays += static_cast<int>(plan.orientations.size());
-    out[p].assign(plan.outcomes.size(), {});
-    for (const auto& m : measured) {
-      // Looked up by outcome: a plan keeps only those measured on every recorded trial.
-      for (std::size_t o = 0; o < plan.outcomes.size(); ++o) {
-        const auto it = std::find_if(m.begin(), m.end(), [&](const auto& v) { return v.first == plan.outcomes[o]; });
-        if (it == m.end()) continue;
-        if (std::isfinite(it->second))
-          out[p][o].push_back(it->second);
-        else if (it->first == Outcome::SlipAngle)
-          out[p][o].push_back(89.0);  // a replay runs to 89 degrees: one that never slid counts as sliding there
-      }
+    job.world = std::move(*world);
+    if (rec.test == LabTest::Tilt) job.tilt_start = tilt_start_deg(job.world.interaction, job.lab.terms);
+    for (std::size_t k = 0; k < plans[p].orientations.size(); ++k) tasks.emplace_back(jobs.size(), k);
+    jobs.push_back(std::move(job));
+  }
+  std::vector<std::vector<std::pair<Outcome, double>>> measured(tasks.size());
+  tbb::parallel_for(std::size_t{0}, tasks.size(), [&](std::size_t i) {
+    const PlanJob& job = jobs[tasks[i].first];
+    measured[i] = replay_for(job, plans[job.plan], recs[plans[job.plan].recording], tasks[i].second);
+  });
+  for (const auto& job : jobs) out[job.plan].assign(plans[job.plan].outcomes.size(), {});
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    const std::size_t p = jobs[tasks[i].first].plan;
+    const Plan& plan = plans[p];
+    // Looked up by outcome: a plan keeps only those measured on every recorded trial.
+    for (std::size_t o = 0; o < plan.outcomes.size(); ++o) {
+      const auto& m = measured[i];
+      const auto it = std::find_if(m.begin(), m.end(), [&](const auto& v) { return v.first == plan.outcomes[o]; });
+      if (it == m.end()) continue;
+      if (std::isfinite(it->second))
+        out[p][o].push_back(it->second);
+      else if (it->first == Outcome::SlipAngle)
+        out[p][o].push_back(89.0);  // a replay runs to 89 degrees: one that never slid counts as sliding there
     }
   }
+  replays += static_cast<int>(tasks.size());
   return out;
 }
 
