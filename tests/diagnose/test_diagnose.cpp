@@ -1,6 +1,7 @@
 // The diagnosis: its measurement model on known tracks, the concealed-effect generator, and
 // a fast blind subset (a control and a strong effect on drop recordings).
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -810,6 +811,35 @@ TEST(DiagnoseEnsemble, ARecordingWithMoreTrialsThanReplaysIsReplayedOncePerTrial
     EXPECT_EQ(c.recorded_n, 14) << outcome_name(c.outcome);
     EXPECT_EQ(c.ensemble_n, 14) << outcome_name(c.outcome);
   }
+}
+
+TEST(DiagnoseEnsemble, TheOutcomesAreTheSameWhateverTheThreadCount) {
+  // The ensemble runs every recording's replays in one parallel loop (291b7e0): each replay is
+  // its own, so one thread and two must give the same comparisons to the bit, and so the
+  // same report. Tuber drops from 0.2 and 0.5 m on soil, from the finer adaptive-340.
+  auto made = soil_drops_from_the_finer_body(6, {0.2, 0.5}, 2613);
+  ASSERT_TRUE(made) << made.error().message;
+  const MaterialTable table = default_material_table();
+  DiagnoseOptions options;
+  options.effects = {Effect::AirDrag};
+  std::vector<DiagnoseResult> results;
+  for (int threads : {1, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    auto result = diagnose(diagnosis_clump(), table, made->recordings, made->names, options);
+    ASSERT_TRUE(result) << result.error().message;
+    ASSERT_TRUE(result->ensemble.has_value()) << result->statement;
+    results.push_back(std::move(*result));
+  }
+  const auto& one = results[0].ensemble->null_comparisons;
+  const auto& two = results[1].ensemble->null_comparisons;
+  ASSERT_EQ(one.size(), two.size());
+  ASSERT_GE(one.size(), 4u);  // rebound height and drift, mean and spread, of both recordings
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].ensemble_mean, two[i].ensemble_mean) << outcome_name(one[i].outcome);
+    EXPECT_EQ(one[i].ensemble_sd, two[i].ensemble_sd) << outcome_name(one[i].outcome);
+  }
+  EXPECT_EQ(results[0].verdict, results[1].verdict);
+  EXPECT_EQ(results[0].statement, results[1].statement);
 }
 
 // The independent simulator's exact sphere (r 9.35 mm, 1085 kg/m^3) as a one-sphere clump.
