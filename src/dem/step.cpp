@@ -270,10 +270,8 @@ void step(World& world, double dt) {
     body.angular_momentum += 0.5 * dt * world.torque[b];
     body.position += dt * body.velocity;
     rotate(body, dt);
-    // How far any point of the body, or of a moving wall near it, may have gone. The spin's
-    // size is the body frame's (a rotation keeps lengths): one turn of a vector, not a matrix.
-    const double spin = (body.orientation.conjugate() * body.angular_momentum).cwiseQuotient(body.inertia).norm();
-    double travel = (body.velocity.norm() + spin * body.bounding_radius) * dt;
+    // How far any point of the body, or of a moving wall near it, may have gone.
+    double travel = (body.velocity.norm() + body.body_angular_velocity().norm() * body.bounding_radius) * dt;
     for (const auto& wall : world.walls)
       travel += wall.spin.norm() * ((body.position - wall.pivot).norm() + body.bounding_radius) * dt;
     world.candidate_travel[b] += travel;

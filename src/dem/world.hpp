@@ -28,6 +28,11 @@ struct RigidBody {
   double bounding_radius = 0.0;                                     ///< max |centre| + radius [m]
 
   Eigen::Vector3d angular_velocity() const;  ///< world frame [rad/s]
+  /// The same in the body frame: one turn of the angular momentum, no rotation matrix (its
+  /// length is the spin's, a rotation keeping lengths) [rad/s].
+  Eigen::Vector3d body_angular_velocity() const {
+    return (orientation.conjugate() * angular_momentum).cwiseQuotient(inertia);
+  }
   Eigen::Vector3d sphere_position(std::size_t k) const { return position + orientation * spheres[k].centre; }
   double kinetic_energy() const;
 };
