@@ -120,8 +120,9 @@ struct World {
   std::unordered_map<std::uint64_t, ContactState> history;  ///< key: contact id
   /// Per (body, wall): spheres that may touch the wall before the next refresh.
   std::vector<std::vector<std::vector<int>>> wall_candidates;
-  std::vector<double> candidate_travel;        ///< per body: motion since its candidates were refreshed [m]
-  std::vector<double> candidate_skin;          ///< per body: the skin they were listed with [m]
+  std::vector<double> candidate_travel;  ///< per body: motion since its candidates were refreshed [m]
+  /// Per body: the smallest gap to a wall of a sphere left out of its lists (at least the skin) [m].
+  std::vector<double> candidate_clearance;
   std::vector<Eigen::Vector3d> force, torque;  ///< per body, at the current state (world frame)
   /// Per material pair (row-major): E*, G* and beta, and the E, nu (both) and e they came from.
   std::vector<PairConstants> pair_constants;
