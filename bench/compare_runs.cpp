@@ -26,7 +26,14 @@ namespace {
 struct StoredReport {
   std::string verdict, basis;
   double seconds = NAN;
+  int spheres = 0;  ///< the particle model's resolution it was judged on; 0: none named
 };
+
+int resolution_of(const nlohmann::json& report) {
+  if (!report.contains("particle_model") || !report["particle_model"].is_object()) return 0;
+  const auto& needed = report["particle_model"]["resolution_needed_spheres"];
+  return needed.is_number_integer() ? needed.get<int>() : 0;
+}
 
 /// The reports stored in `run` (each case folder's report.json), by case name.
 Result<std::map<std::string, StoredReport>> stored_reports(const fs::path& run) {
@@ -41,16 +48,22 @@ Result<std::map<std::string, StoredReport>> stored_reports(const fs::path& run) 
       return fail(ErrorCode::ParseError, file.string() + ": not a JSON object (a diagnose report)");
     out[entry.path().filename().string()] = {
         string_or(j, "verdict", "?"), string_or(j, "basis", "?"),
-        j.contains("seconds") && j["seconds"].is_number() ? j["seconds"].get<double>() : NAN};
+        j.contains("seconds") && j["seconds"].is_number() ? j["seconds"].get<double>() : NAN, resolution_of(j)};
   }
   return out;
 }
 
-/// The finite ratios this run's time over the other's, case by case.
-std::vector<double> time_ratios(const RunComparison& c) {
+/// Judged the same way in both runs: the same verdict, basis and particle-model resolution.
+bool judged_alike(const CaseComparison& k) {
+  return k.verdict_there == k.verdict_here && k.basis_there == k.basis_here && k.spheres_there == k.spheres_here;
+}
+
+/// The finite ratios this run's time over the other's, case by case (only the cases judged alike).
+std::vector<double> time_ratios(const RunComparison& c, bool alike_only = false) {
   std::vector<double> ratios;
   for (const auto& k : c.cases)
-    if (std::isfinite(k.seconds_there) && std::isfinite(k.seconds_here) && k.seconds_there > 0.0)
+    if (std::isfinite(k.seconds_there) && std::isfinite(k.seconds_here) && k.seconds_there > 0.0 &&
+        (!alike_only || judged_alike(k)))
       ratios.push_back(k.seconds_here / k.seconds_there);
   return ratios;
 }
@@ -87,8 +100,8 @@ Result<RunComparison> compare_runs(const fs::path& here, const fs::path& there) 
       out.only_here.push_back(id);
       continue;
     }
-    out.cases.push_back(
-        {id, other->second.verdict, r.verdict, other->second.basis, r.basis, other->second.seconds, r.seconds});
+    out.cases.push_back({id, other->second.verdict, r.verdict, other->second.basis, r.basis, other->second.seconds,
+                         r.seconds, other->second.spheres, r.spheres});
   }
   for (const auto& [id, r] : *theirs)
     if (!mine->contains(id)) out.only_there.push_back(id);
@@ -97,14 +110,17 @@ Result<RunComparison> compare_runs(const fs::path& here, const fs::path& there) 
 
 std::string comparison_markdown(const RunComparison& c, const std::string& there_name) {
   std::string md = fmt::format(
-      "compared with {}: {} cases diagnosed in both\n\n| case | verdict there -> here | basis there -> here | time "
-      "there -> here [s] | ratio |\n|---|---|---|---:|---:|\n",
+      "compared with {}: {} cases diagnosed in both (spheres judged: the particle model's resolution the "
+      "verdict names)\n\n| case | verdict there -> here | basis there -> here | spheres judged | time there -> here "
+      "[s] | ratio |\n|---|---|---|---|---:|---:|\n",
       there_name, c.cases.size());
   for (const auto& k : c.cases) {
     auto pair = [](const std::string& a, const std::string& b) { return a == b ? a : fmt::format("{} -> {}", a, b); };
+    auto spheres = [](int n) { return n > 0 ? std::to_string(n) : std::string("-"); };
     const double ratio = k.seconds_here / k.seconds_there;
-    md += fmt::format("| {} | {} | {} | {:.1f} -> {:.1f} | {} |\n", k.id, pair(k.verdict_there, k.verdict_here),
-                      pair(k.basis_there, k.basis_here), k.seconds_there, k.seconds_here,
+    md += fmt::format("| {} | {} | {} | {} | {:.1f} -> {:.1f} | {} |\n", k.id, pair(k.verdict_there, k.verdict_here),
+                      pair(k.basis_there, k.basis_here), pair(spheres(k.spheres_there), spheres(k.spheres_here)),
+                      k.seconds_there, k.seconds_here,
                       std::isfinite(ratio) ? fmt::format("{:.2f}", ratio) : std::string("-"));
   }
   const auto ratios = time_ratios(c);
@@ -116,6 +132,10 @@ std::string comparison_markdown(const RunComparison& c, const std::string& there
         "time per case, here over there: {:.2f}-{:.2f}, median {:.2f}; median time there {:.1f} s, here {:.1f} s\n",
         *std::min_element(ratios.begin(), ratios.end()), *std::max_element(ratios.begin(), ratios.end()),
         median(ratios), median(seconds_of(c, false)), median(seconds_of(c, true)));
+  if (const auto alike = time_ratios(c, true); !alike.empty())
+    md += fmt::format(
+        "time per case judged alike (the same verdict, basis and spheres judged): {} of {}, median {:.2f}\n",
+        alike.size(), ratios.size(), median(alike));
   if (!c.only_here.empty() || !c.only_there.empty())
     md += fmt::format("diagnosed here only: {}{}; there only: {}{}\n", c.only_here.size(), listed(c.only_here),
                       c.only_there.size(), listed(c.only_there));
@@ -131,13 +151,17 @@ nlohmann::json comparison_json(const RunComparison& c, const std::string& there_
                      {"basis_there", k.basis_there},
                      {"basis_here", k.basis_here},
                      {"seconds_there", k.seconds_there},
-                     {"seconds_here", k.seconds_here}});
-  const auto ratios = time_ratios(c);
+                     {"seconds_here", k.seconds_here},
+                     {"spheres_judged_there", k.spheres_there},
+                     {"spheres_judged_here", k.spheres_here},
+                     {"judged_alike", judged_alike(k)}});
+  const auto ratios = time_ratios(c), alike = time_ratios(c, true);
   return {{"there", there_name},
           {"cases", cases},
           {"verdicts_changed", changed(c, true)},
           {"bases_changed", changed(c, false)},
           {"median_time_ratio", ratios.empty() ? nlohmann::json() : nlohmann::json(median(ratios))},
+          {"median_time_ratio_judged_alike", alike.empty() ? nlohmann::json() : nlohmann::json(median(alike))},
           {"median_seconds_there", median(seconds_of(c, false))},
           {"median_seconds_here", median(seconds_of(c, true))},
           {"only_here", c.only_here},

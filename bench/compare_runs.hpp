@@ -23,6 +23,9 @@ struct CaseComparison {
   std::string id;
   std::string verdict_there, verdict_here, basis_there, basis_here;
   double seconds_there = 0.0, seconds_here = 0.0;
+  /// The particle model's resolution each verdict was judged on (report.json's
+  /// particle_model.resolution_needed_spheres); 0: none named.
+  int spheres_there = 0, spheres_here = 0;
 };
 
 struct RunComparison {
@@ -36,7 +39,9 @@ struct RunComparison {
 Result<RunComparison> compare_runs(const std::filesystem::path& here, const std::filesystem::path& there);
 
 /// The comparison as markdown: a row per case, then the verdicts and bases that changed and the
-/// time ratios (this run over the other: range and median) with each run's median time.
+/// time ratios (this run over the other: range and median) with each run's median time, and the
+/// median ratio of the cases judged alike (the same verdict, basis and resolution: the same work
+/// asked of two builds, where a case judged on another clump of the ladder replays another one).
 std::string comparison_markdown(const RunComparison& comparison, const std::string& there_name);
 
 /// The same for compare.json.
