@@ -279,8 +279,7 @@ void compute_forces(World& world, double dt) {
     if (std::all_of(lists.begin(), lists.end(), [](const auto& list) { return list.empty(); }))
       continue;  // in flight: no rotation matrix needed
     const Eigen::Matrix3d rotation = body.orientation.toRotationMatrix();
-    const BodyFrame frame{rotation,
-                          rotation * (rotation.transpose() * body.angular_momentum).cwiseQuotient(body.inertia)};
+    const BodyFrame frame{rotation, body.angular_velocity(rotation)};
     for (std::size_t w = 0; w < world.walls.size(); ++w) {
       for (int k : lists[w]) wall_contact(world, b, static_cast<std::size_t>(k), w, dt, frame);
     }

@@ -5,8 +5,7 @@
 namespace clumpforge {
 
 Eigen::Vector3d RigidBody::angular_velocity() const {
-  const Eigen::Matrix3d r = orientation.toRotationMatrix();
-  return r * (r.transpose() * angular_momentum).cwiseQuotient(inertia);
+  return angular_velocity(orientation.toRotationMatrix());
 }
 
 double RigidBody::kinetic_energy() const {

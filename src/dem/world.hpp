@@ -28,6 +28,10 @@ struct RigidBody {
   double bounding_radius = 0.0;                                     ///< max |centre| + radius [m]
 
   Eigen::Vector3d angular_velocity() const;  ///< world frame [rad/s]
+  /// The same from the body's rotation matrix, when the caller has built it already.
+  Eigen::Vector3d angular_velocity(const Eigen::Matrix3d& rotation) const {
+    return rotation * (rotation.transpose() * angular_momentum).cwiseQuotient(inertia);
+  }
   /// The same in the body frame: one turn of the angular momentum, no rotation matrix (its
   /// length is the spin's, a rotation keeping lengths) [rad/s].
   Eigen::Vector3d body_angular_velocity() const {
