@@ -24,6 +24,9 @@ struct LeastSquaresOptions {
   double lambda_floor = 1e-6;    ///< the damping never falls below this
   double converged_gain = 0.0;   ///< stop once an accepted step lowers |r|^2 by less than this
   double converged_value = 0.0;  ///< stop once |r|^2 is below this
+  /// When no damped step from a Jacobian lowers |r|^2: the Jacobian taken again by central
+  /// differences with `step` times this, and the damping reset, before the fit stops (0: it stops).
+  double stall_step_factor = 0.0;
   /// Called before each Jacobian with the iteration's index (progress reports).
   std::function<void(int)> on_iteration;
 };

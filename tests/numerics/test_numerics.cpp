@@ -67,6 +67,46 @@ TEST(LevenbergMarquardt, PassesTheResidualFunctionsErrorOn) {
   EXPECT_EQ(fit.error().code, ErrorCode::InvalidArgument);
 }
 
+TEST(LevenbergMarquardt, AStallOnAStaircaseIsTakenAgainWithWiderCentralDifferences) {
+  // The decay's residuals evaluated at x rounded to a grid of 1e-4: flat between steps, so a
+  // forward difference of 2e-5 sees no slope (or a cliff) and no damped step from it helps. Taken
+  // again by central differences of 8 x 2e-5 = 1.6e-4, wider than a stair, the slope shows and
+  // the fit goes on to the grid point nearest the answer.
+  const ResidualFunction smooth = decay(2.0, 1.3);
+  const ResidualFunction stairs = [&smooth](const Eigen::VectorXd& x) {
+    return smooth(((x.array() / 1e-4).round() * 1e-4).matrix());
+  };
+  LeastSquaresOptions o = box(0.0, 5.0, 0.0, 5.0);
+  o.step = Eigen::Vector2d(2e-5, 2e-5);
+  const auto stalled = levenberg_marquardt(stairs, Eigen::Vector2d(1.0, 0.5), o);
+  ASSERT_TRUE(stalled);
+  EXPECT_GT(stalled->value, 1.0);  // it stops where it started
+  o.stall_step_factor = 8.0;
+  const auto fit = levenberg_marquardt(stairs, Eigen::Vector2d(1.0, 0.5), o);
+  ASSERT_TRUE(fit);
+  EXPECT_NEAR(fit->x(0), 2.0, 2e-3);
+  EXPECT_NEAR(fit->x(1), 1.3, 2e-3);
+  EXPECT_LT(fit->value, 1e-4);
+}
+
+TEST(LevenbergMarquardt, TakesCentralDifferencesOneSidedAtABound) {
+  // A fit ends by stalling at its optimum, so the central differences are taken there: a's
+  // answer, 2.0, is its upper bound, where its difference must be one-sided. No residual is
+  // asked for outside the box.
+  LeastSquaresOptions o = box(0.0, 2.0, 0.0, 5.0);
+  o.stall_step_factor = 8.0;
+  int outside = 0;
+  const ResidualFunction watched = [&](const Eigen::VectorXd& x) {
+    if ((x.array() < o.lower.array()).any() || (x.array() > o.upper.array()).any()) ++outside;
+    return decay(2.0, 1.3)(x);
+  };
+  const auto fit = levenberg_marquardt(watched, Eigen::Vector2d(2.0, 0.5), o);
+  ASSERT_TRUE(fit);
+  EXPECT_NEAR(fit->x(0), 2.0, 1e-6);
+  EXPECT_NEAR(fit->x(1), 1.3, 1e-6);
+  EXPECT_EQ(outside, 0);
+}
+
 TEST(ResidualProjection, LeavesWhatAFitOnTheColumnsCannotExplain) {
   // Columns 1 and t over t = 0..9 (a straight-line fit): a line is projected out entirely, a
   // parabola leaves its residual from the least-squares line, orthogonal to both columns; the
