@@ -28,7 +28,7 @@ struct DiagnoseArgs {
   std::string mesh, clump, clump_name, out, materials, units = "mm";
   std::string roll_release = "on-edge";
   double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3, impact_accuracy_pct = 1.0;
-  int ensemble_replays = 12;
+  int ensemble_replays = 12, ensemble_replays_at_gate = 48;
   int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
   std::uint64_t seed = 1;
   bool json = false;
@@ -115,6 +115,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.model_accuracy_m = args.model_accuracy_mm * 1e-3;
   options.impact_accuracy = args.impact_accuracy_pct / 100.0;
   options.ensemble_replays = args.ensemble_replays;
+  options.ensemble_replays_at_gate = args.ensemble_replays_at_gate;
   options.release_orientations = args.release_orientations;
   for (const auto& name : args.effects) {
     auto e = parse_effect(name);
@@ -188,6 +189,10 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_option("--ensemble-replays", args->ensemble_replays,
                   "Replays per drop and roll recording from the release prior, to compare the recorded outcomes "
                   "beyond the release horizon; a recording with more trials is replayed once per trial (0: skip)");
+  sub->add_option("--ensemble-replays-at-gate", args->ensemble_replays_at_gate,
+                  "Replays per recording when the first comparison decided at a gate (the null's consistency, a "
+                  "candidate's margin or a finer clump's convergence within the draw's reach): it is made again "
+                  "with these (0, or no more than --ensemble-replays: never)");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   add_output_option(*sub, args->out, "Directory for report.json, tracks.json and the figures (PNG, SVG)");

@@ -151,9 +151,8 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   if (by_flights) say_flights(result, *result.flights);
   if (open && !by_flights && options.ensemble_replays > 0) {
     run.report("ensembles", 0.9);
-    if (auto ok = judge_ensembles(c, result, baseline, *full_base, effects, options); !ok)
+    if (auto ok = ensemble_stage(c, result, baseline, *full_base, effects, options); !ok)
       return std::unexpected(ok.error());
-    reconcile_advice(result);
   }
   ask_for_deciding_experiments(result);
   say_which_were_asked(result, options);

@@ -56,6 +56,10 @@ struct DiagnoseOptions {
   /// for the comparison beyond the release horizon (see diagnose/ensemble.hpp); a recording
   /// with more tracked trials is replayed once per trial. 0 skips it.
   int ensemble_replays = 12;
+  /// Replays per recording when the comparison with `ensemble_replays` decided at one of its gates
+  /// (diagnosis::at_a_gate): it is made again with these, and judged on them alone; 0, or no more
+  /// than `ensemble_replays`: never.
+  int ensemble_replays_at_gate = 48;
   /// Finer particle models of the same body (more spheres, or built another way), coarsest
   /// first; the clump diagnosed is the coarsest of all. They serve twice (see
   /// ParticleModelCheck): the resolution is raised while the replayed tracks still change

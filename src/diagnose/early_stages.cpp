@@ -114,6 +114,12 @@ Result<void> check_options(const DiagnoseOptions& options) {
                 fmt::format("replays per recording for the ensemble comparison must be 0 (skip) or 4 to 1000, not {}",
                             options.ensemble_replays));
   }
+  if (options.ensemble_replays_at_gate != 0 &&
+      (options.ensemble_replays_at_gate < 4 || options.ensemble_replays_at_gate > 1000)) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("replays per recording at a gate must be 0 (never) or 4 to 1000, not {}",
+                            options.ensemble_replays_at_gate));
+  }
   if (options.release_orientations < 2 || options.release_orientations > 1000) {
     return fail(
         ErrorCode::InvalidArgument,

@@ -346,6 +346,19 @@ void reconcile_advice(DiagnoseResult& result);
 Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& baseline,
                              const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
                              const DiagnoseOptions& options);
+/// Where a comparison beyond the release horizon decided within reach of the draw of its
+/// replays: the calibrated null's consistency tail within a factor kGateBand of its threshold, a
+/// candidate's delta-BIC (lower draw) from half the margin to twice it, or a finer clump's outcome
+/// shift within a factor kGateBand of kReal in p while it matters. What it was, for a note; empty
+/// when every gate was passed or failed by more.
+constexpr double kGateBand = 10.0;
+std::optional<std::string> at_a_gate(const DiagnoseResult& result, double min_delta_bic);
+/// The ensemble stage: judge_ensembles with options.ensemble_replays, made again from where it
+/// started with options.ensemble_replays_at_gate when it decided at a gate (at_a_gate), then
+/// reconcile_advice.
+Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& baseline,
+                            const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
+                            const DiagnoseOptions& options);
 std::optional<FlightWobble> flights_of(const Context& c, const std::vector<Recording>& recordings,
                                        const DiagnoseOptions& options);
 void say_flights(DiagnoseResult& result, const FlightWobble& f);

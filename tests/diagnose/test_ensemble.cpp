@@ -839,6 +839,64 @@ TEST(EnsembleRival, ACandidateWithinTheMarginOnEitherDrawMakesTheVerdictAmbiguou
   }
 }
 
+// The comparison beyond the horizon is made again with more replays where it decided within the
+// draw's reach: the null's consistency tail within a factor 10 of 5e-5, a plausible candidate's
+// lower draw from half the margin to twice it, a finer clump's shift within a factor 10 of p =
+// 0.01 while it matters. Lab-like case-08's null at 12 replays had its means at chi^2 37.6 over
+// 12 degrees of freedom (tail 1.8e-4): consistent, so no candidate was tried; with 48 the
+// elastic-plastic restitution was named at delta-BIC 24.6.
+TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
+  auto report_with = [](double means_chi2, double spreads_chi2) {
+    DiagnoseResult result;
+    EnsembleReport e;
+    e.outcomes = 32;
+    e.calibrated_here = {"Q235:restitution", "Q235:rolling_friction", "soil:restitution", "soil:rolling_friction"};
+    for (int o = 0; o < 32; ++o) {
+      const bool mean = o < 16;
+      e.null_comparisons.push_back({.statistic = mean ? Statistic::Mean : Statistic::Spread,
+                                    .z = std::sqrt((mean ? means_chi2 : spreads_chi2) / 16.0)});
+    }
+    result.ensemble = std::move(e);
+    return result;
+  };
+  EXPECT_TRUE(diagnosis::at_a_gate(report_with(37.6, 16.1), 10.0));   // tail 1.8e-4
+  EXPECT_FALSE(diagnosis::at_a_gate(report_with(12.0, 16.1), 10.0));  // tail 0.45: consistent by far
+  EXPECT_FALSE(diagnosis::at_a_gate(report_with(90.0, 16.1), 10.0));  // tail 4e-14: inconsistent by far
+  EXPECT_TRUE(diagnosis::at_a_gate(report_with(12.0, 46.0), 10.0));   // the spreads' tail, 1e-4
+
+  auto with_candidate = [&](double first, double fresh, bool plausible) {
+    DiagnoseResult result = report_with(12.0, 16.1);
+    EnsembleHypothesis h;
+    h.effect = Effect::ViscousRolling;
+    h.plausible = plausible;
+    h.first_delta_bic = first;
+    h.fresh_delta_bic = fresh;
+    result.ensemble->hypotheses.push_back(h);
+    return diagnosis::at_a_gate(result, 10.0).has_value();
+  };
+  EXPECT_TRUE(with_candidate(11.8, 5.5, true));   // lab-like case-01's viscous rolling
+  EXPECT_TRUE(with_candidate(19.0, 25.0, true));  // named on the lower draw, 19: within reach
+  EXPECT_FALSE(with_candidate(24.6, 30.0, true));
+  EXPECT_FALSE(with_candidate(4.9, 8.0, true));    // its lower draw below half the margin
+  EXPECT_FALSE(with_candidate(11.8, 5.5, false));  // implausible: no draw names it
+
+  auto with_shift = [&](double p, double largest) {
+    DiagnoseResult result = report_with(12.0, 16.1);
+    ParticleModelCheck check;
+    ParticleModelRung rung;
+    rung.name = "adaptive-256";
+    rung.outcome_shift = OutcomeShift{.means = 16, .chi2 = 30.0, .p = p, .largest = largest};
+    check.rungs = {ParticleModelRung{}, rung};
+    result.particle_model = check;
+    return diagnosis::at_a_gate(result, 10.0).has_value();
+  };
+  EXPECT_TRUE(with_shift(0.0021, 1.8));   // the nine-set-up strong offset's 128 -> 256 shift at 5e7e13c
+  EXPECT_TRUE(with_shift(0.05, 1.8));     // converged, but within the draw's reach
+  EXPECT_FALSE(with_shift(5e-12, 4.0));   // lab-like case-08's 64 -> 128 at 48 replays
+  EXPECT_FALSE(with_shift(0.0021, 0.6));  // real, but under a recorded standard error: it does not matter
+  EXPECT_FALSE(with_shift(0.5, 1.2));
+}
+
 // A restitution candidate's tilt replays start from a level plate, as the generator's do; other
 // models start at 70 % of the friction angle (tests/dem/test_lab.cpp: why).
 TEST(EnsembleTilt, ARestitutionLawsTiltReplayStartsLevel) {

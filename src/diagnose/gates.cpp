@@ -1,0 +1,87 @@
+/// The comparison beyond the release horizon made again with more replays where its first draw
+/// decided at a gate.
+#include <fmt/format.h>
+
+#include "diagnose/stages.hpp"
+#include "numerics/statistics.hpp"
+
+namespace clumpforge::diagnosis {
+namespace {
+
+/// Whether `value` lies within a factor kGateBand of `threshold`, on either side.
+bool near(double value, double threshold) {
+  return value > threshold / kGateBand && value < threshold * kGateBand;
+}
+
+/// The calibrated null's consistency (outcomes_consistent: the means' tail and the spreads'
+/// apart) when either tail sits near the threshold.
+std::optional<std::string> consistency_at_gate(const EnsembleReport& e) {
+  double chi2[2] = {0.0, 0.0};
+  int count[2] = {0, 0};
+  for (const auto& o : e.null_comparisons) {
+    const int k = o.statistic == Statistic::Mean ? 0 : 1;
+    chi2[k] += o.z * o.z;
+    ++count[k];
+  }
+  const double threshold = 0.5 * kConsistentTail;
+  for (int k = 0; k < 2; ++k) {
+    if (count[k] == 0) continue;
+    const double dof = k == 0 ? null_dof(count[k], e.calibrated_here.size()) : count[k];
+    const double tail = chi2_upper_tail(chi2[k], dof);
+    if (near(tail, threshold))
+      return fmt::format(
+          "the calibrated null's {} at chi^2 {:.1f} over {:.0f} degrees of freedom, tail {:.2g} "
+          "against the {:.2g} that decides consistency",
+          k == 0 ? "means" : "spreads", chi2[k], dof, tail, threshold);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::string> at_a_gate(const DiagnoseResult& result, double min_delta_bic) {
+  if (!result.ensemble || result.ensemble->outcomes == 0) return std::nullopt;
+  const EnsembleReport& e = *result.ensemble;
+  if (auto why = consistency_at_gate(e)) return why;
+  for (const EnsembleHypothesis& h : e.hypotheses) {
+    const double d = h.delta_bic();
+    if (h.plausible && d >= 0.5 * min_delta_bic && d < 2.0 * min_delta_bic)
+      return fmt::format("{} at delta-BIC {:.1f} against the margin of {:.0f}", effect_name(h.effect), d,
+                         min_delta_bic);
+  }
+  if (result.particle_model) {
+    for (const ParticleModelRung& r : result.particle_model->rungs) {
+      const auto& s = r.outcome_shift;
+      if (s && s->means > 0 && s->largest >= OutcomeShift::kMatters && near(s->p, OutcomeShift::kReal))
+        return fmt::format(
+            "{}'s outcomes moved from the previous clump's at p = {:.2g} against the {:.2g} that "
+            "decides convergence",
+            r.name, s->p, OutcomeShift::kReal);
+    }
+  }
+  return std::nullopt;
+}
+
+Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& baseline,
+                            const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
+                            const DiagnoseOptions& options) {
+  const DiagnoseResult before = result;
+  if (auto ok = judge_ensembles(c, result, baseline, full_scores, effects, options); !ok) return ok;
+  if (options.ensemble_replays_at_gate > options.ensemble_replays) {
+    if (auto why = at_a_gate(result, options.min_delta_bic)) {
+      const int first = result.ensemble ? result.ensemble->replays : 0;
+      result = before;
+      DiagnoseOptions more = options;
+      more.ensemble_replays = options.ensemble_replays_at_gate;
+      if (auto ok = judge_ensembles(c, result, baseline, full_scores, effects, more); !ok) return ok;
+      result.notes.push_back(fmt::format(
+          "the outcomes judged with {} replays per recording: with {} (the first draw, {} replays) the comparison "
+          "decided at a gate, {}, where another draw of release orientations can decide otherwise",
+          options.ensemble_replays_at_gate, options.ensemble_replays, first, *why));
+    }
+  }
+  reconcile_advice(result);
+  return {};
+}
+
+}  // namespace clumpforge::diagnosis
