@@ -334,15 +334,16 @@ void expect_speed_dependent_restitution_named(const nlohmann::json& j) {
 }  // namespace
 
 TEST(DiagnoseCli, AnotherSimulatorsSpeedDependentRestitutionIsNamedRightOrLeftOpenWithTheDefaultReplays) {
-  // Case-08 with the default 12 replays per recording. Whether the law is named depends on the
-  // draw of replay orientations: named at 3 of seeds 1-5 with a3e2907's rotation, 1 of 5 with
-  // the cheaper rotation after it (docs/diagnose.md, "A cheaper rotation"); the calibrated null
-  // is otherwise consistent with the outcomes at that sampling noise. What holds at every draw:
-  // a restitution law named on both draws at the margin, or `none` that leaves both laws open
-  // (never claimed absent), never another effect, never `unexplained`. With 48 replays the law
-  // is named at every seed tried: the slow test below.
+  // Case-08 with 12 replays per recording and no second comparison at a gate
+  // (--ensemble-replays-at-gate 0). Whether the law is named depends on the draw of replay
+  // orientations: named at 3 of seeds 1-5 with a3e2907's rotation, 1 of 5 with the cheaper
+  // rotation after it (docs/diagnose.md, "A cheaper rotation"); the calibrated null is otherwise
+  // consistent with the outcomes at that sampling noise, at a gate. What holds at every draw: a
+  // restitution law named on both draws at the margin, or `none` that leaves both laws open
+  // (never claimed absent), never another effect, never `unexplained`. By default such a gate
+  // makes the comparison again with 48 replays, which names the law: the slow test below.
   test::ScratchDir dir("diagnose-lab-like-speed-restitution");
-  const auto j = diagnose_lab_like_tuber("case-08", dir / "out", 1);
+  const auto j = diagnose_lab_like_tuber("case-08", dir / "out", 1, "--ensemble-replays-at-gate 0");
   ASSERT_FALSE(j.empty());
   const std::string verdict = j["verdict"];
   if (verdict != "none") {
@@ -356,9 +357,11 @@ TEST(DiagnoseCli, AnotherSimulatorsSpeedDependentRestitutionIsNamedRightOrLeftOp
 }
 
 TEST(DiagnoseCli, AnotherSimulatorsSpeedDependentRestitutionIsFoundByCalibratingItsLevel) {
-  // Case-08 with 48 replays per recording (about 220 s a run on two cores; labelled slow), at
-  // two seeds of the replay orientations that leave it `none` with the default 12. Beyond the
-  // release horizon the calibrated null leaves the outcomes inconsistent, and the linear
+  // Case-08 with the default options (about 250 s a run on two cores; labelled slow), at two
+  // seeds of the replay orientations that leave it `none` with 12 replays alone: with 12 the
+  // calibrated null is consistent at a gate (its means' tail 1.8e-4 at seed 1 against 5e-5), so
+  // the comparison is made again with 48 replays per recording, and a note says so. With 48 the
+  // calibrated null leaves the outcomes inconsistent, and the linear
   // surrogate about the null found no candidate reaching the margin: the steel e must rise at
   // 0.2 m and fall at 1 m, far from the null's. Calibrated with its level, a speed-dependent
   // restitution must be named, on both draws of orientations (delta-BIC and fresh delta-BIC at
@@ -368,10 +371,10 @@ TEST(DiagnoseCli, AnotherSimulatorsSpeedDependentRestitutionIsFoundByCalibrating
   for (int seed : {1, 3}) {
     SCOPED_TRACE(seed);
     test::ScratchDir dir(fmt::format("diagnose-lab-like-speed-restitution-48-{}", seed));
-    const auto j =
-        diagnose_lab_like_tuber("case-08", dir / "out", 1, fmt::format("--ensemble-replays 48 --seed {}", seed));
+    const auto j = diagnose_lab_like_tuber("case-08", dir / "out", 1, fmt::format("--seed {}", seed));
     ASSERT_FALSE(j.empty());
     expect_speed_dependent_restitution_named(j);
+    EXPECT_NE(j["notes"].dump().find("judged with 48 replays per recording"), std::string::npos) << j["notes"].dump();
   }
 }
 
@@ -454,8 +457,9 @@ TEST(DiagnoseCli, AStrongOffsetTriedOnTheOutcomesIsNotCalledAbsent) {
     if (d["name"] != "com_offset") continue;
     ++judged;
     const double needed = d["needed"].get<double>(), dispersion = d["dispersion"].get<double>();
-    if (d["strong_signal"].get<double>() >= needed)
+    if (d["strong_signal"].get<double>() >= needed) {
       EXPECT_LT(d["strong_rejection"].get<double>(), dispersion * needed) << d.dump();
+    }
     EXPECT_NE(d["advice"], "decided") << d.dump();
   }
   EXPECT_EQ(judged, 1);

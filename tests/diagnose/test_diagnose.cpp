@@ -803,6 +803,7 @@ TEST(DiagnoseEnsemble, ARecordingWithMoreTrialsThanReplaysIsReplayedOncePerTrial
   DiagnoseOptions options;
   options.effects = {Effect::AirDrag};
   ASSERT_EQ(options.ensemble_replays, 12);
+  options.ensemble_replays_at_gate = 0;  // the 12 replays' rule, not the second comparison's
   auto result = diagnose(diagnosis_clump(), table, made->recordings, made->names, options);
   ASSERT_TRUE(result) << result.error().message;
   ASSERT_TRUE(result->ensemble.has_value()) << result->statement;
