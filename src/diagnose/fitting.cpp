@@ -245,9 +245,7 @@ Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::v
   // of a parameter's range see the coefficients' effect and not the origin search's steps.
   // Not everywhere: a sphere's many bounces on soil make the residuals rough at that scale, and
   // lab-like case-05's plastic substrate stalled at plastic_ratio 0.30 (chi^2 20,793) where
-  // central differences of 8 x 2e-3 went on to 0.45 (15,868; the simulator's 0.5). Each stall
-  // there came after a step that gained 600 or more; a fit that stalls after gains under 10
-  // (20 times converged_gain) is taken to be at its minimum, for the rescue costs 2p + 6 replays.
+  // central differences of 8 x 2e-3 went on to 0.45 (15,868; the simulator's 0.5).
   LeastSquaresOptions options{.lower = Eigen::VectorXd::Zero(p),
                               .upper = Eigen::VectorXd::Ones(p),
                               .step = Eigen::VectorXd::Constant(p, 2e-3),
@@ -258,7 +256,6 @@ Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::v
                               .converged_gain = 0.5,
                               .converged_value = 0.0,
                               .stall_step_factor = 8.0,
-                              .stall_gain = 10.0,
                               .on_iteration = {}};
   auto fit = clumpforge::levenberg_marquardt(residuals, Eigen::Map<const Eigen::VectorXd>(unit.data(), p), options);
   if (!fit) return std::unexpected(fit.error());

@@ -2,7 +2,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -126,14 +125,13 @@ Result<LeastSquaresResult> levenberg_marquardt(const ResidualFunction& residuals
   out.residuals = std::move(*r0);
   out.value = out.residuals.squaredNorm();
   double lambda = o.lambda;
-  double last_gain = std::numeric_limits<double>::infinity();
   for (int iteration = 0; iteration < o.iterations; ++iteration) {
     if (o.on_iteration) o.on_iteration(iteration);
     double gain = 0.0;
     // A stall on a rough surface: forward differences of a small step can point the wrong way
     // where the residuals are not smooth at that scale; a wider central difference may not.
     for (const bool central : {false, true}) {
-      if (central && (gain > 0.0 || o.stall_step_factor <= 0.0 || last_gain < o.stall_gain)) break;
+      if (central && (gain > 0.0 || o.stall_step_factor <= 0.0)) break;
       auto jacobian = jacobian_at(residuals, out, o, central);
       if (!jacobian) return std::unexpected(jacobian.error());
       if (!*jacobian) return out;
@@ -144,7 +142,6 @@ Result<LeastSquaresResult> levenberg_marquardt(const ResidualFunction& residuals
       gain = *step;
     }
     if (gain <= 0.0 || gain < o.converged_gain || out.value < o.converged_value) break;
-    last_gain = gain;
   }
   return out;
 }

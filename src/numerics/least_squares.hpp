@@ -27,9 +27,6 @@ struct LeastSquaresOptions {
   /// When no damped step from a Jacobian lowers |r|^2: the Jacobian taken again by central
   /// differences with `step` times this, and the damping reset, before the fit stops (0: it stops).
   double stall_step_factor = 0.0;
-  /// ... only at the first Jacobian or after a step that lowered |r|^2 by this or more: a fit that
-  /// stalls after small gains is taken to be at its minimum.
-  double stall_gain = 0.0;
   /// Called before each Jacobian with the iteration's index (progress reports).
   std::function<void(int)> on_iteration;
 };

@@ -87,14 +87,6 @@ TEST(LevenbergMarquardt, AStallOnAStaircaseIsTakenAgainWithWiderCentralDifferenc
   EXPECT_NEAR(fit->x(0), 2.0, 2e-3);
   EXPECT_NEAR(fit->x(1), 1.3, 2e-3);
   EXPECT_LT(fit->value, 1e-4);
-  // Rescued only at the first Jacobian or after a step that gained stall_gain: with a gain no
-  // step reaches, the fit is rescued once, at the start, and stops at its next stall.
-  o.stall_gain = 1e12;
-  const auto once = levenberg_marquardt(stairs, Eigen::Vector2d(1.0, 0.5), o);
-  ASSERT_TRUE(once);
-  EXPECT_LT(once->value, stalled->value);
-  EXPECT_GT(once->value, fit->value);
-  EXPECT_LT(once->evaluations, fit->evaluations);
 }
 
 TEST(LevenbergMarquardt, TakesCentralDifferencesOneSidedAtABound) {
