@@ -1091,16 +1091,26 @@ double null_dof(int outcomes, std::size_t free) {
   return std::max(1.0, outcomes - static_cast<double>(free));
 }
 
-bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted) {
-  double chi2[2] = {0.0, 0.0};
-  int count[2] = {0, 0};
+ConsistencyTests consistency_tests(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted) {
+  ConsistencyTests t;
+  int means = 0, spreads = 0;
   for (const auto& o : comparisons) {
-    const int k = o.statistic == Statistic::Mean ? 0 : 1;
-    chi2[k] += o.z * o.z;
-    ++count[k];
+    const bool mean = o.statistic == Statistic::Mean;
+    (mean ? t.means : t.spreads).chi2 += o.z * o.z;
+    ++(mean ? means : spreads);
   }
-  return chi2_upper_tail(chi2[0], null_dof(count[0], fitted)) >= 0.5 * kConsistentTail &&
-         (count[1] == 0 || chi2_upper_tail(chi2[1], count[1]) >= 0.5 * kConsistentTail);
+  t.means.dof = null_dof(means, fitted);
+  t.means.tail = chi2_upper_tail(t.means.chi2, t.means.dof);
+  if (spreads > 0) {
+    t.spreads.dof = spreads;
+    t.spreads.tail = chi2_upper_tail(t.spreads.chi2, t.spreads.dof);
+  }
+  return t;
+}
+
+bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted) {
+  const ConsistencyTests t = consistency_tests(comparisons, fitted);
+  return t.means.tail >= 0.5 * kConsistentTail && t.spreads.tail >= 0.5 * kConsistentTail;
 }
 
 Result<std::vector<OutcomeComparison>> compare_model(const Evaluator& ev, const Model& model,

@@ -157,6 +157,17 @@ double tilt_start_deg(const Interaction& interaction, const std::vector<PhysicsT
 /// agree, nor the reverse.
 bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted);
 
+/// The two chi^2 tests outcomes_consistent makes: the means' (over their number less `fitted`, at
+/// least one) and the spreads' (over their number), each with its upper tail (1 and no degrees of
+/// freedom when there are none of that statistic).
+struct ConsistencyTest {
+  double chi2 = 0.0, dof = 0.0, tail = 1.0;
+};
+struct ConsistencyTests {
+  ConsistencyTest means, spreads;
+};
+ConsistencyTests consistency_tests(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted);
+
 /// The replays of a recording of `trials` tracked trials: `replays`, or one per trial when there
 /// are more, so that the replays' sampling noise never exceeds the recorded sample's.
 int replays_per_recording(int replays, std::size_t trials);

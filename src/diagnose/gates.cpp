@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include "diagnose/stages.hpp"
-#include "numerics/statistics.hpp"
 
 namespace clumpforge::diagnosis {
 namespace {
@@ -16,23 +15,14 @@ bool near(double value, double threshold) {
 /// The calibrated null's consistency (outcomes_consistent: the means' tail and the spreads'
 /// apart) when either tail sits near the threshold.
 std::optional<std::string> consistency_at_gate(const EnsembleReport& e) {
-  double chi2[2] = {0.0, 0.0};
-  int count[2] = {0, 0};
-  for (const auto& o : e.null_comparisons) {
-    const int k = o.statistic == Statistic::Mean ? 0 : 1;
-    chi2[k] += o.z * o.z;
-    ++count[k];
-  }
+  const ConsistencyTests t = consistency_tests(e.null_comparisons, e.calibrated_here.size());
   const double threshold = 0.5 * kConsistentTail;
-  for (int k = 0; k < 2; ++k) {
-    if (count[k] == 0) continue;
-    const double dof = k == 0 ? null_dof(count[k], e.calibrated_here.size()) : count[k];
-    const double tail = chi2_upper_tail(chi2[k], dof);
-    if (near(tail, threshold))
+  for (const auto& [name, test] : {std::pair{"means", t.means}, std::pair{"spreads", t.spreads}}) {
+    if (test.dof > 0.0 && near(test.tail, threshold))
       return fmt::format(
           "the calibrated null's {} at chi^2 {:.1f} over {:.0f} degrees of freedom, tail {:.2g} "
           "against the {:.2g} that decides consistency",
-          k == 0 ? "means" : "spreads", chi2[k], dof, tail, threshold);
+          name, test.chi2, test.dof, test.tail, threshold);
   }
   return std::nullopt;
 }
