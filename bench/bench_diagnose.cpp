@@ -683,6 +683,8 @@ struct BenchOptions {
                               generator_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default.h5",
                               generator_name = "adaptive-340";
   int spheres = 0, threads = 0;
+  /// Replays per recording of the second comparison at a gate (DiagnoseOptions::ensemble_replays_at_gate).
+  int replays_at_gate = DiagnoseOptions{}.ensemble_replays_at_gate;
   /// Finer clumps of the particle-model check (DiagnoseJob::finer_clumps); unset: 3 for the
   /// generated set (its ladder's 64, 128 and 256 spheres: from 64 to 128 the tuber's outcomes
   /// still move), 2 with --recordings-set (as diagnose: fills with 2 and 4 times the spheres).
@@ -742,6 +744,10 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "(default 3: 64, 128, 256); with --recordings-set, fills of the mesh with 2, 4, ... times the "
                  "spheres (default 2, as diagnose)")
       ->check(CLI::Range(0, 4));
+  app.add_option("--ensemble-replays-at-gate", o.replays_at_gate,
+                 "Replays per recording of a case's second comparison beyond the release horizon when the first "
+                 "decided at a gate (as diagnose's; 0: never)")
+      ->check(CLI::Range(0, 1000));
   app.add_option("--compare", o.compare,
                  "Another run's --out (the same cases: the same recordings diagnosed by another build, or the set "
                  "filmed another way): after scoring, each case's verdict, basis and time beside that run's, the "
@@ -872,10 +878,11 @@ std::string surface_folder(const std::string& surface, const std::string& name) 
 /// (the diagnosis sees the recordings directory and the clump, nothing else).
 bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTable& table, const BenchOptions& o) {
   const fs::path dir = fs::path(o.out) / c.id;
-  const cli::DiagnoseJob job{.recordings = {(dir / "recordings").string()},
-                             .library = o.clump_file,
-                             .clump_name = o.clump_name,
-                             .finer_clumps = o.finer_clumps.value_or(3)};
+  cli::DiagnoseJob job{.recordings = {(dir / "recordings").string()},
+                       .library = o.clump_file,
+                       .clump_name = o.clump_name,
+                       .finer_clumps = o.finer_clumps.value_or(3)};
+  job.options.ensemble_replays_at_gate = o.replays_at_gate;
   // Recordings already made (their answer is written last) are diagnosed as they are: delete a
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
@@ -996,10 +1003,11 @@ int main(int argc, char** argv) {
   auto compared = [&](int scored) {
     return scored != 0 || !team->leader() || o.compare.empty() ? scored : write_comparison(o.out, o.compare);
   };
-  if (!o.recordings_set.empty())
-    return compared(run_recordings_set(
-        o.recordings_set, o.out, cli::DiagnoseJob{.spheres = o.spheres, .finer_clumps = o.finer_clumps.value_or(2)},
-        o.existing_only, *team));
+  if (!o.recordings_set.empty()) {
+    cli::DiagnoseJob job{.spheres = o.spheres, .finer_clumps = o.finer_clumps.value_or(2)};
+    job.options.ensemble_replays_at_gate = o.replays_at_gate;
+    return compared(run_recordings_set(o.recordings_set, o.out, job, o.existing_only, *team));
+  }
   const MaterialTable table = default_material_table();
   auto generator = generator_clump(o);
   auto cases = generator ? generated_cases(o, table) : Result<std::vector<Case>>(std::unexpected(generator.error()));
