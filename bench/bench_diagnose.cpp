@@ -142,6 +142,37 @@ std::string contradiction_line(const std::vector<std::optional<bool>>& contradic
       contradicting, judged);
 }
 
+/// The gate a report's comparison beyond the release horizon was made again at (its gate_retry),
+/// or empty.
+std::string gate_of(const nlohmann::json& report) {
+  if (!report.contains("gate_retry") || !report["gate_retry"].is_object()) return "";
+  return bench::string_or(report["gate_retry"], "gate", "?");
+}
+
+/// The cases compared again at a gate (each case's gate, empty where none, and its time): how
+/// many, at which gates, and the median time of those cases and of the others; a markdown line,
+/// and summary["second_comparisons"].
+std::string gate_line(const std::vector<std::pair<std::string, double>>& cases, nlohmann::json& summary) {
+  std::map<std::string, int> count;
+  std::vector<double> again, once;
+  for (const auto& [gate, seconds] : cases) {
+    if (!gate.empty()) ++count[gate];
+    (gate.empty() ? once : again).push_back(seconds);
+  }
+  summary["second_comparisons"] = {{"cases", again.size()},
+                                   {"of", cases.size()},
+                                   {"gates", count},
+                                   {"median_seconds_again", median(again)},
+                                   {"median_seconds_once", median(once)}};
+  std::vector<std::string> gates;
+  for (const auto& [gate, n] : count) gates.push_back(fmt::format("{} {}", gate, n));
+  return fmt::format(
+      "compared again beyond the release horizon with more replays, the first draw at a gate: {}/{}{}; median "
+      "time of those {:.1f} s, of the others {:.1f} s\n",
+      again.size(), cases.size(), gates.empty() ? std::string() : fmt::format(" ({})", fmt::join(gates, ", ")),
+      median(again), median(once));
+}
+
 /// The missed effects' advice counted (advice_for, the trials count left off): a markdown line,
 /// and summary["missed_advice"].
 std::string advice_tally(const std::vector<std::vector<std::string>>& missed, nlohmann::json& summary) {
@@ -336,6 +367,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   std::vector<std::string> missed_called_decided;
   std::vector<std::pair<std::string, std::string>> misnamed;
   std::vector<std::optional<bool>> contradicts;
+  std::vector<std::pair<std::string, double>> gates;  // gate_of each report, and its time
   std::vector<std::pair<std::string, std::optional<bench::TwinShift>>> missed_twins;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
@@ -371,6 +403,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       if (missed) missed_twins.emplace_back(id, twin);
     }
     seconds.push_back(j.value("seconds", NAN));
+    gates.emplace_back(gate_of(j), j.value("seconds", NAN));
     contradicts.push_back(advice_contradicts_verdict(j));
     table +=
         fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} | {} |\n", id,
@@ -406,6 +439,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   table += advice_tally(missed_advice, summary);
   table += twin_line(missed_twins, summary);
   table += contradiction_line(contradicts, summary);
+  table += gate_line(gates, summary);
   std::cout << "\n" << table;
   summary.update(nlohmann::json{{"set", set.string()},
                                 {"effects", effects},
@@ -448,6 +482,7 @@ struct CaseScore {
   std::vector<std::string> advice;         ///< what the report says more trials would do for the truth (advice_for)
   std::optional<bool> advice_contradicts;  ///< advice_contradicts_verdict
   std::string id;                          ///< the case's folder
+  std::string gate;                        ///< gate_of its report
   std::optional<bench::TwinShift> twin;    ///< from its answer's twins (nullopt: a control, or none stored)
 };
 
@@ -478,6 +513,7 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   }
   if (truth != "none") o.advice = advice_for(j, {truth});
   o.advice_contradicts = advice_contradicts_verdict(j);
+  o.gate = gate_of(j);
   if (j.contains("stage_seconds") && j["stage_seconds"].is_array()) {
     for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", NAN));
   }
@@ -505,6 +541,9 @@ std::string time_summary(const std::vector<CaseScore>& outcomes, nlohmann::json&
                                median(controls), median(effects));
   summary["median_seconds_controls"] = median(controls);
   summary["median_seconds_effects"] = median(effects);
+  std::vector<std::pair<std::string, double>> gates;
+  for (const auto& o : outcomes) gates.emplace_back(o.gate, o.seconds);
+  md += gate_line(gates, summary);
   if (order.empty()) return md;
   md += "\n| stage | median share of a case |\n|---|---:|\n";
   for (const auto& stage : order) {

@@ -320,6 +320,16 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["particle_model"] = particle_model_json(r);
   j["flights"] = r.flights ? flights_json(*r.flights) : nlohmann::json();
   if (r.ensemble) j["ensemble"] = ensemble_json(*r.ensemble);
+  if (r.gate_retry) {
+    const GateRetry& g = *r.gate_retry;
+    j["gate_retry"] = {{"gate", gate_name(g.gate)},
+                       {"value", g.value},
+                       {"threshold", g.threshold},
+                       {"replays_first", g.replays_first},
+                       {"replays_second", g.replays_second},
+                       {"replayed_first", g.replayed_first},
+                       {"statement", g.statement}};
+  }
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
   j["phases"] = phases_json(r.phases);
   j["hypotheses"] = hypotheses_json(r.hypotheses);

@@ -219,6 +219,24 @@ struct EnsembleReport {
   double trials = 0.0;                              ///< recorded trials per recording (mean)
 };
 
+/// The gate a comparison beyond the release horizon decided at (diagnosis::at_a_gate).
+enum class Gate {
+  NullConsistency,  ///< the calibrated null's consistency tail near its threshold
+  CandidateMargin,  ///< a plausible candidate's lower-draw delta-BIC near the margin
+  Convergence,      ///< a finer clump's outcome shift near its p threshold, while it matters
+};
+std::string_view gate_name(Gate gate);
+
+/// A comparison made again with more replays because its first draw decided at a gate.
+struct GateRetry {
+  Gate gate = Gate::NullConsistency;
+  double value = 0.0, threshold = 0.0;  ///< the gate's statistic and its threshold (a tail, a delta-BIC or a p)
+  int replays_first = 0;                ///< replays per recording of the first comparison
+  int replays_second = 0;               ///< and of the one the verdict rests on
+  int replayed_first = 0;               ///< DEM replays the first comparison ran
+  std::string statement;                ///< for a person
+};
+
 /// A phase of one recording (the phases of all its trials), where a finding is.
 struct PhaseOf {
   std::string recording;  ///< recording name
@@ -307,6 +325,7 @@ struct DiagnoseResult {
   bool summaries_only = false;  ///< no tracks: what summaries can and cannot decide (in `decidable`, `undecidable`)
   std::vector<std::string> decidable, undecidable;
   std::optional<EnsembleReport> ensemble;
+  std::optional<GateRetry> gate_retry;               ///< when the ensemble was compared again at a gate
   std::optional<ParticleModelCheck> particle_model;  ///< when finer clumps were given
   std::optional<FlightWobble> flights;               ///< when drops were tracked
   int tracked_trials = 0, training_trials = 0, evaluations = 0;

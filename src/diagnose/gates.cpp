@@ -4,7 +4,21 @@
 
 #include "diagnose/stages.hpp"
 
-namespace clumpforge::diagnosis {
+namespace clumpforge {
+
+std::string_view gate_name(Gate gate) {
+  switch (gate) {
+    case Gate::NullConsistency:
+      return "null_consistency";
+    case Gate::CandidateMargin:
+      return "candidate_margin";
+    case Gate::Convergence:
+      return "convergence";
+  }
+  return "null_consistency";
+}
+
+namespace diagnosis {
 namespace {
 
 /// Whether `value` lies within a factor kGateBand of `threshold`, on either side.
@@ -14,39 +28,46 @@ bool near(double value, double threshold) {
 
 /// The calibrated null's consistency (outcomes_consistent: the means' tail and the spreads'
 /// apart) when either tail sits near the threshold.
-std::optional<std::string> consistency_at_gate(const EnsembleReport& e) {
+std::optional<GateRetry> consistency_at_gate(const EnsembleReport& e) {
   const ConsistencyTests t = consistency_tests(e.null_comparisons, e.calibrated_here.size());
   const double threshold = 0.5 * kConsistentTail;
   for (const auto& [name, test] : {std::pair{"means", t.means}, std::pair{"spreads", t.spreads}}) {
     if (test.dof > 0.0 && near(test.tail, threshold))
-      return fmt::format(
-          "the calibrated null's {} at chi^2 {:.1f} over {:.0f} degrees of freedom, tail {:.2g} "
-          "against the {:.2g} that decides consistency",
-          name, test.chi2, test.dof, test.tail, threshold);
+      return GateRetry{.gate = Gate::NullConsistency,
+                       .value = test.tail,
+                       .threshold = threshold,
+                       .statement = fmt::format("the calibrated null's {} at chi^2 {:.1f} over {:.0f} degrees of "
+                                                "freedom, tail {:.2g} against the {:.2g} that decides consistency",
+                                                name, test.chi2, test.dof, test.tail, threshold)};
   }
   return std::nullopt;
 }
 
 }  // namespace
 
-std::optional<std::string> at_a_gate(const DiagnoseResult& result, double min_delta_bic) {
+std::optional<GateRetry> at_a_gate(const DiagnoseResult& result, double min_delta_bic) {
   if (!result.ensemble || result.ensemble->outcomes == 0) return std::nullopt;
   const EnsembleReport& e = *result.ensemble;
   if (auto why = consistency_at_gate(e)) return why;
   for (const EnsembleHypothesis& h : e.hypotheses) {
     const double d = h.delta_bic();
     if (h.plausible && d >= 0.5 * min_delta_bic && d < 2.0 * min_delta_bic)
-      return fmt::format("{} at delta-BIC {:.1f} against the margin of {:.0f}", effect_name(h.effect), d,
-                         min_delta_bic);
+      return GateRetry{.gate = Gate::CandidateMargin,
+                       .value = d,
+                       .threshold = min_delta_bic,
+                       .statement = fmt::format("{} at delta-BIC {:.1f} against the margin of {:.0f}",
+                                                effect_name(h.effect), d, min_delta_bic)};
   }
   if (result.particle_model) {
     for (const ParticleModelRung& r : result.particle_model->rungs) {
       const auto& s = r.outcome_shift;
       if (s && s->means > 0 && s->largest >= OutcomeShift::kMatters && near(s->p, OutcomeShift::kReal))
-        return fmt::format(
-            "{}'s outcomes moved from the previous clump's at p = {:.2g} against the {:.2g} that "
-            "decides convergence",
-            r.name, s->p, OutcomeShift::kReal);
+        return GateRetry{.gate = Gate::Convergence,
+                         .value = s->p,
+                         .threshold = OutcomeShift::kReal,
+                         .statement = fmt::format("{}'s outcomes moved from the previous clump's at p = {:.2g} "
+                                                  "against the {:.2g} that decides convergence",
+                                                  r.name, s->p, OutcomeShift::kReal)};
     }
   }
   return std::nullopt;
@@ -58,8 +79,10 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
   const DiagnoseResult before = result;
   if (auto ok = judge_ensembles(c, result, baseline, full_scores, effects, options); !ok) return ok;
   if (options.ensemble_replays_at_gate > options.ensemble_replays) {
-    if (auto why = at_a_gate(result, options.min_delta_bic)) {
-      const int first = result.ensemble ? result.ensemble->replays : 0;
+    if (auto retry = at_a_gate(result, options.min_delta_bic)) {
+      retry->replays_first = options.ensemble_replays;
+      retry->replays_second = options.ensemble_replays_at_gate;
+      retry->replayed_first = result.ensemble ? result.ensemble->replays : 0;
       result = before;
       DiagnoseOptions more = options;
       more.ensemble_replays = options.ensemble_replays_at_gate;
@@ -67,11 +90,13 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
       result.notes.push_back(fmt::format(
           "the outcomes judged with {} replays per recording: with {} (the first draw, {} replays) the comparison "
           "decided at a gate, {}, where another draw of release orientations can decide otherwise",
-          options.ensemble_replays_at_gate, options.ensemble_replays, first, *why));
+          retry->replays_second, retry->replays_first, retry->replayed_first, retry->statement));
+      result.gate_retry = std::move(*retry);
     }
   }
   reconcile_advice(result);
   return {};
 }
 
-}  // namespace clumpforge::diagnosis
+}  // namespace diagnosis
+}  // namespace clumpforge

@@ -352,7 +352,8 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
 /// shift within a factor kGateBand of kReal in p while it matters. What it was, for a note; empty
 /// when every gate was passed or failed by more.
 constexpr double kGateBand = 10.0;
-std::optional<std::string> at_a_gate(const DiagnoseResult& result, double min_delta_bic);
+/// The gate found (GateRetry's gate, value, threshold and statement; the replays are the caller's).
+std::optional<GateRetry> at_a_gate(const DiagnoseResult& result, double min_delta_bic);
 /// The ensemble stage: judge_ensembles with options.ensemble_replays, made again from where it
 /// started with options.ensemble_replays_at_gate when it decided at a gate (at_a_gate), then
 /// reconcile_advice.

@@ -859,7 +859,11 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
     result.ensemble = std::move(e);
     return result;
   };
-  EXPECT_TRUE(diagnosis::at_a_gate(report_with(37.6, 16.1), 10.0));   // tail 1.8e-4
+  const auto case08 = diagnosis::at_a_gate(report_with(37.6, 16.1), 10.0);  // tail 1.8e-4
+  ASSERT_TRUE(case08);
+  EXPECT_EQ(case08->gate, Gate::NullConsistency);
+  EXPECT_NEAR(case08->value, 1.9e-4, 0.2e-4);  // the exact tail is 1.8e-4; chi2_upper_tail is Wilson-Hilferty's
+  EXPECT_EQ(case08->threshold, 5e-5);
   EXPECT_FALSE(diagnosis::at_a_gate(report_with(12.0, 16.1), 10.0));  // tail 0.45: consistent by far
   EXPECT_FALSE(diagnosis::at_a_gate(report_with(90.0, 16.1), 10.0));  // tail 4e-14: inconsistent by far
   EXPECT_TRUE(diagnosis::at_a_gate(report_with(12.0, 46.0), 10.0));   // the spreads' tail, 1e-4
@@ -872,7 +876,9 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
     h.first_delta_bic = first;
     h.fresh_delta_bic = fresh;
     result.ensemble->hypotheses.push_back(h);
-    return diagnosis::at_a_gate(result, 10.0).has_value();
+    const auto gate = diagnosis::at_a_gate(result, 10.0);
+    EXPECT_TRUE(!gate || gate->gate == Gate::CandidateMargin);
+    return gate.has_value();
   };
   EXPECT_TRUE(with_candidate(11.8, 5.5, true));   // lab-like case-01's viscous rolling
   EXPECT_TRUE(with_candidate(19.0, 25.0, true));  // named on the lower draw, 19: within reach
@@ -888,7 +894,9 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
     rung.outcome_shift = OutcomeShift{.means = 16, .chi2 = 30.0, .p = p, .largest = largest};
     check.rungs = {ParticleModelRung{}, rung};
     result.particle_model = check;
-    return diagnosis::at_a_gate(result, 10.0).has_value();
+    const auto gate = diagnosis::at_a_gate(result, 10.0);
+    EXPECT_TRUE(!gate || gate->gate == Gate::Convergence);
+    return gate.has_value();
   };
   EXPECT_TRUE(with_shift(0.0021, 1.8));   // the nine-set-up strong offset's 128 -> 256 shift at 5e7e13c
   EXPECT_TRUE(with_shift(0.05, 1.8));     // converged, but within the draw's reach
