@@ -43,21 +43,43 @@ std::optional<GateRetry> consistency_at_gate(const EnsembleReport& e) {
   return std::nullopt;
 }
 
+/// The candidates' margins: the best plausible candidate's over the null (its lower draw from half
+/// the margin to twice it), or, when it reaches the margin, a plausible rival's gap below it (the
+/// best's lower draw less the rival's higher one, under twice the margin: within the margin it
+/// makes the verdict ambiguous, closest_rival). A candidate far below a clear best decides nothing.
+std::optional<GateRetry> margin_at_gate(const EnsembleReport& e, double margin) {
+  const EnsembleHypothesis* best = nullptr;
+  for (const EnsembleHypothesis& h : e.hypotheses)
+    if (h.plausible && (!best || h.delta_bic() > best->delta_bic())) best = &h;
+  if (!best) return std::nullopt;
+  const double d = best->delta_bic();
+  if (d >= 0.5 * margin && d < 2.0 * margin)
+    return GateRetry{.gate = Gate::CandidateMargin,
+                     .value = d,
+                     .threshold = margin,
+                     .statement = fmt::format("{} at delta-BIC {:.1f} against the margin of {:.0f}",
+                                              effect_name(best->effect), d, margin)};
+  if (d < margin) return std::nullopt;
+  for (const EnsembleHypothesis& h : e.hypotheses) {
+    const double gap = d - h.best_delta_bic();
+    if (&h != best && h.plausible && gap > 0.0 && gap < 2.0 * margin)
+      return GateRetry{.gate = Gate::CandidateMargin,
+                       .value = gap,
+                       .threshold = margin,
+                       .statement = fmt::format("{} (delta-BIC {:.1f}) {:.1f} above its rival {} against the "
+                                                "margin of {:.0f}",
+                                                effect_name(best->effect), d, gap, effect_name(h.effect), margin)};
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<GateRetry> at_a_gate(const DiagnoseResult& result, double min_delta_bic) {
   if (!result.ensemble || result.ensemble->outcomes == 0) return std::nullopt;
   const EnsembleReport& e = *result.ensemble;
   if (auto why = consistency_at_gate(e)) return why;
-  for (const EnsembleHypothesis& h : e.hypotheses) {
-    const double d = h.delta_bic();
-    if (h.plausible && d >= 0.5 * min_delta_bic && d < 2.0 * min_delta_bic)
-      return GateRetry{.gate = Gate::CandidateMargin,
-                       .value = d,
-                       .threshold = min_delta_bic,
-                       .statement = fmt::format("{} at delta-BIC {:.1f} against the margin of {:.0f}",
-                                                effect_name(h.effect), d, min_delta_bic)};
-  }
+  if (auto why = margin_at_gate(e, min_delta_bic)) return why;
   if (result.particle_model) {
     for (const ParticleModelRung& r : result.particle_model->rungs) {
       const auto& s = r.outcome_shift;

@@ -347,10 +347,11 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
                              const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
                              const DiagnoseOptions& options);
 /// Where a comparison beyond the release horizon decided within reach of the draw of its
-/// replays: the calibrated null's consistency tail within a factor kGateBand of its threshold, a
-/// candidate's delta-BIC (lower draw) from half the margin to twice it, or a finer clump's outcome
-/// shift within a factor kGateBand of kReal in p while it matters. What it was, for a note; empty
-/// when every gate was passed or failed by more.
+/// replays: the calibrated null's consistency tail within a factor kGateBand of its threshold, the
+/// best plausible candidate's delta-BIC (lower draw) from half the margin to twice it or a rival
+/// less than twice the margin below a best that reaches it, or a finer clump's outcome shift within
+/// a factor kGateBand of kReal in p while it matters. Empty when every gate was passed or failed by
+/// more.
 constexpr double kGateBand = 10.0;
 /// The gate found (GateRetry's gate, value, threshold and statement; the replays are the caller's).
 std::optional<GateRetry> at_a_gate(const DiagnoseResult& result, double min_delta_bic);

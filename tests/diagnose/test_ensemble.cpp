@@ -868,7 +868,7 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
   EXPECT_FALSE(diagnosis::at_a_gate(report_with(90.0, 16.1), 10.0));  // tail 4e-14: inconsistent by far
   EXPECT_TRUE(diagnosis::at_a_gate(report_with(12.0, 46.0), 10.0));   // the spreads' tail, 1e-4
 
-  auto with_candidate = [&](double first, double fresh, bool plausible) {
+  auto with_candidate = [&](double first, double fresh, bool plausible, double best = NAN) {
     DiagnoseResult result = report_with(12.0, 16.1);
     EnsembleHypothesis h;
     h.effect = Effect::ViscousRolling;
@@ -876,6 +876,12 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
     h.first_delta_bic = first;
     h.fresh_delta_bic = fresh;
     result.ensemble->hypotheses.push_back(h);
+    if (std::isfinite(best)) {  // another candidate, better on its lower draw
+      h.effect = Effect::ComOffset;
+      h.plausible = true;
+      h.first_delta_bic = h.fresh_delta_bic = best;
+      result.ensemble->hypotheses.push_back(h);
+    }
     const auto gate = diagnosis::at_a_gate(result, 10.0);
     EXPECT_TRUE(!gate || gate->gate == Gate::CandidateMargin);
     return gate.has_value();
@@ -885,6 +891,12 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
   EXPECT_FALSE(with_candidate(24.6, 30.0, true));
   EXPECT_FALSE(with_candidate(4.9, 8.0, true));    // its lower draw below half the margin
   EXPECT_FALSE(with_candidate(11.8, 5.5, false));  // implausible: no draw names it
+  // A candidate far below a clear best decides nothing (lab-like case-10: com_offset named at
+  // 440.2, epsd_rolling at 6.4); a rival whose higher draw is less than twice the margin below
+  // the best's lower one is within reach of the rival rule.
+  EXPECT_FALSE(with_candidate(6.4, 6.4, true, 440.2));
+  EXPECT_TRUE(with_candidate(12.0, 25.0, true, 40.0));   // 15 below
+  EXPECT_FALSE(with_candidate(12.0, 15.0, true, 40.0));  // 25 below
 
   auto with_shift = [&](double p, double largest) {
     DiagnoseResult result = report_with(12.0, 16.1);
