@@ -149,28 +149,48 @@ std::string gate_of(const nlohmann::json& report) {
   return bench::string_or(report["gate_retry"], "gate", "?");
 }
 
-/// The cases compared again at a gate (each case's gate, empty where none, and its time): how
-/// many, at which gates, and the median time of those cases and of the others; a markdown line,
-/// and summary["second_comparisons"].
-std::string gate_line(const std::vector<std::pair<std::string, double>>& cases, nlohmann::json& summary) {
+/// A report's time without its second comparison at a gate (its seconds less gate_retry's
+/// seconds_second): what the case took with 12 replays alone.
+double seconds_once(const nlohmann::json& report) {
+  const double seconds = report.value("seconds", NAN);
+  if (!report.contains("gate_retry") || !report["gate_retry"].is_object()) return seconds;
+  return seconds - report["gate_retry"].value("seconds_second", 0.0);
+}
+
+/// A case as the gate line counts it: its report's gate (gate_of, empty where none), its time and
+/// its time without the second comparison (seconds_once).
+struct GateCase {
+  std::string gate;
+  double seconds = NAN, seconds_once = NAN;
+};
+GateCase gate_case(const nlohmann::json& report) {
+  return {gate_of(report), report.value("seconds", NAN), seconds_once(report)};
+}
+
+/// The cases compared again at a gate: how many, at which gates, the median time of those cases
+/// and of the others, and of every case without its second comparison; a markdown line, and
+/// summary["second_comparisons"].
+std::string gate_line(const std::vector<GateCase>& cases, nlohmann::json& summary) {
   std::map<std::string, int> count;
-  std::vector<double> again, once;
-  for (const auto& [gate, seconds] : cases) {
-    if (!gate.empty()) ++count[gate];
-    (gate.empty() ? once : again).push_back(seconds);
+  std::vector<double> again, once, without;
+  for (const auto& c : cases) {
+    if (!c.gate.empty()) ++count[c.gate];
+    (c.gate.empty() ? once : again).push_back(c.seconds);
+    without.push_back(c.seconds_once);
   }
   summary["second_comparisons"] = {{"cases", again.size()},
                                    {"of", cases.size()},
                                    {"gates", count},
                                    {"median_seconds_again", median(again)},
-                                   {"median_seconds_once", median(once)}};
+                                   {"median_seconds_once", median(once)},
+                                   {"median_seconds_without", median(without)}};
   std::vector<std::string> gates;
   for (const auto& [gate, n] : count) gates.push_back(fmt::format("{} {}", gate, n));
   return fmt::format(
       "compared again beyond the release horizon with more replays, the first draw at a gate: {}/{}{}; median "
-      "time of those {:.1f} s, of the others {:.1f} s\n",
+      "time of those {:.1f} s, of the others {:.1f} s; of every case without its second comparison {:.1f} s\n",
       again.size(), cases.size(), gates.empty() ? std::string() : fmt::format(" ({})", fmt::join(gates, ", ")),
-      median(again), median(once));
+      median(again), median(once), median(without));
 }
 
 /// The missed effects' advice counted (advice_for, the trials count left off): a markdown line,
@@ -367,7 +387,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   std::vector<std::string> missed_called_decided;
   std::vector<std::pair<std::string, std::string>> misnamed;
   std::vector<std::optional<bool>> contradicts;
-  std::vector<std::pair<std::string, double>> gates;  // gate_of each report, and its time
+  std::vector<GateCase> gates;
   std::vector<std::pair<std::string, std::optional<bench::TwinShift>>> missed_twins;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
@@ -403,7 +423,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       if (missed) missed_twins.emplace_back(id, twin);
     }
     seconds.push_back(j.value("seconds", NAN));
-    gates.emplace_back(gate_of(j), j.value("seconds", NAN));
+    gates.push_back(gate_case(j));
     contradicts.push_back(advice_contradicts_verdict(j));
     table +=
         fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} | {} |\n", id,
@@ -482,7 +502,7 @@ struct CaseScore {
   std::vector<std::string> advice;         ///< what the report says more trials would do for the truth (advice_for)
   std::optional<bool> advice_contradicts;  ///< advice_contradicts_verdict
   std::string id;                          ///< the case's folder
-  std::string gate;                        ///< gate_of its report
+  GateCase gate;                           ///< gate_case of its report
   std::optional<bench::TwinShift> twin;    ///< from its answer's twins (nullopt: a control, or none stored)
 };
 
@@ -513,7 +533,7 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   }
   if (truth != "none") o.advice = advice_for(j, {truth});
   o.advice_contradicts = advice_contradicts_verdict(j);
-  o.gate = gate_of(j);
+  o.gate = gate_case(j);
   if (j.contains("stage_seconds") && j["stage_seconds"].is_array()) {
     for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", NAN));
   }
@@ -541,8 +561,8 @@ std::string time_summary(const std::vector<CaseScore>& outcomes, nlohmann::json&
                                median(controls), median(effects));
   summary["median_seconds_controls"] = median(controls);
   summary["median_seconds_effects"] = median(effects);
-  std::vector<std::pair<std::string, double>> gates;
-  for (const auto& o : outcomes) gates.emplace_back(o.gate, o.seconds);
+  std::vector<GateCase> gates;
+  for (const auto& o : outcomes) gates.push_back(o.gate);
   md += gate_line(gates, summary);
   if (order.empty()) return md;
   md += "\n| stage | median share of a case |\n|---|---:|\n";

@@ -328,6 +328,8 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                        {"replays_first", g.replays_first},
                        {"replays_second", g.replays_second},
                        {"replayed_first", g.replayed_first},
+                       {"seconds_first", g.seconds_first},
+                       {"seconds_second", g.seconds_second},
                        {"statement", g.statement}};
   }
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};

@@ -234,6 +234,8 @@ struct GateRetry {
   int replays_first = 0;                ///< replays per recording of the first comparison
   int replays_second = 0;               ///< and of the one the verdict rests on
   int replayed_first = 0;               ///< DEM replays the first comparison ran
+  double seconds_first = 0.0;           ///< [s] wall clock of the first comparison
+  double seconds_second = 0.0;          ///< [s] and of the second (a case's time without it: seconds less this)
   std::string statement;                ///< for a person
 };
 
