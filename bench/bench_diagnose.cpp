@@ -142,29 +142,22 @@ std::string contradiction_line(const std::vector<std::optional<bool>>& contradic
       contradicting, judged);
 }
 
-/// The gate a report's comparison beyond the release horizon was made again at (its gate_retry),
-/// or empty.
-std::string gate_of(const nlohmann::json& report) {
-  if (!report.contains("gate_retry") || !report["gate_retry"].is_object()) return "";
-  return bench::string_or(report["gate_retry"], "gate", "?");
-}
-
-/// A report's time without its second comparison at a gate (its seconds less gate_retry's
-/// seconds_second): what the case took with 12 replays alone.
-double seconds_once(const nlohmann::json& report) {
-  const double seconds = report.value("seconds", NAN);
-  if (!report.contains("gate_retry") || !report["gate_retry"].is_object()) return seconds;
-  return seconds - report["gate_retry"].value("seconds_second", 0.0);
-}
-
-/// A case as the gate line counts it: its report's gate (gate_of, empty where none), its time and
-/// its time without the second comparison (seconds_once).
+/// A case as the gate line counts it: the gate its comparison beyond the release horizon was made
+/// again at (its report's gate_retry; empty where none), its time, and its time without that second
+/// comparison (seconds less gate_retry's seconds_second).
 struct GateCase {
   std::string gate;
-  double seconds = NAN, seconds_once = NAN;
+  double seconds = NAN, seconds_without = NAN;
 };
 GateCase gate_case(const nlohmann::json& report) {
-  return {gate_of(report), report.value("seconds", NAN), seconds_once(report)};
+  GateCase c{.seconds = report.value("seconds", NAN)};
+  c.seconds_without = c.seconds;
+  if (report.contains("gate_retry") && report["gate_retry"].is_object()) {
+    const auto& retry = report["gate_retry"];
+    c.gate = bench::string_or(retry, "gate", "?");
+    c.seconds_without -= retry.value("seconds_second", 0.0);
+  }
+  return c;
 }
 
 /// The cases compared again at a gate: how many, at which gates, the median time of those cases
@@ -176,7 +169,7 @@ std::string gate_line(const std::vector<GateCase>& cases, nlohmann::json& summar
   for (const auto& c : cases) {
     if (!c.gate.empty()) ++count[c.gate];
     (c.gate.empty() ? once : again).push_back(c.seconds);
-    without.push_back(c.seconds_once);
+    without.push_back(c.seconds_without);
   }
   summary["second_comparisons"] = {{"cases", again.size()},
                                    {"of", cases.size()},
