@@ -799,7 +799,7 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--ensemble-replays-at-gate", o.replays_at_gate,
                  "Replays per recording of a case's second comparison beyond the release horizon when the first "
                  "decided at a gate (as diagnose's; 0: never)")
-      ->check(CLI::Range(0, 1000));
+      ->check(CLI::Range(0, 0) | CLI::Range(4, 1000));  // diagnose's own rule, before any case is made
   app.add_option("--compare", o.compare,
                  "Another run's --out (the same cases: the same recordings diagnosed by another build, or the set "
                  "filmed another way): after scoring, each case's verdict, basis and time beside that run's, the "

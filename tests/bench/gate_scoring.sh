@@ -40,4 +40,10 @@ s = json.load(open(sys.argv[1]))["second_comparisons"]
 assert s["cases"] == 1 and s["of"] == 2 and s["gates"] == {"convergence": 1}, s
 assert s["median_seconds_again"] == 7 and s["median_seconds_once"] == 5 and s["median_seconds_without"] == 4.5, s
 PY
+# A second draw too small to have a spread is refused before any case is made.
+if "$bench" -o "$dir/refused" --ensemble-replays-at-gate 2 >"$dir/log" 2>&1; then
+  echo "--ensemble-replays-at-gate 2 was accepted"; exit 1
+fi
+grep -q -- "--ensemble-replays-at-gate" "$dir/log" || { cat "$dir/log"; exit 1; }
+[ ! -e "$dir/refused" ] || { echo "a refused run wrote $dir/refused"; exit 1; }
 echo ok

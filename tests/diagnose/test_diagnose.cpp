@@ -964,6 +964,14 @@ TEST(DiagnoseOptions, AbsurdImpactAccuracyOrEnsembleSizeIsRefusedByName) {
   ASSERT_FALSE(result);
   EXPECT_EQ(result.error().code, ErrorCode::InvalidArgument);
   EXPECT_NE(result.error().message.find("ensemble"), std::string::npos) << result.error().message;
+  for (const int at_gate : {2, 1001}) {  // a second draw too small to have a spread, or absurd
+    options = {};
+    options.ensemble_replays_at_gate = at_gate;
+    result = diagnose(clump, table, recordings, names, options);
+    ASSERT_FALSE(result);
+    EXPECT_EQ(result.error().code, ErrorCode::InvalidArgument);
+    EXPECT_NE(result.error().message.find("at a gate"), std::string::npos) << result.error().message;
+  }
 }
 
 }  // namespace clumpforge
