@@ -107,7 +107,8 @@ struct BodyFrame {
   Eigen::Vector3d omega;
 };
 
-void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, double dt, const BodyFrame& frame) {
+void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, double dt, const BodyFrame& frame,
+                  const PairConstants& pair) {
   RigidBody& body = world.bodies[b];
   const Wall& wall = world.walls[w];
   const Sphere& sphere = body.spheres[k];
@@ -121,7 +122,6 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
   const Eigen::Vector3d point = centre - (sphere.radius - 0.5 * overlap) * wall.normal;
   const Eigen::Vector3d arm = point - body.position;
   const Eigen::Vector3d& omega = frame.omega;
-  const PairConstants pair = pair_constants(world, body.material, wall.material);
   ContactInput in;
   in.normal = wall.normal;
   in.overlap = overlap;
@@ -281,7 +281,10 @@ void compute_forces(World& world, double dt) {
     const Eigen::Matrix3d rotation = body.orientation.toRotationMatrix();
     const BodyFrame frame{rotation, body.angular_velocity(rotation)};
     for (std::size_t w = 0; w < world.walls.size(); ++w) {
-      for (int k : lists[w]) wall_contact(world, b, static_cast<std::size_t>(k), w, dt, frame);
+      if (lists[w].empty()) continue;
+      // Looked up once per wall, not per sphere listed (3 % of a replay's time under perf).
+      const PairConstants pair = pair_constants(world, body.material, world.walls[w].material);
+      for (int k : lists[w]) wall_contact(world, b, static_cast<std::size_t>(k), w, dt, frame, pair);
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
