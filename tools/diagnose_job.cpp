@@ -137,17 +137,18 @@ nlohmann::json particle_model_json(const DiagnoseResult& r) {
   const auto& m = *r.particle_model;
   nlohmann::json rungs = nlohmann::json::array();
   for (const auto& rung : m.rungs) {
-    rungs.push_back(
-        {{"clump", rung.name},
-         {"spheres", rung.spheres},
-         {"track_difference_mm", finite_or_null(rung.track_difference_m * 1e3)},
-         {"refitted", rung.refitted},
-         {"chi2_per_value", rung.refitted ? finite_or_null(rung.chi2_per_value) : nlohmann::json()},
-         {"worst_phase_chi2_per_value",
-          rung.refitted ? finite_or_null(rung.worst_phase_chi2_per_value) : nlohmann::json()},
-         {"explains", rung.explains},
-         {"outcome_shift",
-          outcome_shift_json(rung.outcome_shift, r.ensemble ? r.ensemble->recordings : std::vector<std::string>{})}});
+    rungs.push_back({{"clump", rung.name},
+                     {"spheres", rung.spheres},
+                     {"track_difference_mm", finite_or_null(rung.track_difference_m * 1e3)},
+                     {"refitted", rung.refitted},
+                     {"chi2_per_value", rung.refitted ? finite_or_null(rung.chi2_per_value) : nlohmann::json()},
+                     {"worst_phase_chi2_per_value",
+                      rung.refitted ? finite_or_null(rung.worst_phase_chi2_per_value) : nlohmann::json()},
+                     {"explains", rung.explains},
+                     {"outcome_shift", outcome_shift_json(rung.outcome_shift, r.ensemble ? r.ensemble->recordings
+                                                                                         : std::vector<std::string>{})},
+                     {"seconds", rung.seconds},
+                     {"seconds_refit", rung.seconds_refit}});
   }
   return {{"diagnosed", m.diagnosed},
           {"spheres", m.spheres},

@@ -143,7 +143,11 @@ void bind_parts(py::module_& m) {
       .def_readonly("chi2_per_value", &ParticleModelRung::chi2_per_value)
       .def_readonly("worst_phase_chi2_per_value", &ParticleModelRung::worst_phase_chi2_per_value)
       .def_readonly("explains", &ParticleModelRung::explains)
-      .def_readonly("outcome_shift", &ParticleModelRung::outcome_shift);
+      .def_readonly("outcome_shift", &ParticleModelRung::outcome_shift)
+      .def_readonly("seconds", &ParticleModelRung::seconds,
+                    "[s] wall clock of its check beyond the release horizon (refit, replays, shifts)")
+      .def_readonly("seconds_refit", &ParticleModelRung::seconds_refit,
+                    "[s] of its refit alone; 0 when a second comparison at a gate took the first one's again");
   py::class_<ParticleModelCheck>(m, "ParticleModelCheck",
                                  "Whether the particle model, not missing physics, explains a mismatch.")
       .def_readonly("diagnosed", &ParticleModelCheck::diagnosed)

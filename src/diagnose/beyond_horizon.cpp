@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <iterator>
 #include <limits>
@@ -221,23 +222,40 @@ bool judge_on_converged_clump(DiagnoseResult& result, const ParticleModelCheck& 
 
 namespace {
 
+/// [s] the wall clock since `t`.
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+/// Adds the wall clock of its scope to `into` [s].
+class ScopeClock {
+ public:
+  explicit ScopeClock(double& into) : into_(into), started_(std::chrono::steady_clock::now()) {}
+  ~ScopeClock() { into_ += seconds_since(started_); }
+  ScopeClock(const ScopeClock&) = delete;
+  ScopeClock& operator=(const ScopeClock&) = delete;
+
+ private:
+  double& into_;
+  std::chrono::steady_clock::time_point started_;
+};
+
 /// A finer clump (swapped in) refitted: the baseline's coefficients refitted with it
 /// (fit_coefficients_near: the coefficients the frames pin change with the clump, a coarse clump
 /// rolls otherwise; those the windows leave unpinned stay the table's, unsearched: the windows are
 /// the diagnosed clump's, and whether a coefficient acts in them does not change with the clump),
-/// and its whole tracks replayed to put the recordings in its frame.
-struct Refitted {
-  Fitted fitted;
-  std::vector<TrialScore> scores;
-};
-Result<Refitted> refit_with_clump(Context& c, const Model& baseline, int max_evaluations) {
+/// and its whole tracks replayed to put the recordings in its frame; kept in c.refits, and a
+/// second comparison at a gate takes it from there.
+Result<const Refitted*> refit_with_clump(Context& c, const Model& baseline, int max_evaluations) {
+  const auto key = std::pair{c.ev.clump, &baseline};
+  if (auto kept = c.refits.find(key); kept != c.refits.end()) return &kept->second;
   auto fitted = fit_coefficients_near(c, baseline, c.training, max_evaluations);
   if (!fitted) return std::unexpected(fitted.error());
   c.ev.full_duration = true;
   auto scores = score(c, fitted->model, c.all, true);
   c.ev.full_duration = false;
   if (!scores) return std::unexpected(scores.error());
-  return Refitted{std::move(*fitted), std::move(*scores)};
+  return &(c.refits[key] = Refitted{std::move(*fitted), std::move(*scores)});
 }
 
 /// How far the resolution alone moves the outcomes: the clump swapped in (`scores` its
@@ -421,13 +439,18 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
   std::vector<Effect> passed_unconverged;   // candidates that passed on an agreement that moved on
   for (std::size_t k = 0; k < c.finer.size(); ++k) {
     const ClumpSwap swap(c, c.finer[k]);
-    auto refit = refit_with_clump(c, baseline, max_evaluations);
-    if (!refit) return std::unexpected(refit.error());
     ParticleModelRung& rung = check.rungs.at(k + 1);
+    const ScopeClock clock(rung.seconds);
+    const bool kept = c.refits.contains({c.ev.clump, &baseline});
+    const auto started = std::chrono::steady_clock::now();
+    auto refitted = refit_with_clump(c, baseline, max_evaluations);
+    if (!refitted) return std::unexpected(refitted.error());
+    const Refitted& refit = **refitted;
+    rung.seconds_refit = kept ? 0.0 : seconds_since(started);
     rung.refitted = true;
     if (agreement) {
       // The previous clump explained the outcomes: does this one replay them the same?
-      auto shift = shift_from(c, previous_model, previous, refit->scores, eo);
+      auto shift = shift_from(c, previous_model, previous, refit.scores, eo);
       if (!shift) return std::unexpected(shift.error());
       rung.outcome_shift = *shift;
       ParticleModelRung& agreed = check.rungs.at(k);
@@ -450,7 +473,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     // The candidates of a rung that does not explain the outcomes are read only on the last rung
     // (judge_on_converged_clump); an explaining one's always (settled on, or its agreement).
     pursue.candidates_when_inconsistent = k + 1 == c.finer.size();
-    auto fine = compare_ensembles(c.ev, refit->fitted.model, refit->scores, free, candidates, pursue);
+    auto fine = compare_ensembles(c.ev, refit.fitted.model, refit.scores, free, candidates, pursue);
     if (!fine) return std::unexpected(fine.error());
     c.evaluations += fine->replays;
     rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
@@ -469,12 +492,12 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     if (!rung.explains && !rung.outcome_shift) {
       // This clump at the previous one's calibrated coefficients: how far the resolution alone
       // moves the outcomes (what particle_model_unconverged judges).
-      auto shift = shift_from(c, previous_model, previous, refit->scores, eo);
+      auto shift = shift_from(c, previous_model, previous, refit.scores, eo);
       if (!shift) return std::unexpected(shift.error());
       rung.outcome_shift = *shift;
     }
     previous = fine->null_comparisons;
-    previous_model = refit->fitted.model;
+    previous_model = refit.fitted.model;
     previous_model.base = fine->calibrated;
     if (rung.explains)
       agreement = std::move(*fine);

@@ -91,6 +91,9 @@ struct ParticleModelRung {
   /// that clump's calibrated coefficients (empty when not compared on outcomes, or when it
   /// explains them and the previous clump did not).
   std::optional<OutcomeShift> outcome_shift;
+  /// [s] wall clock of its check beyond the release horizon (its refit, replays and shifts), and of
+  /// its refit alone (0 when a first comparison's refit was taken again, diagnosis::Context::refits).
+  double seconds = 0.0, seconds_refit = 0.0;
 };
 
 /// Whether the particle model, not missing physics, explains a mismatch.

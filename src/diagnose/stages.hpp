@@ -129,6 +129,20 @@ struct TrialSpread {
   int trials = 0;
 };
 
+struct Fitted {
+  Model model;
+  double chi2 = 0.0;
+  int evaluations = 0;
+  int values = 0;  ///< residual values behind chi2 (set by refit)
+};
+
+/// A finer clump's coefficients refitted on the training trials, with its whole tracks replayed
+/// at them to put the recordings in its frame (refit_with_clump).
+struct Refitted {
+  Fitted fitted;
+  std::vector<TrialScore> scores;
+};
+
 struct Context {
   Evaluator ev;
   /// Coefficients the fitted windows do not pin (surface, which), and the materials table's
@@ -147,6 +161,10 @@ struct Context {
   /// Finer clumps of the same body than the one diagnosed (c.ev.clump), coarsest first: what the
   /// particle-model check refits with before a mismatch is blamed on missing physics.
   std::vector<const Clump*> finer;
+  /// Each finer clump's refit from a baseline (refit_with_clump), kept for a second comparison at
+  /// a gate, which asks the same of it: the refit is frame by frame, before the release horizon,
+  /// and does not depend on the replays beyond it.
+  std::map<std::pair<const Clump*, const Model*>, Refitted> refits;
 };
 
 /// Replays run with `clump` while it lives; the clump before it is restored after.
@@ -160,13 +178,6 @@ class ClumpSwap {
  private:
   Context& c_;
   const Clump* kept_;
-};
-
-struct Fitted {
-  Model model;
-  double chi2 = 0.0;
-  int evaluations = 0;
-  int values = 0;  ///< residual values behind chi2 (set by refit)
 };
 
 /// What the baseline leaves, per trial and phase.

@@ -330,6 +330,10 @@ void expect_speed_dependent_restitution_named(const nlohmann::json& j) {
   const auto& rungs = j["particle_model"]["rungs"];
   ASSERT_EQ(rungs.size(), 2u) << j["particle_model"].dump();
   EXPECT_TRUE(rungs[1]["refitted"].get<bool>()) << j["particle_model"].dump();
+  // What its check cost, its refit a part of that.
+  EXPECT_GT(rungs[1]["seconds"].get<double>(), 0.0) << rungs[1].dump();
+  EXPECT_GE(rungs[1]["seconds_refit"].get<double>(), 0.0) << rungs[1].dump();
+  EXPECT_LE(rungs[1]["seconds_refit"].get<double>(), rungs[1]["seconds"].get<double>()) << rungs[1].dump();
 }
 }  // namespace
 
@@ -394,6 +398,13 @@ TEST(DiagnoseCli, AnAgreementThatMovesWithTheResolutionNamesNothingAndClaimsNoAb
   const auto& rungs = pm["rungs"];
   // The 128-sphere clump was checked against the 256-sphere one.
   ASSERT_TRUE(rungs[2]["refitted"].get<bool>()) << pm.dump();
+  // Each rung refitted says what its check cost, its refit a part of that.
+  for (const auto& rung : rungs) {
+    if (!rung["refitted"].get<bool>()) continue;
+    EXPECT_GT(rung["seconds"].get<double>(), 0.0) << rung.dump();
+    EXPECT_GE(rung["seconds_refit"].get<double>(), 0.0) << rung.dump();
+    EXPECT_LE(rung["seconds_refit"].get<double>(), rung["seconds"].get<double>()) << rung.dump();
+  }
   ASSERT_TRUE(rungs[2]["outcome_shift"].is_object()) << pm.dump();
   const bool converged = rungs[2]["outcome_shift"]["converged"].get<bool>();
   if (verdict == "elastic_plastic_restitution" || verdict == "viscoelastic_restitution") {

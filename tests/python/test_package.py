@@ -176,6 +176,7 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
     assert cf.Basis.unconverged_particle_model != cf.Basis.unexplained_outcomes
     assert {"means", "chi2", "p", "largest", "outcome", "converged"} <= set(dir(cf.OutcomeShift))
     assert "outcome_shift" in dir(cf.ParticleModelRung)
+    assert "seconds" in dir(cf.ParticleModelRung) and "seconds_refit" in dir(cf.ParticleModelRung)
     # The drops' free flights: what they say about the tracked point, and the basis they name on.
     assert "flights" in dir(cf.DiagnoseResult)
     assert {"judged", "wobble_m", "allowance_m", "detected", "offset_m", "smallest_offset_m"} <= set(dir(cf.FlightWobble))
