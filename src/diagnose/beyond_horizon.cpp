@@ -222,11 +222,6 @@ bool judge_on_converged_clump(DiagnoseResult& result, const ParticleModelCheck& 
 
 namespace {
 
-/// [s] the wall clock since `t`.
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 /// Adds the wall clock of its scope to `into` [s].
 class ScopeClock {
  public:

@@ -15,9 +15,8 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   DiagnoseResult result;
   // Closes a stage: the time since the last one closed.
   const auto took = [&](Stage stage) {
-    const auto now = std::chrono::steady_clock::now();
-    result.stage_seconds.push_back({stage, std::chrono::duration<double>(now - lap).count()});
-    lap = now;
+    result.stage_seconds.push_back({stage, seconds_since(lap)});
+    lap = std::chrono::steady_clock::now();
   };
   if (auto ok = check_inputs(clump, recordings, names, options); !ok) return std::unexpected(ok.error());
   bool any_track = false;
@@ -37,9 +36,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   c.ev.impact_accuracy = options.impact_accuracy;
   const std::vector<double> camera_noise = load_tracks(c, result, recordings, names, options);
   took(Stage::LoadAndNoise);
-  const auto seconds = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  };
+  const auto seconds = [&] { return seconds_since(started); };
   if (auto why = undecidable_tracks(c, camera_noise)) {
     result.verdict = Verdict::Undecidable;
     std::tie(result.basis, result.statement) = std::move(*why);

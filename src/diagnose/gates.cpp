@@ -102,22 +102,19 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
                             const DiagnoseOptions& options) {
   const DiagnoseResult before = result;
   const auto started = std::chrono::steady_clock::now();
-  const auto since = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-  };
   if (auto ok = judge_ensembles(c, result, baseline, full_scores, effects, options); !ok) return ok;
   if (options.ensemble_replays_at_gate > options.ensemble_replays) {
     if (auto retry = at_a_gate(result, options.min_delta_bic)) {
       retry->replays_first = options.ensemble_replays;
       retry->replays_second = options.ensemble_replays_at_gate;
       retry->replayed_first = result.ensemble ? result.ensemble->replays : 0;
-      retry->seconds_first = since(started);
+      retry->seconds_first = seconds_since(started);
       const auto second = std::chrono::steady_clock::now();
       result = before;
       DiagnoseOptions more = options;
       more.ensemble_replays = options.ensemble_replays_at_gate;
       if (auto ok = judge_ensembles(c, result, baseline, full_scores, effects, more); !ok) return ok;
-      retry->seconds_second = since(second);
+      retry->seconds_second = seconds_since(second);
       result.notes.push_back(fmt::format(
           "the outcomes judged with {} replays per recording: with {} (the first draw, {} replays) the comparison "
           "decided at a gate, {}, where another draw of release orientations can decide otherwise",

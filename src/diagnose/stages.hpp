@@ -12,6 +12,7 @@
 /// - beyond_horizon.cpp: the free flights, and the outcomes over the unknown release compared
 ///   with replay ensembles;
 /// - verdict.cpp: the decision between the hypotheses and what the result says.
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -135,6 +136,11 @@ struct Fitted {
   int evaluations = 0;
   int values = 0;  ///< residual values behind chi2 (set by refit)
 };
+
+/// [s] the wall clock since `t` (the report's stage, comparison and rung times).
+inline double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
 
 /// A finer clump's coefficients refitted on the training trials, with its whole tracks replayed
 /// at them to put the recordings in its frame (refit_with_clump).
