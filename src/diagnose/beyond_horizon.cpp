@@ -240,16 +240,19 @@ class ScopeClock {
 /// rolls otherwise; those the windows leave unpinned stay the table's, unsearched: the windows are
 /// the diagnosed clump's, and whether a coefficient acts in them does not change with the clump),
 /// and its whole tracks replayed to put the recordings in its frame; kept in c.refits, and a
-/// second comparison at a gate takes it from there.
-Result<const Refitted*> refit_with_clump(Context& c, const Model& baseline, int max_evaluations) {
+/// second comparison at a gate takes it from there. `seconds` is what it took: 0 when kept.
+Result<const Refitted*> refit_with_clump(Context& c, const Model& baseline, int max_evaluations, double& seconds) {
+  seconds = 0.0;
   const auto key = std::pair{c.ev.clump, &baseline};
   if (auto kept = c.refits.find(key); kept != c.refits.end()) return &kept->second;
+  const auto started = std::chrono::steady_clock::now();
   auto fitted = fit_coefficients_near(c, baseline, c.training, max_evaluations);
   if (!fitted) return std::unexpected(fitted.error());
   c.ev.full_duration = true;
   auto scores = score(c, fitted->model, c.all, true);
   c.ev.full_duration = false;
   if (!scores) return std::unexpected(scores.error());
+  seconds = seconds_since(started);
   return &(c.refits[key] = Refitted{std::move(*fitted), std::move(*scores)});
 }
 
@@ -436,12 +439,9 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     const ClumpSwap swap(c, c.finer[k]);
     ParticleModelRung& rung = check.rungs.at(k + 1);
     const ScopeClock clock(rung.seconds);
-    const bool kept = c.refits.contains({c.ev.clump, &baseline});
-    const auto started = std::chrono::steady_clock::now();
-    auto refitted = refit_with_clump(c, baseline, max_evaluations);
+    auto refitted = refit_with_clump(c, baseline, max_evaluations, rung.seconds_refit);
     if (!refitted) return std::unexpected(refitted.error());
     const Refitted& refit = **refitted;
-    rung.seconds_refit = kept ? 0.0 : seconds_since(started);
     rung.refitted = true;
     if (agreement) {
       // The previous clump explained the outcomes: does this one replay them the same?

@@ -122,6 +122,7 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
       result.gate_retry = std::move(*retry);
     }
   }
+  c.refits.clear();  // only a second comparison takes them again
   reconcile_advice(result);
   return {};
 }

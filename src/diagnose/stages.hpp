@@ -137,7 +137,7 @@ struct Fitted {
   int values = 0;  ///< residual values behind chi2 (set by refit)
 };
 
-/// [s] the wall clock since `t` (the report's stage, comparison and rung times).
+/// [s] the wall clock since `t` (the report's comparison and rung times).
 inline double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -169,7 +169,7 @@ struct Context {
   std::vector<const Clump*> finer;
   /// Each finer clump's refit from a baseline (refit_with_clump), kept for a second comparison at
   /// a gate, which asks the same of it: the refit is frame by frame, before the release horizon,
-  /// and does not depend on the replays beyond it.
+  /// and does not depend on the replays beyond it. Emptied when the ensemble stage ends.
   std::map<std::pair<const Clump*, const Model*>, Refitted> refits;
 };
 
