@@ -250,8 +250,13 @@ Eigen::Vector2d silhouette_centroid(const std::vector<Sphere>& spheres, const Ei
   std::stable_sort(discs.begin(), discs.end(), [](const Disc& a, const Disc& b) { return a.r > b.r; });
   std::vector<Disc> shown;
   for (const Disc& d : discs) {
-    const bool hidden = std::any_of(shown.begin(), shown.end(),
-                                    [&](const Disc& s) { return std::hypot(d.x - s.x, d.z - s.z) + d.r <= s.r; });
+    // hypot is at least the larger offset (faithfully rounded, it never falls below a double its
+    // exact value reaches), so a disc whose larger offset already reaches past s is not inside it:
+    // the same answer without the hypot, which was a fifth of a four-square tilt's filming.
+    const bool hidden = std::any_of(shown.begin(), shown.end(), [&](const Disc& s) {
+      const double dx = std::abs(d.x - s.x), dz = std::abs(d.z - s.z);
+      return std::max(dx, dz) + d.r <= s.r && std::hypot(dx, dz) + d.r <= s.r;
+    });
     if (!hidden) shown.push_back(d);
   }
   // The spans, grouped by row (a counting sort), each row's sorted by its left end.
