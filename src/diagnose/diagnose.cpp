@@ -37,11 +37,10 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   c.ev.impact_accuracy = options.impact_accuracy;
   const std::vector<double> camera_noise = load_tracks(c, result, recordings, names, options);
   took(Stage::LoadAndNoise);
-  const auto seconds = [&] { return seconds_since(started); };
   if (auto why = undecidable_tracks(c, camera_noise)) {
     result.verdict = Verdict::Undecidable;
     std::tie(result.basis, result.statement) = std::move(*why);
-    result.seconds = seconds();
+    result.seconds = seconds_since(started);
     return result;
   }
   auto start = starting_model(c, table, recordings, options);
@@ -157,7 +156,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   track_plots(c, result, *full_base, *full_improved);
   took(Stage::Ensemble);
   result.evaluations = c.evaluations;
-  result.seconds = seconds();
+  result.seconds = seconds_since(started);
   run.report("done", 1.0);
   return result;
 }

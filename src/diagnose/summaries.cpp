@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "diagnose/diagnose.hpp"
+#include "diagnose/stages.hpp"
 #include "numerics/minimize.hpp"
 #include "numerics/statistics.hpp"
 
@@ -111,7 +112,7 @@ Result<DiagnoseResult> diagnose_summaries(const Clump& clump, const MaterialTabl
   result.experiment =
       "film the drops from 0.5 and 1.0 m and the rolls at 1000 fps with sub-pixel centroid tracking, and add a second "
       "drop height and start distance";
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  result.seconds = diagnosis::seconds_since(started);
   return result;
 }
 
