@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "core/rng.hpp"
@@ -35,6 +37,76 @@ double lowest_height(const RigidBody& body) {
   const Eigen::Vector3d up = body.orientation.conjugate() * Eigen::Vector3d::UnitZ();
   double lowest = std::numeric_limits<double>::infinity();
   for (const auto& s : body.spheres) lowest = std::min(lowest, s.centre.dot(up) - s.radius);
+  return lowest + body.position.z();
+}
+
+// The body's spheres in groups of nearby ones (halved along the widest extent of their centres
+// down to 32 or fewer), each with its centre g and reach, max |c - g| + r over its spheres: no
+// sphere of a group has its lowest point below g . up - reach. For the generator's four-square
+// tilt (1360 spheres sampled every 0.1 ms) turning every sphere was a seventh of its time.
+struct SphereGroups {
+  struct Group {
+    Eigen::Vector3d centre;
+    double reach = 0.0;
+    std::size_t begin = 0, end = 0;  // into order
+  };
+  std::vector<std::size_t> order;
+  std::vector<Group> groups;
+};
+
+void split_groups(const std::vector<Sphere>& spheres, SphereGroups& out, std::size_t begin, std::size_t end) {
+  const auto first = out.order.begin() + static_cast<std::ptrdiff_t>(begin);
+  const auto last = out.order.begin() + static_cast<std::ptrdiff_t>(end);
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), high = -low;
+  for (auto it = first; it != last; ++it) {
+    low = low.cwiseMin(spheres[*it].centre);
+    high = high.cwiseMax(spheres[*it].centre);
+  }
+  if (end - begin > 32) {
+    Eigen::Index axis = 0;
+    (high - low).maxCoeff(&axis);
+    const std::size_t middle = begin + (end - begin) / 2;
+    std::nth_element(first, out.order.begin() + static_cast<std::ptrdiff_t>(middle), last,
+                     [&](std::size_t a, std::size_t b) { return spheres[a].centre(axis) < spheres[b].centre(axis); });
+    split_groups(spheres, out, begin, middle);
+    split_groups(spheres, out, middle, end);
+    return;
+  }
+  SphereGroups::Group g{.centre = 0.5 * (low + high), .begin = begin, .end = end};
+  for (auto it = first; it != last; ++it)
+    g.reach = std::max(g.reach, (spheres[*it].centre - g.centre).norm() + spheres[*it].radius);
+  out.groups.push_back(g);
+}
+
+SphereGroups group_spheres(const std::vector<Sphere>& spheres) {
+  SphereGroups out;
+  out.order.resize(spheres.size());
+  for (std::size_t k = 0; k < spheres.size(); ++k) out.order[k] = k;
+  if (!spheres.empty()) split_groups(spheres, out, 0, spheres.size());
+  return out;
+}
+
+// lowest_height, the same double: the group that may reach lowest first, then only the groups
+// that may reach below what was found. A group skipped reaches above it by more than a nanometre,
+// and the rounding of c . up - r (about 1e-18 m here) cannot close that gap, so every sphere left
+// out has a value above the minimum.
+double lowest_height(const RigidBody& body, const SphereGroups& groups) {
+  const Eigen::Vector3d up = body.orientation.conjugate() * Eigen::Vector3d::UnitZ();
+  auto bound = [&](const SphereGroups::Group& g) { return g.centre.dot(up) - g.reach; };
+  auto lowest_of = [&](const SphereGroups::Group& g, double lowest) {
+    for (std::size_t k = g.begin; k < g.end; ++k) {
+      const Sphere& s = body.spheres[groups.order[k]];
+      lowest = std::min(lowest, s.centre.dot(up) - s.radius);
+    }
+    return lowest;
+  };
+  if (groups.groups.empty()) return lowest_height(body);
+  std::size_t start = 0;
+  for (std::size_t i = 1; i < groups.groups.size(); ++i)
+    if (bound(groups.groups[i]) < bound(groups.groups[start])) start = i;
+  double lowest = lowest_of(groups.groups[start], std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < groups.groups.size(); ++i)
+    if (i != start && bound(groups.groups[i]) <= lowest + 1e-9) lowest = lowest_of(groups.groups[i], lowest);
   return lowest + body.position.z();
 }
 
@@ -367,6 +439,7 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
     origin = world.time - replay.tilt_start_deg * kPi / 180.0 / rate;
     next = origin + std::ceil((world.time - origin) / replay.sample_interval - 1e-9) * replay.sample_interval;
   }
+  const SphereGroups groups = group_spheres(body.spheres);
   std::vector<ReplaySample> samples;
   samples.reserve(static_cast<std::size_t>(replay.duration / replay.sample_interval) + 2);
   double slid_at = -1.0, rest_since = -1.0;
@@ -383,7 +456,7 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
       sample.angle = std::atan2(axis.z(), axis.x());
       sample.tilt_deg = rate * (world.time - origin) * 180.0 / kPi;
       sample.speed = b.velocity.norm();
-      sample.lowest = lowest_height(b);
+      sample.lowest = lowest_height(b, groups);
       sample.along_plate = (b.position - world.walls[0].pivot).dot(world.walls[0].u_axis);
       sample.contacts = active_contacts(world);
       sample.position = b.position;

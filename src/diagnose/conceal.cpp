@@ -277,6 +277,10 @@ Eigen::Vector2d silhouette_centroid(const std::vector<Sphere>& spheres, const Ei
   std::vector<std::pair<double, double>> spans(
       begin.back(), {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()});
   std::vector<std::size_t> fill(begin.begin(), begin.end() - 1);
+  // Laid from left to right by the discs' centres, each row's spans come nearly in order of
+  // their left ends (each lies within its disc's radius of its centre), and an insertion sort
+  // has little to move (a general sort of them was a fifth of the generator's time under perf).
+  std::stable_sort(shown.begin(), shown.end(), [](const Disc& a, const Disc& b) { return a.x < b.x; });
   for (const Disc& d : shown) {
     const auto [first, last] = rows_of(d);
     for (std::size_t k = first; k <= last; ++k) {
@@ -290,7 +294,14 @@ Eigen::Vector2d silhouette_centroid(const std::vector<Sphere>& spheres, const Ei
   for (std::size_t k = 0; k < row_count; ++k) {
     const auto row_begin = spans.begin() + static_cast<std::ptrdiff_t>(begin[k]);
     const auto row_end = spans.begin() + static_cast<std::ptrdiff_t>(fill[k]);
-    std::sort(row_begin, row_end);
+    // By left end alone: spans of one left end merge to the same union in either order (the
+    // largest right end of a run is kept), so the bytes are those of a sort by both ends.
+    for (auto it = row_begin; it != row_end; ++it) {
+      const std::pair<double, double> span = *it;
+      auto to = it;
+      for (; to != row_begin && std::prev(to)->first > span.first; --to) *to = *std::prev(to);
+      *to = span;
+    }
     const double z = low + (static_cast<double>(k) + 0.5) * pixel;
     double a = -std::numeric_limits<double>::infinity(), b = a;
     auto close = [&] {
