@@ -102,8 +102,11 @@ double lowest_height(const RigidBody& body, const SphereGroups& groups) {
   };
   if (groups.groups.empty()) return lowest_height(body);
   std::size_t start = 0;
-  for (std::size_t i = 1; i < groups.groups.size(); ++i)
-    if (bound(groups.groups[i]) < bound(groups.groups[start])) start = i;
+  double start_bound = bound(groups.groups.front());
+  for (std::size_t i = 1; i < groups.groups.size(); ++i) {
+    const double b = bound(groups.groups[i]);
+    if (b < start_bound) start = i, start_bound = b;
+  }
   double lowest = lowest_of(groups.groups[start], std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < groups.groups.size(); ++i)
     if (i != start && bound(groups.groups[i]) <= lowest + 1e-9) lowest = lowest_of(groups.groups[i], lowest);

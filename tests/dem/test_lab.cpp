@@ -199,9 +199,7 @@ TEST(LabTests, UnderARestitutionLawATiltReplayStartedOnATiltedPlateSlipsEarly) {
     }
   }
 }
-}  // namespace clumpforge
 
-namespace clumpforge {
 TEST(LabTests, AReplaysLowestPointIsTheMinimumOverEverySphereToTheBit) {
   // replay_trial takes the lowest point over groups of nearby spheres and skips a group that
   // cannot reach within a nanometre of the lowest found. The answer must be the same double as
@@ -241,7 +239,9 @@ TEST(LabTests, AReplaysLowestPointIsTheMinimumOverEverySphereToTheBit) {
     SCOPED_TRACE(testing::Message() << spheres.size() << " spheres, " << samples.size() << " samples, lowest sphere "
                                     << lowest_changes << " times another");
     EXPECT_EQ(differing, 0U);
-    if (setup.test == LabTest::Drop) EXPECT_GT(lowest_changes, 5U);  // it tumbles after the impact
+    if (setup.test == LabTest::Drop) {
+      EXPECT_GT(lowest_changes, 5U);  // it tumbles after the impact
+    }
   }
 }
 }  // namespace clumpforge
