@@ -105,7 +105,10 @@ double lowest_height(const RigidBody& body, const SphereGroups& groups) {
   double start_bound = bound(groups.groups.front());
   for (std::size_t i = 1; i < groups.groups.size(); ++i) {
     const double b = bound(groups.groups[i]);
-    if (b < start_bound) start = i, start_bound = b;
+    if (b < start_bound) {
+      start = i;
+      start_bound = b;
+    }
   }
   double lowest = lowest_of(groups.groups[start], std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < groups.groups.size(); ++i)
