@@ -1161,7 +1161,12 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   const auto library = effect_library();
   const bool unexplained = !outcomes_consistent(result.null_comparisons, free.size());
   std::vector<Proposal> proposals;
-  const bool try_candidates = !unexplained || options.candidates_when_inconsistent;
+  bool try_candidates = true;
+  if (unexplained && options.candidates_when_inconsistent) {
+    auto asked = options.candidates_when_inconsistent();
+    if (!asked) return std::unexpected(asked.error());
+    try_candidates = *asked;
+  }
   for (Effect e : try_candidates ? candidates : std::vector<Effect>{}) {
     auto proposal = propose(ev, plans, null_model, null_sample, null_means, recorded, inverse_se, scaling, jacobian,
                             free, effect_spec(library, e), options,

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string_view>
@@ -124,11 +125,13 @@ struct EnsembleOptions {
   /// outcomes would decide has its strong magnitude replayed with it too
   /// (Detectability::strong_resolution).
   const Clump* finer = nullptr;
-  /// Whether the candidates are tried when the calibrated null leaves the outcomes inconsistent.
-  /// Off for a rung of the particle-model check with a finer one after it: there only whether its
-  /// null explains the outcomes is asked (on the generated nine-set-up strong adhesion case the
-  /// 64-sphere rung's comparison took 14.2 s with its candidates and 2.3 s without).
-  bool candidates_when_inconsistent = true;
+  /// Whether the candidates are tried when the calibrated null leaves the outcomes inconsistent,
+  /// asked only then (unset: they are). No for a rung of the particle-model check with a finer one
+  /// after it: there only whether its null explains the outcomes is asked (on the generated
+  /// nine-set-up strong adhesion case the 64-sphere rung's comparison took 14.2 s with its
+  /// candidates and 2.3 s without); the last rung answers once it knows whether its outcomes
+  /// moved from the previous clump's (finer_clump_explains_outcomes).
+  std::function<Result<bool>()> candidates_when_inconsistent;
 };
 
 /// Recorded outcomes are consistent with replays while their chi^2 tail is at least this (the
