@@ -471,16 +471,23 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     // leaves the outcomes inconsistent, its move from the previous clump is measured first: tried
     // after an unconverged move, the candidates were half a second comparison's time and never
     // read (the generated nine-set-up set's strong cases at 4d984a9 with 48 replays: 5 of 8).
-    const bool last = k + 1 == c.finer.size();
+    // This clump at the previous one's calibrated coefficients: how far the resolution alone
+    // moves the outcomes (what particle_model_unconverged judges), measured once.
     std::optional<OutcomeShift> moved = rung.outcome_shift;
-    pursue.candidates_when_inconsistent = [&]() -> Result<bool> {
-      if (!last) return false;
+    auto move = [&]() -> Result<OutcomeShift> {
       if (!moved) {
         auto shift = shift_from(c, previous_model, previous, refit.scores, eo);
         if (!shift) return std::unexpected(shift.error());
         moved = *shift;
       }
-      return moved->converged();
+      return *moved;
+    };
+    const bool last = k + 1 == c.finer.size();
+    pursue.candidates_when_inconsistent = [&]() -> Result<bool> {
+      if (!last) return false;
+      auto shift = move();
+      if (!shift) return std::unexpected(shift.error());
+      return shift->converged();
     };
     auto fine = compare_ensembles(c.ev, refit.fitted.model, refit.scores, free, candidates, pursue);
     if (!fine) return std::unexpected(fine.error());
@@ -499,14 +506,9 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
       return true;
     }
     if (!rung.explains && !rung.outcome_shift) {
-      // This clump at the previous one's calibrated coefficients: how far the resolution alone
-      // moves the outcomes (what particle_model_unconverged judges).
-      if (!moved) {
-        auto shift = shift_from(c, previous_model, previous, refit.scores, eo);
-        if (!shift) return std::unexpected(shift.error());
-        moved = *shift;
-      }
-      rung.outcome_shift = *moved;
+      auto shift = move();
+      if (!shift) return std::unexpected(shift.error());
+      rung.outcome_shift = *shift;
     }
     previous = fine->null_comparisons;
     previous_model = refit.fitted.model;
