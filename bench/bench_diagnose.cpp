@@ -142,11 +142,14 @@ std::string contradiction_line(const std::vector<std::optional<bool>>& contradic
       contradicting, judged);
 }
 
-/// A case as the gate line counts it: the gate its comparison beyond the release horizon was made
-/// again at (its report's gate_retry; empty where none), its time, and its time without that second
-/// comparison (seconds less gate_retry's seconds_second).
+/// A case as the gate line counts it: the gate its comparison beyond the release horizon decided at
+/// (its report's gate_retry; empty where none), whether the gates' decisions held when judged again
+/// with more replays (then the comparison was not made again; reports before the checks: never), its
+/// time, and its time without what followed the first comparison (seconds less gate_retry's
+/// seconds_second).
 struct GateCase {
   std::string gate;
+  bool held = false;
   double seconds = NAN, seconds_without = NAN;
 };
 GateCase gate_case(const nlohmann::json& report) {
@@ -155,24 +158,28 @@ GateCase gate_case(const nlohmann::json& report) {
   if (report.contains("gate_retry") && report["gate_retry"].is_object()) {
     const auto& retry = report["gate_retry"];
     c.gate = bench::string_or(retry, "gate", "?");
+    c.held = retry.value("held", false);
     c.seconds_without -= retry.value("seconds_second", 0.0);
   }
   return c;
 }
 
-/// The cases compared again at a gate: how many, at which gates, the median time of those cases
-/// and of the others, and of every case without its second comparison; a markdown line, and
-/// summary["second_comparisons"].
+/// The cases at a gate: how many, at which gates, how many of them held when judged again (not
+/// compared again), the median time of those cases and of the others, and of every case without
+/// what followed its first comparison; a markdown line, and summary["second_comparisons"].
 std::string gate_line(const std::vector<GateCase>& cases, nlohmann::json& summary) {
   std::map<std::string, int> count;
   std::vector<double> again, once, without;
+  int held = 0;
   for (const auto& c : cases) {
     if (!c.gate.empty()) ++count[c.gate];
+    held += c.held ? 1 : 0;
     (c.gate.empty() ? once : again).push_back(c.seconds);
     without.push_back(c.seconds_without);
   }
   summary["second_comparisons"] = {{"cases", again.size()},
                                    {"of", cases.size()},
+                                   {"held", held},
                                    {"gates", count},
                                    {"median_seconds_again", median(again)},
                                    {"median_seconds_once", median(once)},
@@ -180,9 +187,10 @@ std::string gate_line(const std::vector<GateCase>& cases, nlohmann::json& summar
   std::vector<std::string> gates;
   for (const auto& [gate, n] : count) gates.push_back(fmt::format("{} {}", gate, n));
   return fmt::format(
-      "compared again beyond the release horizon with more replays, the first draw at a gate: {}/{}{}; median "
-      "time of those {:.1f} s, of the others {:.1f} s; of every case without its second comparison {:.1f} s\n",
-      again.size(), cases.size(), gates.empty() ? std::string() : fmt::format(" ({})", fmt::join(gates, ", ")),
+      "compared again beyond the release horizon with more replays, the first draw at a gate: {}/{}{}; of those, "
+      "the gates' decisions held with more replays (not compared again): {}; median time of those at a gate "
+      "{:.1f} s, of the others {:.1f} s; of every case without what followed its first comparison {:.1f} s\n",
+      again.size(), cases.size(), gates.empty() ? std::string() : fmt::format(" ({})", fmt::join(gates, ", ")), held,
       median(again), median(once), median(without));
 }
 

@@ -323,15 +323,18 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   if (r.ensemble) j["ensemble"] = ensemble_json(*r.ensemble);
   if (r.gate_retry) {
     const GateRetry& g = *r.gate_retry;
-    j["gate_retry"] = {{"gate", gate_name(g.gate)},
-                       {"value", g.value},
-                       {"threshold", g.threshold},
-                       {"replays_first", g.replays_first},
-                       {"replays_second", g.replays_second},
-                       {"replayed_first", g.replayed_first},
-                       {"seconds_first", g.seconds_first},
-                       {"seconds_second", g.seconds_second},
-                       {"statement", g.statement}};
+    j["gate_retry"] = {{"gate", gate_name(g.gate)},          {"value", g.value},
+                       {"threshold", g.threshold},           {"replays_first", g.replays_first},
+                       {"replays_second", g.replays_second}, {"replayed_first", g.replayed_first},
+                       {"seconds_first", g.seconds_first},   {"seconds_second", g.seconds_second},
+                       {"seconds_checks", g.seconds_checks}, {"held", g.held},
+                       {"checks", nlohmann::json::array()},  {"statement", g.statement}};
+    for (const GateCheck& k : g.checks)
+      j["gate_retry"]["checks"].push_back({{"gate", gate_name(k.gate)},
+                                           {"first", k.first},
+                                           {"second", k.second},
+                                           {"threshold", k.threshold},
+                                           {"held", k.held}});
   }
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
   j["phases"] = phases_json(r.phases);

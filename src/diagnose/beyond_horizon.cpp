@@ -163,9 +163,11 @@ void name_beyond_horizon(DiagnoseResult& result, const EnsembleResult& ens,
   }
 }
 
-/// The report's view of an ensemble comparison: the calibrated null and the candidates tried
-/// (replays are added, since a finer clump's comparison comes on top of the diagnosed one's).
-void report_ensemble(EnsembleReport& report, const EnsembleResult& ens) {
+/// The report's view of an ensemble comparison made with rung `rung`'s clump: the calibrated null
+/// and the candidates tried (replays are added, since a finer clump's comparison comes on top of
+/// the diagnosed one's).
+void report_ensemble(EnsembleReport& report, const EnsembleResult& ens, std::size_t rung) {
+  report.rung = rung;
   report.replays += ens.replays;
   report.outcomes = ens.outcomes;
   report.null_chi2 = ens.null_chi2;
@@ -210,7 +212,7 @@ bool judge_on_converged_clump(DiagnoseResult& result, const ParticleModelCheck& 
           last.name, hypotheses_tried(finest), min_delta_bic));
     return false;
   }
-  report_ensemble(*result.ensemble, finest);
+  report_ensemble(*result.ensemble, finest, check.rungs.size() - 1);
   name_beyond_horizon(result, finest, passing, min_delta_bic);
   result.statement += fmt::format(
       " Judged with {} ({} spheres), the finest clump tried: its replayed outcomes agree with those of {} spheres at "
@@ -347,7 +349,7 @@ bool settle_on_explaining_clump(DiagnoseResult& result, ParticleModelCheck& chec
     return false;
   }
   // Named on the clump the body needs: the report's ensemble is that clump's.
-  report_ensemble(*result.ensemble, fine);
+  report_ensemble(*result.ensemble, fine, static_cast<std::size_t>(&rung - check.rungs.data()));
   name_beyond_horizon(result, fine, passing, eo.min_delta_bic);
   result.statement +=
       coarse.consistent ? fmt::format(
@@ -428,6 +430,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
   // replaced when a candidate passes.)
   const Coarse coarse{e.null_chi2, e.outcomes, outcomes_consistent(e.null_comparisons, free.size())};
   check.worst_phase_chi2_per_value = largest_z2(e.null_comparisons);
+  check.rungs.front().calibrated = e.calibrated;
   // The previous rung's calibrated null: its model and its comparisons.
   Model previous_model = baseline;
   previous_model.base = e.calibrated;
@@ -492,6 +495,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     auto fine = compare_ensembles(c.ev, refit.fitted.model, refit.scores, free, candidates, pursue);
     if (!fine) return std::unexpected(fine.error());
     c.evaluations += fine->replays;
+    rung.calibrated = fine->calibrated;
     rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
     rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
     rung.explains = fine->outcomes == coarse.outcomes && outcomes_consistent(fine->null_comparisons, free.size());
@@ -738,6 +742,18 @@ void reconcile_advice(DiagnoseResult& result) {
   }
 }
 
+EnsembleOptions ensemble_options(const Context& c, const DiagnoseOptions& options, int replays) {
+  EnsembleOptions eo;
+  eo.replays = replays;
+  eo.orientation_prior_deg = options.orientation_prior_deg;
+  eo.roll_on_edge = on_edge_rolls(*c.ev.clump, options);
+  eo.impact_accuracy = options.impact_accuracy;
+  eo.min_delta_bic = options.min_delta_bic;
+  eo.seed = options.seed;
+  eo.finer = c.finer.empty() ? nullptr : c.finer.front();
+  return eo;
+}
+
 /// Beyond the release horizons: the recorded trials against replays from the release prior
 /// (diagnose/ensemble.hpp). The coefficients the frame fits left unpinned are calibrated on
 /// the outcomes; a candidate is named when its replays beat that null by the delta-BIC
@@ -770,19 +786,12 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
         !(e == Effect::ComOffset && flights_rule_out_offset(result)))
       candidates.push_back(e);
   }
-  EnsembleOptions eo;
-  eo.replays = options.ensemble_replays;
-  eo.orientation_prior_deg = options.orientation_prior_deg;
-  eo.roll_on_edge = on_edge_rolls(*c.ev.clump, options);
-  eo.impact_accuracy = options.impact_accuracy;
-  eo.min_delta_bic = options.min_delta_bic;
-  eo.seed = options.seed;
-  eo.finer = c.finer.empty() ? nullptr : c.finer.front();
+  EnsembleOptions eo = ensemble_options(c, options, options.ensemble_replays);
   auto ens = compare_ensembles(c.ev, baseline, full_scores, free, candidates, eo);
   if (!ens) return std::unexpected(ens.error());
   c.evaluations += ens->replays;
   EnsembleReport report;
-  report_ensemble(report, *ens);
+  report_ensemble(report, *ens, 0);
   report.recordings = c.names;
   for (const auto& f : free) {
     const auto& surface = baseline.base[f.surface].surface;

@@ -57,8 +57,9 @@ struct DiagnoseOptions {
   /// with more tracked trials is replayed once per trial. 0 skips it.
   int ensemble_replays = 12;
   /// Replays per recording when the comparison with `ensemble_replays` decided at one of its gates
-  /// (diagnosis::at_a_gate): it is made again with these, and judged on them alone; 0, or no more
-  /// than `ensemble_replays`: never.
+  /// (diagnosis::gates_at): each such decision is judged again with these, at the first draw's
+  /// calibrated coefficients; when one does not hold, the comparison is made again with these and
+  /// judged on them alone (GateRetry). 0, or no more than `ensemble_replays`: never.
   int ensemble_replays_at_gate = 48;
   /// Finer particle models of the same body (more spheres, or built another way), coarsest
   /// first; the clump diagnosed is the coarsest of all. They serve twice (see
@@ -94,6 +95,9 @@ struct ParticleModelRung {
   /// [s] wall clock of its check beyond the release horizon (its refit, replays and shifts), and of
   /// its refit alone (0 when a first comparison's refit was taken again, diagnosis::Context::refits).
   double seconds = 0.0, seconds_refit = 0.0;
+  /// Beyond the release horizon: its null's coefficients calibrated on the outcomes (empty when not
+  /// compared there); what the next clump's outcome_shift replays, and a gate's check again.
+  std::vector<SurfaceParameters> calibrated;
 };
 
 /// Whether the particle model, not missing physics, explains a mismatch.
@@ -220,6 +224,9 @@ struct EnsembleReport {
   std::vector<EnsembleHypothesis> hypotheses;       ///< tried with replays, best first
   std::vector<Detectability> detectability;         ///< per candidate
   double trials = 0.0;                              ///< recorded trials per recording (mean)
+  /// The particle-model rung whose clump it was made with (ParticleModelCheck::rungs; 0: the
+  /// diagnosed clump).
+  std::size_t rung = 0;
 };
 
 /// The gate a comparison beyond the release horizon decided at (diagnosis::at_a_gate).
@@ -230,7 +237,17 @@ enum class Gate {
 };
 std::string_view gate_name(Gate gate);
 
-/// A comparison made again with more replays because its first draw decided at a gate.
+/// One gate's decision judged again with more replays (diagnosis::gates_hold): its statistic on
+/// each draw, and whether the decision fell on the same side of the threshold.
+struct GateCheck {
+  Gate gate = Gate::NullConsistency;
+  double first = 0.0, second = 0.0, threshold = 0.0;
+  bool held = false;
+};
+
+/// A comparison judged again with more replays because its first draw decided at a gate: each
+/// gate's decision first, on replays from release orientations drawn afresh at the first draw's
+/// calibrated coefficients; the whole comparison made again only when one of them did not hold.
 struct GateRetry {
   Gate gate = Gate::NullConsistency;
   double value = 0.0, threshold = 0.0;  ///< the gate's statistic and its threshold (a tail, a delta-BIC or a p)
@@ -238,7 +255,10 @@ struct GateRetry {
   int replays_second = 0;               ///< and of the one the verdict rests on
   int replayed_first = 0;               ///< DEM replays the first comparison ran
   double seconds_first = 0.0;           ///< [s] wall clock of the first comparison
-  double seconds_second = 0.0;          ///< [s] and of the second (a case's time without it: seconds less this)
+  double seconds_second = 0.0;          ///< [s] and of all after it (a case's time without it: seconds less this)
+  double seconds_checks = 0.0;          ///< [s] of which the gates' checks
+  std::vector<GateCheck> checks;        ///< the gates judged again, in order, up to the first that did not hold
+  bool held = false;                    ///< every gate held: the first comparison stands, not made again
   std::string statement;                ///< for a person
 };
 

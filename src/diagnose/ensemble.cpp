@@ -281,16 +281,6 @@ ResponseSignal response_signal(const Eigen::VectorXd& response, const Eigen::Vec
   return out;
 }
 
-namespace {
-
-/// A candidate's margin over the null: its dispersion (chi^2 per degree of freedom, the
-/// outcomes less the free coefficients and its parameters, when above 1) and delta-BIC =
-/// (chi^2_null - chi^2) / dispersion - k ln n. Judged in units of the candidate's own misfit:
-/// no clump replays a real particle's outcomes exactly, and a candidate must not be named for
-/// absorbing the particle model's share of the misfit.
-struct Margin {
-  double dispersion = 1.0, delta_bic = 0.0;
-};
 Margin margin_over_null(double null_chi2, double chi2, int outcomes, std::size_t free, std::size_t parameters) {
   const double dof =
       std::max(1.0, static_cast<double>(outcomes) - static_cast<double>(free) - static_cast<double>(parameters));
@@ -299,7 +289,11 @@ Margin margin_over_null(double null_chi2, double chi2, int outcomes, std::size_t
           (null_chi2 - chi2) / dispersion - static_cast<double>(parameters) * std::log(std::max(1, outcomes))};
 }
 
-}  // namespace
+double chi2_of(const std::vector<OutcomeComparison>& c) {
+  double sum = 0.0;
+  for (const auto& x : c) sum += x.z * x.z;
+  return sum;
+}
 
 ErrorScaling error_scaling(const std::vector<OutcomeComparison>& made, const Eigen::VectorXd& inverse_se) {
   const auto n = static_cast<Eigen::Index>(made.size());
@@ -357,8 +351,6 @@ struct Plan {
 };
 
 using Sample = std::vector<std::vector<std::vector<double>>>;  ///< [plan][outcome][replay]
-
-constexpr std::uint64_t kNullStream = 90000;  ///< the null's orientations (compare_ensembles, compare_model)
 
 PathSample recorded_path(const Track& track, const TrialScore& score) {
   const double x0 = score.replay.empty() ? 0.0 : interpolate(score.replay, 0.0).x;
@@ -588,12 +580,6 @@ Eigen::VectorXd difference_variance(const std::vector<Plan>& plans, const Sample
     }
   }
   return Eigen::Map<const Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size()));
-}
-
-double chi2_of(const std::vector<OutcomeComparison>& c) {
-  double sum = 0.0;
-  for (const auto& x : c) sum += x.z * x.z;
-  return sum;
 }
 
 /// The replays' statistics (means and spreads) as one vector, in compare_all's order.
@@ -1115,10 +1101,11 @@ bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std:
 
 Result<std::vector<OutcomeComparison>> compare_model(const Evaluator& ev, const Model& model,
                                                      const std::vector<TrialScore>& scores,
-                                                     const EnsembleOptions& options, int& replays) {
+                                                     const EnsembleOptions& options, int& replays,
+                                                     std::uint64_t stream) {
   if (scores.size() != ev.trials.size())
     return fail(ErrorCode::InvalidArgument, "one full-duration score per tracked trial is needed");
-  const std::vector<Plan> plans = make_plans(ev, scores, options, kNullStream);
+  const std::vector<Plan> plans = make_plans(ev, scores, options, stream);
   auto out = replay_outcomes(ev, model, plans, std::vector<bool>(plans.size(), true), nullptr, replays);
   if (!out) return std::unexpected(out.error());
   return compare_all(plans, *out, options.impact_accuracy);

@@ -343,12 +343,30 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
                                          const std::vector<FreeCoefficient>& free,
                                          const std::vector<Effect>& candidates, const EnsembleOptions& options);
 
+/// The orientations compare_ensembles draws for its null (and compare_model by default).
+constexpr std::uint64_t kNullStream = 90000;
+
 /// The recorded outcomes against replays of `model` as it is (nothing calibrated, no
-/// candidate), from the orientations compare_ensembles draws for its null: a second clump's
-/// outcomes at a first one's calibrated coefficients, for outcome_shift. `replays` counts the
-/// DEM replays run.
+/// candidate), from the orientations of `stream` (by default those compare_ensembles draws for
+/// its null): a second clump's outcomes at a first one's calibrated coefficients, for
+/// outcome_shift, or a calibrated model judged again on other orientations. `replays` counts
+/// the DEM replays run.
 Result<std::vector<OutcomeComparison>> compare_model(const Evaluator& ev, const Model& model,
                                                      const std::vector<TrialScore>& scores,
-                                                     const EnsembleOptions& options, int& replays);
+                                                     const EnsembleOptions& options, int& replays,
+                                                     std::uint64_t stream = kNullStream);
+
+/// The chi^2 of comparisons (each z squared).
+double chi2_of(const std::vector<OutcomeComparison>& c);
+
+/// A candidate's margin over the null: its dispersion (chi^2 per degree of freedom, the
+/// outcomes less the free coefficients and its parameters, when above 1) and delta-BIC =
+/// (chi^2_null - chi^2) / dispersion - k ln n. Judged in units of the candidate's own misfit:
+/// no clump replays a real particle's outcomes exactly, and a candidate must not be named for
+/// absorbing the particle model's share of the misfit.
+struct Margin {
+  double dispersion = 1.0, delta_bic = 0.0;
+};
+Margin margin_over_null(double null_chi2, double chi2, int outcomes, std::size_t free, std::size_t parameters);
 
 }  // namespace clumpforge

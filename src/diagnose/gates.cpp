@@ -1,7 +1,9 @@
 /// The comparison beyond the release horizon made again with more replays where its first draw
 /// decided at a gate.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "diagnose/stages.hpp"
@@ -30,17 +32,19 @@ bool near(double value, double threshold) {
 
 /// The calibrated null's consistency (outcomes_consistent: the means' tail and the spreads'
 /// apart) when either tail sits near the threshold.
-std::optional<GateRetry> consistency_at_gate(const EnsembleReport& e) {
+std::optional<GateFound> consistency_at_gate(const EnsembleReport& e) {
   const ConsistencyTests t = consistency_tests(e.null_comparisons, e.calibrated_here.size());
   const double threshold = 0.5 * kConsistentTail;
   for (const auto& [name, test] : {std::pair{"means", t.means}, std::pair{"spreads", t.spreads}}) {
     if (test.dof > 0.0 && near(test.tail, threshold))
-      return GateRetry{.gate = Gate::NullConsistency,
-                       .value = test.tail,
-                       .threshold = threshold,
-                       .statement = fmt::format("the calibrated null's {} at chi^2 {:.1f} over {:.0f} degrees of "
-                                                "freedom, tail {:.2g} against the {:.2g} that decides consistency",
-                                                name, test.chi2, test.dof, test.tail, threshold)};
+      return GateFound{
+          .retry = {.gate = Gate::NullConsistency,
+                    .value = test.tail,
+                    .threshold = threshold,
+                    .statement = fmt::format("the calibrated null's {} at chi^2 {:.1f} over {:.0f} degrees of "
+                                             "freedom, tail {:.2g} against the {:.2g} that decides consistency",
+                                             name, test.chi2, test.dof, test.tail, threshold)},
+          .spreads = std::string_view(name) == "spreads"};
   }
   return std::nullopt;
 }
@@ -49,53 +53,222 @@ std::optional<GateRetry> consistency_at_gate(const EnsembleReport& e) {
 /// the margin to twice it), or, when it reaches the margin, a plausible rival's gap below it (the
 /// best's lower draw less the rival's higher one, under twice the margin: within the margin it
 /// makes the verdict ambiguous, closest_rival). A candidate far below a clear best decides nothing.
-std::optional<GateRetry> margin_at_gate(const EnsembleReport& e, double margin) {
+std::optional<GateFound> margin_at_gate(const EnsembleReport& e, double margin) {
   const EnsembleHypothesis* best = nullptr;
   for (const EnsembleHypothesis& h : e.hypotheses)
     if (h.plausible && (!best || h.delta_bic() > best->delta_bic())) best = &h;
   if (!best) return std::nullopt;
   const double d = best->delta_bic();
   if (d >= 0.5 * margin && d < 2.0 * margin)
-    return GateRetry{.gate = Gate::CandidateMargin,
-                     .value = d,
-                     .threshold = margin,
-                     .statement = fmt::format("{} at delta-BIC {:.1f} against the margin of {:.0f}",
-                                              effect_name(best->effect), d, margin)};
+    return GateFound{.retry = {.gate = Gate::CandidateMargin,
+                               .value = d,
+                               .threshold = margin,
+                               .statement = fmt::format("{} at delta-BIC {:.1f} against the margin of {:.0f}",
+                                                        effect_name(best->effect), d, margin)},
+                     .best = best->effect};
   if (d < margin) return std::nullopt;
   for (const EnsembleHypothesis& h : e.hypotheses) {
     const double gap = d - h.best_delta_bic();
     if (&h != best && h.plausible && gap > 0.0 && gap < 2.0 * margin)
-      return GateRetry{.gate = Gate::CandidateMargin,
-                       .value = gap,
-                       .threshold = margin,
-                       .statement = fmt::format("{} (delta-BIC {:.1f}) {:.1f} above its rival {} against the "
-                                                "margin of {:.0f}",
-                                                effect_name(best->effect), d, gap, effect_name(h.effect), margin)};
+      return GateFound{
+          .retry = {.gate = Gate::CandidateMargin,
+                    .value = gap,
+                    .threshold = margin,
+                    .statement = fmt::format("{} (delta-BIC {:.1f}) {:.1f} above its rival {} against the "
+                                             "margin of {:.0f}",
+                                             effect_name(best->effect), d, gap, effect_name(h.effect), margin)},
+          .best = best->effect,
+          .rival = h.effect};
   }
   return std::nullopt;
+}
+
+/// A finer clump's outcome shift near kReal in p while it matters, for each rung.
+std::vector<GateFound> convergence_at_gates(const ParticleModelCheck& check) {
+  std::vector<GateFound> found;
+  for (std::size_t k = 0; k < check.rungs.size(); ++k) {
+    const ParticleModelRung& r = check.rungs[k];
+    const auto& s = r.outcome_shift;
+    if (s && s->means > 0 && s->largest >= OutcomeShift::kMatters && near(s->p, OutcomeShift::kReal))
+      found.push_back(GateFound{.retry = {.gate = Gate::Convergence,
+                                          .value = s->p,
+                                          .threshold = OutcomeShift::kReal,
+                                          .statement = fmt::format("{}'s outcomes moved from the previous clump's at "
+                                                                   "p = {:.2g} against the {:.2g} that decides "
+                                                                   "convergence",
+                                                                   r.name, s->p, OutcomeShift::kReal)},
+                                .rung = k});
+  }
+  return found;
+}
+
+/// Orientations drawn afresh for a gate's check: neither the null's nor a candidate's.
+constexpr std::uint64_t kGateCheckStream = 290000;
+
+/// A rung's clump, its full-duration scores and its model (the refit of a finer clump, kept in
+/// Context::refits) with the coefficients `base`.
+struct RungModel {
+  const Clump* clump = nullptr;
+  const std::vector<TrialScore>* scores = nullptr;
+  Model model;
+};
+Result<RungModel> rung_model(const Context& c, const Model& baseline, const std::vector<TrialScore>& full_scores,
+                             std::size_t rung, const std::vector<SurfaceParameters>& base) {
+  if (rung == 0) {
+    Model m = baseline;
+    m.base = base;
+    return RungModel{c.ev.clump, &full_scores, std::move(m)};
+  }
+  if (rung > c.finer.size()) return fail(ErrorCode::InvalidArgument, "a gate names a clump the diagnosis has not");
+  const auto kept = c.refits.find({c.finer[rung - 1], &baseline});
+  if (kept == c.refits.end()) return fail(ErrorCode::InvalidArgument, "a gate's clump was not refitted");
+  Model m = kept->second.fitted.model;
+  m.base = base;
+  return RungModel{c.finer[rung - 1], &kept->second.scores, std::move(m)};
+}
+
+/// `model` replayed with `at`'s clump from the gate checks' orientations, compared.
+Result<std::vector<OutcomeComparison>> replayed(Context& c, const RungModel& at, const Model& model,
+                                                const EnsembleOptions& eo) {
+  const ClumpSwap swap(c, at.clump);
+  int replays = 0;
+  auto out = compare_model(c.ev, model, *at.scores, eo, replays, kGateCheckStream);
+  c.evaluations += replays;
+  return out;
+}
+
+/// The report's model with a hypothesis's coefficients and effect.
+Model with_hypothesis(Model m, const EnsembleHypothesis& h) {
+  m.base = h.base;
+  m.effect = h.effect;
+  m.values = h.values;
+  return m;
+}
+
+const EnsembleHypothesis* hypothesis_of(const EnsembleReport& e, Effect effect) {
+  const auto it = std::find_if(e.hypotheses.begin(), e.hypotheses.end(),
+                               [&](const EnsembleHypothesis& h) { return h.effect == effect; });
+  return it == e.hypotheses.end() ? nullptr : &*it;
+}
+
+/// The null's consistency judged again: its consistency as a whole, the gate's tail its value.
+Result<GateCheck> check_consistency(Context& c, const EnsembleReport& e, const RungModel& at, const GateFound& g,
+                                    const EnsembleOptions& eo) {
+  auto cmp = replayed(c, at, at.model, eo);
+  if (!cmp) return std::unexpected(cmp.error());
+  const std::size_t fitted = e.calibrated_here.size();
+  const ConsistencyTests t = consistency_tests(*cmp, fitted);
+  return GateCheck{.gate = g.retry.gate,
+                   .first = g.retry.value,
+                   .second = g.spreads ? t.spreads.tail : t.means.tail,
+                   .threshold = g.retry.threshold,
+                   .held = outcomes_consistent(*cmp, fitted) == outcomes_consistent(e.null_comparisons, fitted)};
+}
+
+/// The candidate's margin judged again: its delta-BIC over the null on the new replays (or its
+/// gap to the rival's), on the same side of the margin as the first draw's.
+Result<GateCheck> check_margin(Context& c, const EnsembleReport& e, const RungModel& at, const GateFound& g,
+                               const EnsembleOptions& eo) {
+  const EnsembleHypothesis* best = hypothesis_of(e, g.best);
+  const EnsembleHypothesis* rival = g.rival ? hypothesis_of(e, *g.rival) : nullptr;
+  if (!best || (g.rival && !rival)) return fail(ErrorCode::InvalidArgument, "a gate names a candidate not tried");
+  auto null = replayed(c, at, at.model, eo);
+  if (!null) return std::unexpected(null.error());
+  const double null_chi2 = chi2_of(*null);
+  auto delta_bic = [&](const EnsembleHypothesis& h) -> Result<double> {
+    auto cmp = replayed(c, at, with_hypothesis(at.model, h), eo);
+    if (!cmp) return std::unexpected(cmp.error());
+    return margin_over_null(null_chi2, chi2_of(*cmp), e.outcomes, e.calibrated_here.size(), h.values.size()).delta_bic;
+  };
+  auto d = delta_bic(*best);
+  if (!d) return std::unexpected(d.error());
+  GateCheck check{.gate = g.retry.gate, .first = g.retry.value, .second = *d, .threshold = g.retry.threshold};
+  if (rival) {
+    auto r = delta_bic(*rival);
+    if (!r) return std::unexpected(r.error());
+    check.second = *d - *r;
+    check.held = (check.second < check.threshold) == (check.first < check.threshold);
+  } else {
+    check.held = (check.second >= check.threshold) == (check.first >= check.threshold);
+  }
+  return check;
+}
+
+/// A rung's move judged again: both clumps at the previous one's calibrated coefficients.
+Result<GateCheck> check_convergence(Context& c, const DiagnoseResult& result, const Model& baseline,
+                                    const std::vector<TrialScore>& full_scores, const GateFound& g,
+                                    const EnsembleOptions& eo) {
+  const auto& rungs = result.particle_model->rungs;
+  const ParticleModelRung& before = rungs.at(g.rung - 1);
+  if (before.calibrated.empty()) return fail(ErrorCode::InvalidArgument, "a move from a clump not compared");
+  auto coarse = rung_model(c, baseline, full_scores, g.rung - 1, before.calibrated);
+  if (!coarse) return std::unexpected(coarse.error());
+  auto fine = rung_model(c, baseline, full_scores, g.rung, before.calibrated);
+  if (!fine) return std::unexpected(fine.error());
+  auto a = replayed(c, *coarse, coarse->model, eo);
+  if (!a) return std::unexpected(a.error());
+  auto b = replayed(c, *fine, coarse->model, eo);
+  if (!b) return std::unexpected(b.error());
+  const OutcomeShift shift = outcome_shift(*a, *b);
+  return GateCheck{.gate = g.retry.gate,
+                   .first = g.retry.value,
+                   .second = shift.p,
+                   .threshold = g.retry.threshold,
+                   .held = shift.converged() == rungs.at(g.rung).outcome_shift->converged()};
 }
 
 }  // namespace
 
-std::optional<GateRetry> at_a_gate(const DiagnoseResult& result, double min_delta_bic) {
-  if (!result.ensemble || result.ensemble->outcomes == 0) return std::nullopt;
+std::vector<GateFound> gates_at(const DiagnoseResult& result, double min_delta_bic) {
+  std::vector<GateFound> found;
+  if (!result.ensemble || result.ensemble->outcomes == 0) return found;
   const EnsembleReport& e = *result.ensemble;
-  if (auto why = consistency_at_gate(e)) return why;
-  if (auto why = margin_at_gate(e, min_delta_bic)) return why;
-  if (result.particle_model) {
-    for (const ParticleModelRung& r : result.particle_model->rungs) {
-      const auto& s = r.outcome_shift;
-      if (s && s->means > 0 && s->largest >= OutcomeShift::kMatters && near(s->p, OutcomeShift::kReal))
-        return GateRetry{.gate = Gate::Convergence,
-                         .value = s->p,
-                         .threshold = OutcomeShift::kReal,
-                         .statement = fmt::format("{}'s outcomes moved from the previous clump's at p = {:.2g} "
-                                                  "against the {:.2g} that decides convergence",
-                                                  r.name, s->p, OutcomeShift::kReal)};
-    }
-  }
-  return std::nullopt;
+  if (auto g = consistency_at_gate(e)) found.push_back(std::move(*g));
+  if (auto g = margin_at_gate(e, min_delta_bic)) found.push_back(std::move(*g));
+  if (result.particle_model)
+    for (GateFound& g : convergence_at_gates(*result.particle_model)) found.push_back(std::move(g));
+  return found;
 }
+
+std::optional<GateRetry> at_a_gate(const DiagnoseResult& result, double min_delta_bic) {
+  auto found = gates_at(result, min_delta_bic);
+  if (found.empty()) return std::nullopt;
+  return std::move(found.front().retry);
+}
+
+Result<bool> gates_hold(Context& c, const DiagnoseResult& result, const Model& baseline,
+                        const std::vector<TrialScore>& full_scores, const std::vector<GateFound>& gates,
+                        const EnsembleOptions& eo, GateRetry& retry) {
+  const EnsembleReport& e = *result.ensemble;
+  for (const GateFound& g : gates) {
+    Result<GateCheck> check = fail(ErrorCode::InvalidArgument, "a gate without a check");
+    if (g.retry.gate == Gate::Convergence) {
+      check = check_convergence(c, result, baseline, full_scores, g, eo);
+    } else {
+      auto at = rung_model(c, baseline, full_scores, e.rung, e.calibrated);
+      if (!at) return std::unexpected(at.error());
+      check =
+          g.retry.gate == Gate::NullConsistency ? check_consistency(c, e, *at, g, eo) : check_margin(c, e, *at, g, eo);
+    }
+    if (!check) return std::unexpected(check.error());
+    retry.checks.push_back(*check);
+    if (!check->held) return false;
+  }
+  return true;
+}
+
+namespace {
+
+/// What the gates' checks found, for a note.
+std::string checks_said(const std::vector<GateCheck>& checks) {
+  std::vector<std::string> said;
+  for (const GateCheck& k : checks)
+    said.push_back(fmt::format("{} {:.3g} against {:.3g} ({}), {:.3g} before", gate_name(k.gate), k.second, k.threshold,
+                               k.held ? "the same decision" : "the other decision", k.first));
+  return fmt::format("{}", fmt::join(said, "; "));
+}
+
+}  // namespace
 
 Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& baseline,
                             const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
@@ -103,24 +276,41 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
   const DiagnoseResult before = result;
   const auto started = std::chrono::steady_clock::now();
   if (auto ok = judge_ensembles(c, result, baseline, full_scores, effects, options); !ok) return ok;
-  if (options.ensemble_replays_at_gate > options.ensemble_replays) {
-    if (auto retry = at_a_gate(result, options.min_delta_bic)) {
-      retry->replays_first = options.ensemble_replays;
-      retry->replays_second = options.ensemble_replays_at_gate;
-      retry->replayed_first = result.ensemble ? result.ensemble->replays : 0;
-      retry->seconds_first = seconds_since(started);
-      const auto second = std::chrono::steady_clock::now();
+  const std::vector<GateFound> gates = options.ensemble_replays_at_gate > options.ensemble_replays
+                                           ? gates_at(result, options.min_delta_bic)
+                                           : std::vector<GateFound>{};
+  if (!gates.empty()) {
+    GateRetry retry = gates.front().retry;
+    retry.replays_first = options.ensemble_replays;
+    retry.replays_second = options.ensemble_replays_at_gate;
+    retry.replayed_first = result.ensemble ? result.ensemble->replays : 0;
+    retry.seconds_first = seconds_since(started);
+    const auto second = std::chrono::steady_clock::now();
+    const EnsembleOptions more_eo = ensemble_options(c, options, options.ensemble_replays_at_gate);
+    auto held = gates_hold(c, result, baseline, full_scores, gates, more_eo, retry);
+    if (!held) return std::unexpected(held.error());
+    retry.seconds_checks = seconds_since(second);
+    retry.held = *held;
+    if (retry.held) {
+      result.notes.push_back(fmt::format(
+          "the comparison beyond the release horizon decided at a gate, {}; each gate judged again with {} replays "
+          "per recording from release orientations drawn afresh, at its calibrated coefficients, decided the same "
+          "({}): the comparison with {} stands",
+          retry.statement, retry.replays_second, checks_said(retry.checks), retry.replays_first));
+    } else {
       result = before;
       DiagnoseOptions more = options;
       more.ensemble_replays = options.ensemble_replays_at_gate;
       if (auto ok = judge_ensembles(c, result, baseline, full_scores, effects, more); !ok) return ok;
-      retry->seconds_second = seconds_since(second);
       result.notes.push_back(fmt::format(
           "the outcomes judged with {} replays per recording: with {} (the first draw, {} replays) the comparison "
-          "decided at a gate, {}, where another draw of release orientations can decide otherwise",
-          retry->replays_second, retry->replays_first, retry->replayed_first, retry->statement));
-      result.gate_retry = std::move(*retry);
+          "decided at a gate, {}, and judged again with {} at the first draw's coefficients a gate decided otherwise "
+          "({})",
+          retry.replays_second, retry.replays_first, retry.replayed_first, retry.statement, retry.replays_second,
+          checks_said(retry.checks)));
     }
+    retry.seconds_second = seconds_since(second);
+    result.gate_retry = std::move(retry);
   }
   c.refits.clear();  // only a second comparison takes them again
   reconcile_advice(result);

@@ -370,11 +370,34 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
 /// a factor kGateBand of kReal in p while it matters. Empty when every gate was passed or failed by
 /// more.
 constexpr double kGateBand = 10.0;
-/// The gate found (GateRetry's gate, value, threshold and statement; the replays are the caller's).
+/// A gate a comparison decided at, and what decided there: the report's null (consistency), a
+/// candidate and its rival (margin), or a rung's move from the previous clump (convergence).
+struct GateFound {
+  GateRetry retry;                ///< its gate, value, threshold and statement (the replays are the caller's)
+  bool spreads = false;           ///< consistency: the spreads' tail, not the means'
+  Effect best = Effect::AirDrag;  ///< margin: the best plausible candidate
+  std::optional<Effect> rival;    ///< margin: the rival whose gap to it is at the gate
+  std::size_t rung = 0;           ///< convergence: the rung whose move it is
+};
+/// Every gate the comparison decided at, in the order consistency, margin, convergence.
+std::vector<GateFound> gates_at(const DiagnoseResult& result, double min_delta_bic);
+/// The first of gates_at's (GateRetry's gate, value, threshold and statement).
 std::optional<GateRetry> at_a_gate(const DiagnoseResult& result, double min_delta_bic);
-/// The ensemble stage: judge_ensembles with options.ensemble_replays, made again from where it
-/// started with options.ensemble_replays_at_gate when it decided at a gate (at_a_gate), then
-/// reconcile_advice.
+/// Each gate's decision judged again on `eo.replays` replays per recording from release orientations
+/// drawn afresh, at the first draw's calibrated coefficients (a move: both clumps at the previous
+/// one's): the null's consistency, the candidate's delta-BIC over the null (or its gap to the
+/// rival), the rung's convergence. Appends a GateCheck per gate to `retry.checks`, stopping at the
+/// first that does not hold; returns whether all held. Needs the refits of the first comparison
+/// (Context::refits) for a finer clump's model.
+Result<bool> gates_hold(Context& c, const DiagnoseResult& result, const Model& baseline,
+                        const std::vector<TrialScore>& full_scores, const std::vector<GateFound>& gates,
+                        const EnsembleOptions& eo, GateRetry& retry);
+/// The ensemble options of a diagnosis with `replays` per recording.
+EnsembleOptions ensemble_options(const Context& c, const DiagnoseOptions& options, int replays);
+/// The ensemble stage: judge_ensembles with options.ensemble_replays; when it decided at a gate
+/// (gates_at), each gate judged again with options.ensemble_replays_at_gate (gates_hold), and
+/// only when one does not hold the comparison made again from where it started with those
+/// replays; then reconcile_advice.
 Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& baseline,
                             const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
                             const DiagnoseOptions& options);

@@ -917,6 +917,52 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
   EXPECT_FALSE(with_shift(0.5, 1.2));
 }
 
+// Every gate a comparison decided at is found, each with what decided there, so that its decision
+// alone can be judged again (gates_hold): the spreads' tail, the candidate and its rival, the rung.
+TEST(EnsembleGate, EveryGateIsFoundWithWhatDecidedThere) {
+  DiagnoseResult result;
+  EnsembleReport e;
+  e.outcomes = 32;
+  e.calibrated_here = {"Q235:restitution", "soil:restitution"};
+  for (int o = 0; o < 32; ++o) {
+    const bool mean = o < 16;
+    e.null_comparisons.push_back(
+        {.statistic = mean ? Statistic::Mean : Statistic::Spread, .z = std::sqrt((mean ? 12.0 : 46.0) / 16.0)});
+  }
+  EnsembleHypothesis best, rival;
+  best.effect = Effect::ViscoelasticRestitution;
+  best.plausible = rival.plausible = true;
+  best.first_delta_bic = best.fresh_delta_bic = 30.0;
+  rival.effect = Effect::ElasticPlasticRestitution;
+  rival.first_delta_bic = 12.0;
+  rival.fresh_delta_bic = 20.0;  // its higher draw 10 below the best's lower one
+  e.hypotheses = {best, rival};
+  result.ensemble = e;
+  ParticleModelCheck check;
+  check.rungs.resize(4);
+  check.rungs[2].name = "adaptive-128";
+  check.rungs[2].outcome_shift = OutcomeShift{.means = 16, .chi2 = 30.0, .p = 0.02, .largest = 1.5};
+  check.rungs[3].name = "adaptive-256";
+  check.rungs[3].outcome_shift = OutcomeShift{.means = 16, .chi2 = 90.0, .p = 1e-9, .largest = 3.0};
+  result.particle_model = check;
+
+  const auto gates = diagnosis::gates_at(result, 10.0);
+  ASSERT_EQ(gates.size(), 3u);
+  EXPECT_EQ(gates[0].retry.gate, Gate::NullConsistency);
+  EXPECT_TRUE(gates[0].spreads);  // the means' tail (0.45) is far; the spreads' (1e-4) is at the gate
+  EXPECT_EQ(gates[1].retry.gate, Gate::CandidateMargin);
+  EXPECT_EQ(gates[1].best, Effect::ViscoelasticRestitution);
+  ASSERT_TRUE(gates[1].rival.has_value());
+  EXPECT_EQ(*gates[1].rival, Effect::ElasticPlasticRestitution);
+  EXPECT_NEAR(gates[1].retry.value, 10.0, 1e-12);
+  EXPECT_EQ(gates[2].retry.gate, Gate::Convergence);
+  EXPECT_EQ(gates[2].rung, 2u);  // 256's move, at p = 1e-9, is real by far
+  // at_a_gate reports the first.
+  const auto first = diagnosis::at_a_gate(result, 10.0);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->gate, Gate::NullConsistency);
+}
+
 // A restitution candidate's tilt replays start from a level plate, as the generator's do; other
 // models start at 70 % of the friction angle (tests/dem/test_lab.cpp: why).
 TEST(EnsembleTilt, ARestitutionLawsTiltReplayStartsLevel) {
