@@ -229,7 +229,7 @@ struct EnsembleReport {
   std::size_t rung = 0;
 };
 
-/// The gate a comparison beyond the release horizon decided at (diagnosis::at_a_gate).
+/// The gate a comparison beyond the release horizon decided at (diagnosis::gates_at).
 enum class Gate {
   NullConsistency,  ///< the calibrated null's consistency tail near its threshold
   CandidateMargin,  ///< a plausible candidate's lower-draw delta-BIC near the margin

@@ -35,7 +35,8 @@ bool near(double value, double threshold) {
 std::optional<GateFound> consistency_at_gate(const EnsembleReport& e) {
   const ConsistencyTests t = consistency_tests(e.null_comparisons, e.calibrated_here.size());
   const double threshold = 0.5 * kConsistentTail;
-  for (const auto& [name, test] : {std::pair{"means", t.means}, std::pair{"spreads", t.spreads}}) {
+  for (const auto& [spreads, test] : {std::pair{false, t.means}, std::pair{true, t.spreads}}) {
+    const std::string_view name = spreads ? "spreads" : "means";
     if (test.dof > 0.0 && near(test.tail, threshold))
       return GateFound{
           .retry = {.gate = Gate::NullConsistency,
@@ -44,7 +45,7 @@ std::optional<GateFound> consistency_at_gate(const EnsembleReport& e) {
                     .statement = fmt::format("the calibrated null's {} at chi^2 {:.1f} over {:.0f} degrees of "
                                              "freedom, tail {:.2g} against the {:.2g} that decides consistency",
                                              name, test.chi2, test.dof, test.tail, threshold)},
-          .spreads = std::string_view(name) == "spreads"};
+          .spreads = spreads};
   }
   return std::nullopt;
 }
@@ -151,30 +152,28 @@ const EnsembleHypothesis* hypothesis_of(const EnsembleReport& e, Effect effect) 
   return it == e.hypotheses.end() ? nullptr : &*it;
 }
 
-/// The null's consistency judged again: its consistency as a whole, the gate's tail its value.
-Result<GateCheck> check_consistency(Context& c, const EnsembleReport& e, const RungModel& at, const GateFound& g,
-                                    const EnsembleOptions& eo) {
-  auto cmp = replayed(c, at, at.model, eo);
-  if (!cmp) return std::unexpected(cmp.error());
+/// The null's consistency judged again on `null` (its comparisons on the new replays): its
+/// consistency as a whole, the gate's tail its value.
+GateCheck check_consistency(const EnsembleReport& e, const std::vector<OutcomeComparison>& null, const GateFound& g) {
   const std::size_t fitted = e.calibrated_here.size();
-  const ConsistencyTests t = consistency_tests(*cmp, fitted);
+  const ConsistencyTests t = consistency_tests(null, fitted);
   return GateCheck{.gate = g.retry.gate,
                    .first = g.retry.value,
                    .second = g.spreads ? t.spreads.tail : t.means.tail,
                    .threshold = g.retry.threshold,
-                   .held = outcomes_consistent(*cmp, fitted) == outcomes_consistent(e.null_comparisons, fitted)};
+                   .held = outcomes_consistent(null, fitted) == outcomes_consistent(e.null_comparisons, fitted)};
 }
 
-/// The candidate's margin judged again: its delta-BIC over the null on the new replays (or its
-/// gap to the rival's), on the same side of the margin as the first draw's.
-Result<GateCheck> check_margin(Context& c, const EnsembleReport& e, const RungModel& at, const GateFound& g,
+/// The candidate's margin judged again: its delta-BIC over the null (`null`, its comparisons on the
+/// new replays) on the new replays (or its gap to the rival's), on the same side of the margin as
+/// the first draw's.
+Result<GateCheck> check_margin(Context& c, const EnsembleReport& e, const RungModel& at,
+                               const std::vector<OutcomeComparison>& null, const GateFound& g,
                                const EnsembleOptions& eo) {
   const EnsembleHypothesis* best = hypothesis_of(e, g.best);
   const EnsembleHypothesis* rival = g.rival ? hypothesis_of(e, *g.rival) : nullptr;
   if (!best || (g.rival && !rival)) return fail(ErrorCode::InvalidArgument, "a gate names a candidate not tried");
-  auto null = replayed(c, at, at.model, eo);
-  if (!null) return std::unexpected(null.error());
-  const double null_chi2 = chi2_of(*null);
+  const double null_chi2 = chi2_of(null);
   auto delta_bic = [&](const EnsembleHypothesis& h) -> Result<double> {
     auto cmp = replayed(c, at, with_hypothesis(at.model, h), eo);
     if (!cmp) return std::unexpected(cmp.error());
@@ -240,16 +239,28 @@ Result<bool> gates_hold(Context& c, const DiagnoseResult& result, const Model& b
                         const std::vector<TrialScore>& full_scores, const std::vector<GateFound>& gates,
                         const EnsembleOptions& eo, GateRetry& retry) {
   const EnsembleReport& e = *result.ensemble;
-  for (const GateFound& g : gates) {
-    Result<GateCheck> check = fail(ErrorCode::InvalidArgument, "a gate without a check");
-    if (g.retry.gate == Gate::Convergence) {
-      check = check_convergence(c, result, baseline, full_scores, g, eo);
-    } else {
+  // The report's null on the new replays, made once for the consistency and margin gates.
+  std::optional<std::pair<RungModel, std::vector<OutcomeComparison>>> null;
+  auto null_replayed = [&]() -> Result<const std::pair<RungModel, std::vector<OutcomeComparison>>*> {
+    if (!null) {
       auto at = rung_model(c, baseline, full_scores, e.rung, e.calibrated);
       if (!at) return std::unexpected(at.error());
-      check =
-          g.retry.gate == Gate::NullConsistency ? check_consistency(c, e, *at, g, eo) : check_margin(c, e, *at, g, eo);
+      auto cmp = replayed(c, *at, at->model, eo);
+      if (!cmp) return std::unexpected(cmp.error());
+      null.emplace(std::move(*at), std::move(*cmp));
     }
+    return &*null;
+  };
+  auto check_gate = [&](const GateFound& g) -> Result<GateCheck> {
+    if (g.retry.gate == Gate::Convergence) return check_convergence(c, result, baseline, full_scores, g, eo);
+    auto n = null_replayed();
+    if (!n) return std::unexpected(n.error());
+    const auto& [at, cmp] = **n;
+    if (g.retry.gate == Gate::NullConsistency) return check_consistency(e, cmp, g);
+    return check_margin(c, e, at, cmp, g, eo);
+  };
+  for (const GateFound& g : gates) {
+    auto check = check_gate(g);
     if (!check) return std::unexpected(check.error());
     retry.checks.push_back(*check);
     if (!check->held) return false;
@@ -312,7 +323,7 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
     retry.seconds_second = seconds_since(second);
     result.gate_retry = std::move(retry);
   }
-  c.refits.clear();  // only a second comparison takes them again
+  c.refits.clear();  // only the gates' checks and a second comparison take them again
   reconcile_advice(result);
   return {};
 }
