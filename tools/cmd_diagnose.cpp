@@ -190,9 +190,10 @@ Command add_diagnose_command(CLI::App& app) {
                   "Replays per drop and roll recording from the release prior, to compare the recorded outcomes "
                   "beyond the release horizon; a recording with more trials is replayed once per trial (0: skip)");
   sub->add_option("--ensemble-replays-at-gate", args->ensemble_replays_at_gate,
-                  "Replays per recording when the first comparison decided at a gate (the null's consistency, a "
-                  "candidate's margin or a finer clump's convergence within the draw's reach): it is made again "
-                  "with these (0, or no more than --ensemble-replays: never)");
+                  "Replays per recording when the first comparison decided at a gate (the null's consistency or a "
+                  "candidate's margin within the draw's reach, a candidate past the margin that leaves the outcomes "
+                  "inconsistent): each decision is judged again, or the comparison made again, with these; each "
+                  "finer clump's move is measured with them too (0, or no more than --ensemble-replays: never)");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   add_output_option(*sub, args->out, "Directory for report.json, tracks.json and the figures (PNG, SVG)");

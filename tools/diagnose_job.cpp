@@ -52,6 +52,7 @@ nlohmann::json outcome_shift_json(const std::optional<OutcomeShift>& shift, cons
           {"outcome", std::string(outcome_name(shift->outcome))},
           {"from", finite_or_null(shift->from)},
           {"to", finite_or_null(shift->to)},
+          {"replays", shift->replays},
           {"converged", shift->converged()}};
 }
 

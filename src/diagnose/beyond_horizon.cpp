@@ -258,15 +258,41 @@ Result<const Refitted*> refit_with_clump(Context& c, const Model& baseline, int 
   return &(c.refits[key] = Refitted{std::move(*fitted), std::move(*scores)});
 }
 
-/// How far the resolution alone moves the outcomes: the clump swapped in (`scores` its
-/// replays) at the previous clump's calibrated coefficients, against that clump's comparisons.
-Result<OutcomeShift> shift_from(Context& c, const Model& previous_model, const std::vector<OutcomeComparison>& previous,
-                                const std::vector<TrialScore>& scores, const EnsembleOptions& eo) {
+/// The clump a finer one moves from, with its full-duration scores.
+struct MoveFrom {
+  const Clump* clump = nullptr;
+  const std::vector<TrialScore>* scores = nullptr;
+};
+
+/// How far the resolution alone moves the outcomes: the clump swapped in (`scores` its replays) at
+/// the previous clump's calibrated coefficients (`previous_model`), against the previous clump
+/// (`from`). With eo.move_replays replays per recording when more than eo.replays, both clumps
+/// replayed afresh (the test of a move gains power with the replays: a move the first draw's 12
+/// hid is seen with 48, and a move measured so is not a gate to judge again); else against the
+/// previous clump's comparisons `previous` (its calibration's, eo.replays).
+Result<OutcomeShift> measure_move(Context& c, const MoveFrom& from, const Model& previous_model,
+                                  const std::vector<OutcomeComparison>& previous, const std::vector<TrialScore>& scores,
+                                  const EnsembleOptions& eo) {
   int replays = 0;
-  auto same = compare_model(c.ev, previous_model, scores, eo, replays);
-  if (!same) return std::unexpected(same.error());
+  OutcomeShift shift;
+  if (eo.move_replays <= eo.replays) {
+    auto same = compare_model(c.ev, previous_model, scores, eo, replays);
+    if (!same) return std::unexpected(same.error());
+    shift = outcome_shift(previous, *same);
+    shift.replays = eo.replays;
+  } else {
+    EnsembleOptions more = eo;
+    more.replays = eo.move_replays;
+    auto fine = compare_model(c.ev, previous_model, scores, more, replays);
+    if (!fine) return std::unexpected(fine.error());
+    const ClumpSwap swap(c, from.clump);
+    auto coarse = compare_model(c.ev, previous_model, *from.scores, more, replays);
+    if (!coarse) return std::unexpected(coarse.error());
+    shift = outcome_shift(*coarse, *fine);
+    shift.replays = more.replays;
+  }
   c.evaluations += replays;
-  return outcome_shift(previous, *same);
+  return shift;
 }
 
 /// What the check compares the explaining clump with: the diagnosed clump's calibrated null.
@@ -417,6 +443,7 @@ void undecided_by_resolution(DiagnoseResult& result, const ParticleModelRung& be
 /// outcomes. When none explains it but the ladder has converged on the finest one, the candidates are
 /// judged there (judge_on_converged_clump). Returns whether a finer clump settled the verdict.
 Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
+                                           const std::vector<TrialScore>& full_scores,
                                            const std::vector<FreeCoefficient>& free,
                                            const std::vector<Effect>& candidates, const EnsembleOptions& eo,
                                            int max_evaluations, std::optional<LetThrough> let_through) {
@@ -430,11 +457,11 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
   // replaced when a candidate passes.)
   const Coarse coarse{e.null_chi2, e.outcomes, outcomes_consistent(e.null_comparisons, free.size())};
   check.worst_phase_chi2_per_value = largest_z2(e.null_comparisons);
-  check.rungs.front().calibrated = e.calibrated;
   // The previous rung's calibrated null: its model and its comparisons.
   Model previous_model = baseline;
   previous_model.base = e.calibrated;
   std::vector<OutcomeComparison> previous = e.null_comparisons;
+  MoveFrom from{c.ev.clump, &full_scores};  // the previous rung's clump
   std::optional<EnsembleResult> finest;     // the last rung's comparison, when it did not explain
   std::optional<EnsembleResult> agreement;  // the previous rung's, when it explained (checked here)
   std::vector<Effect> passed_unconverged;   // candidates that passed on an agreement that moved on
@@ -448,7 +475,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     rung.refitted = true;
     if (agreement) {
       // The previous clump explained the outcomes: does this one replay them the same?
-      auto shift = shift_from(c, previous_model, previous, refit.scores, eo);
+      auto shift = measure_move(c, from, previous_model, previous, refit.scores, eo);
       if (!shift) return std::unexpected(shift.error());
       rung.outcome_shift = *shift;
       ParticleModelRung& agreed = check.rungs.at(k);
@@ -479,7 +506,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     std::optional<OutcomeShift> moved = rung.outcome_shift;
     auto move = [&]() -> Result<OutcomeShift> {
       if (!moved) {
-        auto shift = shift_from(c, previous_model, previous, refit.scores, eo);
+        auto shift = measure_move(c, from, previous_model, previous, refit.scores, eo);
         if (!shift) return std::unexpected(shift.error());
         moved = *shift;
       }
@@ -495,7 +522,6 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     auto fine = compare_ensembles(c.ev, refit.fitted.model, refit.scores, free, candidates, pursue);
     if (!fine) return std::unexpected(fine.error());
     c.evaluations += fine->replays;
-    rung.calibrated = fine->calibrated;
     rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
     rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
     rung.explains = fine->outcomes == coarse.outcomes && outcomes_consistent(fine->null_comparisons, free.size());
@@ -517,6 +543,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     previous = fine->null_comparisons;
     previous_model = refit.fitted.model;
     previous_model.base = fine->calibrated;
+    from = MoveFrom{c.finer[k], &refit.scores};
     if (rung.explains)
       agreement = std::move(*fine);
     else
@@ -567,13 +594,14 @@ bool particle_model_unconverged(const Context& c, DiagnoseResult& result) {
 /// replays: a mismatch beyond the release horizon. Unless a finer clump explains it
 /// (finer_clump_explains_outcomes), the verdict is unexplained.
 Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Model& baseline,
-                                  const std::vector<FreeCoefficient>& free, const std::vector<Effect>& candidates,
-                                  const EnsembleOptions& eo, int max_evaluations) {
+                                  const std::vector<TrialScore>& full_scores, const std::vector<FreeCoefficient>& free,
+                                  const std::vector<Effect>& candidates, const EnsembleOptions& eo,
+                                  int max_evaluations) {
   const EnsembleReport& e = *result.ensemble;
   if (outcomes_consistent(e.null_comparisons, free.size())) return {};
   const double dof = null_dof(e.outcomes, free.size());
-  auto explained =
-      finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, max_evaluations, std::nullopt);
+  auto explained = finer_clump_explains_outcomes(c, result, baseline, full_scores, free, candidates, eo,
+                                                 max_evaluations, std::nullopt);
   if (!explained) return std::unexpected(explained.error());
   if (*explained) return {};
   if (particle_model_unconverged(c, result)) return {};
@@ -751,7 +779,37 @@ EnsembleOptions ensemble_options(const Context& c, const DiagnoseOptions& option
   eo.min_delta_bic = options.min_delta_bic;
   eo.seed = options.seed;
   eo.finer = c.finer.empty() ? nullptr : c.finer.front();
+  eo.move_replays = options.ensemble_replays_at_gate;
   return eo;
+}
+
+namespace {
+
+/// A tilt is compared as a sample only with four particles glued in a square; the static-kinetic
+/// friction drop acts on tilts alone.
+bool tilts_compared(const std::vector<Recording>& recs) {
+  return std::any_of(recs.begin(), recs.end(),
+                     [](const Recording& r) { return r.test == LabTest::Tilt && compared_as_sample(r); });
+}
+
+}  // namespace
+
+std::vector<FreeCoefficient> calibrated_beyond_horizon(const Context& c, const Model& baseline) {
+  const bool tilts = tilts_compared(*c.ev.recordings);
+  std::vector<FreeCoefficient> free;
+  std::set<std::pair<std::string, Coefficient>> calibrate = c.unpinned;
+  calibrate.insert(c.parted.begin(), c.parted.end());
+  for (const auto& [surface, coefficient] : calibrate) {
+    // The static friction is a tilt's, fitted frame by frame, unless its slip angles are
+    // compared here: the generated four-square tilts part before their first slip (4.3 s against
+    // 4.6), so the frames do not pin it, and a friction drop slips the block at 19 degrees
+    // where its trials slipped at 23 until the static friction is calibrated with it.
+    if (coefficient == Coefficient::StaticFriction && !tilts) continue;
+    for (std::size_t b = 0; b < baseline.base.size(); ++b) {
+      if (baseline.base[b].surface == surface) free.push_back({b, coefficient});
+    }
+  }
+  return free;
 }
 
 /// Beyond the release horizons: the recorded trials against replays from the release prior
@@ -762,28 +820,11 @@ EnsembleOptions ensemble_options(const Context& c, const DiagnoseOptions& option
 Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& baseline,
                              const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
                              const DiagnoseOptions& options) {
-  // A tilt is compared as a sample only with four particles glued in a square; the static-kinetic
-  // friction drop acts on tilts alone.
-  const auto& recs = *c.ev.recordings;
-  const bool tilts_compared = std::any_of(
-      recs.begin(), recs.end(), [](const Recording& r) { return r.test == LabTest::Tilt && compared_as_sample(r); });
-  std::vector<FreeCoefficient> free;
-  std::set<std::pair<std::string, Coefficient>> calibrate = c.unpinned;
-  calibrate.insert(c.parted.begin(), c.parted.end());
-  for (const auto& [surface, coefficient] : calibrate) {
-    // The static friction is a tilt's, fitted frame by frame, unless its slip angles are
-    // compared here: the generated four-square tilts part before their first slip (4.3 s against
-    // 4.6), so the frames do not pin it, and a friction drop slips the block at 19 degrees
-    // where its trials slipped at 23 until the static friction is calibrated with it.
-    if (coefficient == Coefficient::StaticFriction && !tilts_compared) continue;
-    for (std::size_t b = 0; b < baseline.base.size(); ++b) {
-      if (baseline.base[b].surface == surface) free.push_back({b, coefficient});
-    }
-  }
+  const bool tilts = tilts_compared(*c.ev.recordings);
+  const std::vector<FreeCoefficient> free = calibrated_beyond_horizon(c, baseline);
   std::vector<Effect> candidates;
   for (Effect e : effects) {
-    if ((e != Effect::StaticKineticFriction || tilts_compared) &&
-        !(e == Effect::ComOffset && flights_rule_out_offset(result)))
+    if ((e != Effect::StaticKineticFriction || tilts) && !(e == Effect::ComOffset && flights_rule_out_offset(result)))
       candidates.push_back(e);
   }
   EnsembleOptions eo = ensemble_options(c, options, options.ensemble_replays);
@@ -806,7 +847,7 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   std::vector<const EnsembleHypothesis*> passing = passing_hypotheses(*ens, options.min_delta_bic, result.notes);
   if (!ens->outcomes || ens->hypotheses.empty() || passing.empty()) {
     if (ens->outcomes > 0 && result.verdict == Verdict::None)
-      return outcomes_beyond_null(c, result, baseline, free, candidates, eo, options.max_evaluations);
+      return outcomes_beyond_null(c, result, baseline, full_scores, free, candidates, eo, options.max_evaluations);
     return {};
   }
   // Before an effect is named beyond the horizon: what it explains may be the particle model's
@@ -815,8 +856,8 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
   // the margin may still only absorb the coarse clump's bias (generated control-05 at 240 fps
   // was named viscous_rolling so).
   const LetThrough best{passing.front()->effect, passing.front()->delta_bic()};
-  auto explained =
-      finer_clump_explains_outcomes(c, result, baseline, free, candidates, eo, options.max_evaluations, best);
+  auto explained = finer_clump_explains_outcomes(c, result, baseline, full_scores, free, candidates, eo,
+                                                 options.max_evaluations, best);
   if (!explained) return std::unexpected(explained.error());
   if (*explained) return {};
   name_beyond_horizon(result, *ens, passing, options.min_delta_bic);

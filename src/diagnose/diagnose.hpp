@@ -58,8 +58,10 @@ struct DiagnoseOptions {
   int ensemble_replays = 12;
   /// Replays per recording when the comparison with `ensemble_replays` decided at one of its gates
   /// (diagnosis::gates_at): each such decision is judged again with these, at the first draw's
-  /// calibrated coefficients; when one does not hold, the comparison is made again with these and
-  /// judged on them alone (GateRetry). 0, or no more than `ensemble_replays`: never.
+  /// calibrated coefficients; when one does not hold (or the gate is an inconsistent candidate's),
+  /// the comparison is made again with these and judged on them alone (GateRetry). Each finer
+  /// clump's move from the previous one is measured with these too. 0, or no more than
+  /// `ensemble_replays`: never (the moves then with `ensemble_replays`).
   int ensemble_replays_at_gate = 48;
   /// Finer particle models of the same body (more spheres, or built another way), coarsest
   /// first; the clump diagnosed is the coarsest of all. They serve twice (see
@@ -95,9 +97,6 @@ struct ParticleModelRung {
   /// [s] wall clock of its check beyond the release horizon (its refit, replays and shifts), and of
   /// its refit alone (0 when a first comparison's refit was taken again, diagnosis::Context::refits).
   double seconds = 0.0, seconds_refit = 0.0;
-  /// Beyond the release horizon: its null's coefficients calibrated on the outcomes (empty when not
-  /// compared there); what the next clump's outcome_shift replays, and a gate's check again.
-  std::vector<SurfaceParameters> calibrated;
 };
 
 /// Whether the particle model, not missing physics, explains a mismatch.
@@ -233,7 +232,9 @@ struct EnsembleReport {
 enum class Gate {
   NullConsistency,  ///< the calibrated null's consistency tail near its threshold
   CandidateMargin,  ///< a plausible candidate's lower-draw delta-BIC near the margin
-  Convergence,      ///< a finer clump's outcome shift near its p threshold, while it matters
+  /// a plausible candidate past the margin that leaves the outcomes inconsistent (its calibration
+  /// on the first draw may be what misses)
+  CandidateInconsistent,
 };
 std::string_view gate_name(Gate gate);
 
@@ -247,9 +248,10 @@ struct GateCheck {
 
 /// A comparison judged again with more replays because its first draw decided at a gate: each
 /// gate's decision first, on replays from release orientations drawn afresh at the first draw's
-/// calibrated coefficients; the whole comparison made again only when one of them did not hold.
+/// calibrated coefficients; the whole comparison made again only when one of them did not hold,
+/// or at once at an inconsistent candidate past the margin (its gate, then, with no checks).
 struct GateRetry {
-  Gate gate = Gate::NullConsistency;
+  Gate gate = Gate::NullConsistency;    ///< the first gate found, or the inconsistent candidate's
   double value = 0.0, threshold = 0.0;  ///< the gate's statistic and its threshold (a tail, a delta-BIC or a p)
   int replays_first = 0;                ///< replays per recording of the first comparison
   int replays_second = 0;               ///< and of the one the verdict rests on

@@ -103,6 +103,7 @@ struct OutcomeShift {
   std::size_t recording = 0;                 ///< that mean's recording
   Outcome outcome = Outcome::ReboundHeight;  ///< and outcome
   double from = 0.0, to = 0.0;               ///< its replayed value with each clump
+  int replays = 0;                           ///< replays per recording it was measured with
   bool converged() const { return !(means > 0 && p < kReal && largest >= kMatters); }
 };
 /// The shift from `coarse` to `fine` (comparisons of the same recordings, compare_model); only
@@ -113,6 +114,7 @@ struct EnsembleOptions {
   /// Release orientations per recording, >= 4; a recording with more tracked trials is replayed
   /// once per trial (replays_per_recording).
   int replays = 12;
+  int move_replays = 0;  ///< a finer clump's move measured with these (when more than replays)
   double orientation_prior_deg = 15.0;
   bool roll_on_edge = false;  ///< rolls without a recorded orientation start on the rim (OrientationPrior::on_edge)
   double impact_accuracy = 0.01;

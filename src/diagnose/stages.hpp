@@ -328,7 +328,12 @@ struct LetThrough {
   double delta_bic = 0.0;
 };
 void report_ensemble(EnsembleReport& report, const EnsembleResult& ens);
+/// The coefficients the comparison beyond the release horizon calibrates: those the frames leave
+/// unpinned (Context::unpinned) or that part the trials (Context::parted), a tilt's static
+/// friction only when its slip angles are compared.
+std::vector<FreeCoefficient> calibrated_beyond_horizon(const Context& c, const Model& baseline);
 Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
+                                           const std::vector<TrialScore>& full_scores,
                                            const std::vector<FreeCoefficient>& free,
                                            const std::vector<Effect>& candidates, const EnsembleOptions& eo,
                                            int max_evaluations, std::optional<LetThrough> let_through);
@@ -342,8 +347,9 @@ std::vector<std::string> absences_on_explaining_clump(DiagnoseResult& result, co
 bool judge_on_converged_clump(DiagnoseResult& result, const ParticleModelCheck& check, const EnsembleResult& finest,
                               double min_delta_bic);
 Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Model& baseline,
-                                  const std::vector<FreeCoefficient>& free, const std::vector<Effect>& candidates,
-                                  const EnsembleOptions& eo, int max_evaluations);
+                                  const std::vector<TrialScore>& full_scores, const std::vector<FreeCoefficient>& free,
+                                  const std::vector<Effect>& candidates, const EnsembleOptions& eo,
+                                  int max_evaluations);
 bool flights_rule_out_offset(DiagnoseResult& result);
 /// What the outcomes decided: an effect leaves `result.undecidable` when its candidate was tried
 /// on the outcomes and its strong signal reaches the margin; `experiment` lists the trials per
@@ -366,29 +372,29 @@ Result<void> judge_ensembles(Context& c, DiagnoseResult& result, const Model& ba
 /// Where a comparison beyond the release horizon decided within reach of the draw of its
 /// replays: the calibrated null's consistency tail within a factor kGateBand of its threshold, the
 /// best plausible candidate's delta-BIC (lower draw) from half the margin to twice it or a rival
-/// less than twice the margin below a best that reaches it, or a finer clump's outcome shift within
-/// a factor kGateBand of kReal in p while it matters. Empty when every gate was passed or failed by
-/// more.
+/// less than twice the margin below a best that reaches it, or a plausible candidate past the
+/// margin that leaves the outcomes inconsistent (however far: its calibration on the draw may be
+/// what misses). Empty when every gate was passed or failed by more.
 constexpr double kGateBand = 10.0;
 /// A gate a comparison decided at, and what decided there: the report's null (consistency), a
-/// candidate and its rival (margin), or a rung's move from the previous clump (convergence).
+/// candidate and its rival (margin), or a candidate past the margin that left the outcomes
+/// inconsistent (candidate_inconsistent).
 struct GateFound {
   GateRetry retry;                ///< its gate, value, threshold and statement (the replays are the caller's)
   bool spreads = false;           ///< consistency: the spreads' tail, not the means'
-  Effect best = Effect::AirDrag;  ///< margin: the best plausible candidate
+  Effect best = Effect::AirDrag;  ///< margin: the best plausible candidate; candidate_inconsistent: that one
   std::optional<Effect> rival;    ///< margin: the rival whose gap to it is at the gate
-  std::size_t rung = 0;           ///< convergence: the rung whose move it is
 };
-/// Every gate the comparison decided at, in the order consistency, margin, convergence.
+/// Every gate the comparison decided at, in the order consistency, margin, an inconsistent
+/// candidate past the margin. (A finer clump's move is no gate: it is measured with
+/// EnsembleOptions::move_replays, the replays a check would take.)
 std::vector<GateFound> gates_at(const DiagnoseResult& result, double min_delta_bic);
-/// The first of gates_at's (GateRetry's gate, value, threshold and statement).
-std::optional<GateRetry> at_a_gate(const DiagnoseResult& result, double min_delta_bic);
-/// Each gate's decision judged again on `eo.replays` replays per recording from release orientations
-/// drawn afresh, at the first draw's calibrated coefficients (a move: both clumps at the previous
-/// one's): the null's consistency, the candidate's delta-BIC over the null (or its gap to the
-/// rival), the rung's convergence. Appends a GateCheck per gate to `retry.checks`, stopping at the
-/// first that does not hold; returns whether all held. Needs the refits of the first comparison
-/// (Context::refits) for a finer clump's model.
+/// Each gate's decision judged again on `eo.replays` replays per recording from release
+/// orientations drawn afresh, at the first draw's calibrated coefficients: the null's
+/// consistency, the candidate's delta-BIC over the null (or its gap to the rival). Appends a
+/// GateCheck per gate to `retry.checks`, stopping at the first that does not hold; returns whether
+/// all held. Needs the refits of the first comparison (Context::refits) for a finer clump's model.
+/// (An inconsistent candidate's gate has no check: ensemble_stage compares again whole.)
 Result<bool> gates_hold(Context& c, const DiagnoseResult& result, const Model& baseline,
                         const std::vector<TrialScore>& full_scores, const std::vector<GateFound>& gates,
                         const EnsembleOptions& eo, GateRetry& retry);
@@ -396,8 +402,8 @@ Result<bool> gates_hold(Context& c, const DiagnoseResult& result, const Model& b
 EnsembleOptions ensemble_options(const Context& c, const DiagnoseOptions& options, int replays);
 /// The ensemble stage: judge_ensembles with options.ensemble_replays; when it decided at a gate
 /// (gates_at), each gate judged again with options.ensemble_replays_at_gate (gates_hold), and
-/// only when one does not hold the comparison made again from where it started with those
-/// replays; then reconcile_advice.
+/// only when one does not hold (or at once, at an inconsistent candidate past the margin) the
+/// comparison made again from where it started with those replays; then reconcile_advice.
 Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& baseline,
                             const std::vector<TrialScore>& full_scores, const std::vector<Effect>& effects,
                             const DiagnoseOptions& options);

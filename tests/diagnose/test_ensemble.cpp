@@ -845,6 +845,15 @@ TEST(EnsembleRival, ACandidateWithinTheMarginOnEitherDrawMakesTheVerdictAmbiguou
 // 0.01 while it matters. Lab-like case-08's null at 12 replays had its means at chi^2 37.6 over
 // 12 degrees of freedom (tail 1.8e-4): consistent, so no candidate was tried; with 48 the
 // elastic-plastic restitution was named at delta-BIC 24.6.
+namespace {
+// The first gate a comparison decided at (its gates judged again with 48 replays per recording).
+std::optional<GateRetry> at_a_gate(const DiagnoseResult& result, double margin) {
+  const auto found = diagnosis::gates_at(result, margin);
+  if (found.empty()) return std::nullopt;
+  return found.front().retry;
+}
+}  // namespace
+
 TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
   auto report_with = [](double means_chi2, double spreads_chi2) {
     DiagnoseResult result;
@@ -859,14 +868,14 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
     result.ensemble = std::move(e);
     return result;
   };
-  const auto case08 = diagnosis::at_a_gate(report_with(37.6, 16.1), 10.0);  // tail 1.8e-4
+  const auto case08 = at_a_gate(report_with(37.6, 16.1), 10.0);  // tail 1.8e-4
   ASSERT_TRUE(case08);
   EXPECT_EQ(case08->gate, Gate::NullConsistency);
   EXPECT_NEAR(case08->value, 1.9e-4, 0.2e-4);  // the exact tail is 1.8e-4; chi2_upper_tail is Wilson-Hilferty's
   EXPECT_EQ(case08->threshold, 5e-5);
-  EXPECT_FALSE(diagnosis::at_a_gate(report_with(12.0, 16.1), 10.0));  // tail 0.45: consistent by far
-  EXPECT_FALSE(diagnosis::at_a_gate(report_with(90.0, 16.1), 10.0));  // tail 4e-14: inconsistent by far
-  EXPECT_TRUE(diagnosis::at_a_gate(report_with(12.0, 46.0), 10.0));   // the spreads' tail, 1e-4
+  EXPECT_FALSE(at_a_gate(report_with(12.0, 16.1), 10.0));  // tail 0.45: consistent by far
+  EXPECT_FALSE(at_a_gate(report_with(90.0, 16.1), 10.0));  // tail 4e-14: inconsistent by far
+  EXPECT_TRUE(at_a_gate(report_with(12.0, 46.0), 10.0));   // the spreads' tail, 1e-4
 
   auto with_candidate = [&](double first, double fresh, bool plausible, double best = NAN) {
     DiagnoseResult result = report_with(12.0, 16.1);
@@ -882,7 +891,7 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
       h.first_delta_bic = h.fresh_delta_bic = best;
       result.ensemble->hypotheses.push_back(h);
     }
-    const auto gate = diagnosis::at_a_gate(result, 10.0);
+    const auto gate = at_a_gate(result, 10.0);
     EXPECT_TRUE(!gate || gate->gate == Gate::CandidateMargin);
     return gate.has_value();
   };
@@ -898,27 +907,45 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
   EXPECT_TRUE(with_candidate(12.0, 25.0, true, 40.0));   // 15 below
   EXPECT_FALSE(with_candidate(12.0, 15.0, true, 40.0));  // 25 below
 
-  auto with_shift = [&](double p, double largest) {
+  // A finer clump's move is no gate: it is measured with the 48 replays a check would take
+  // (measure_move), even at the nine-set-up strong offset's 128 -> 256 shift at 5e7e13c, p =
+  // 0.0021 on 12 replays.
+  {
     DiagnoseResult result = report_with(12.0, 16.1);
     ParticleModelCheck check;
     ParticleModelRung rung;
-    rung.name = "adaptive-256";
-    rung.outcome_shift = OutcomeShift{.means = 16, .chi2 = 30.0, .p = p, .largest = largest};
+    rung.outcome_shift = OutcomeShift{.means = 16, .chi2 = 30.0, .p = 0.0021, .largest = 1.8, .replays = 48};
     check.rungs = {ParticleModelRung{}, rung};
     result.particle_model = check;
-    const auto gate = diagnosis::at_a_gate(result, 10.0);
-    EXPECT_TRUE(!gate || gate->gate == Gate::Convergence);
+    EXPECT_FALSE(at_a_gate(result, 10.0));
+  }
+
+  // A candidate past the margin that leaves the outcomes inconsistent, however far past (the
+  // nine-set-up realistic friction drop beat the null by 101.8 on 12 replays per recording).
+  // Its 18 means at chi^2 80 over 16 degrees of freedom: tail 1e-9.
+  auto with_fit = [&](double chi2, bool plausible) {
+    DiagnoseResult result = report_with(12.0, 16.1);
+    EnsembleHypothesis h;
+    h.effect = Effect::StaticKineticFriction;
+    h.plausible = plausible;
+    h.first_delta_bic = h.fresh_delta_bic = 101.8;
+    h.values = {0.3, 0.5};
+    for (int o = 0; o < 36; ++o)
+      h.comparisons.push_back({.statistic = o < 18 ? Statistic::Mean : Statistic::Spread, .z = std::sqrt(chi2 / 36)});
+    h.chi2 = chi2;
+    result.ensemble->hypotheses.push_back(h);
+    const auto gate = at_a_gate(result, 10.0);
+    EXPECT_TRUE(!gate || gate->gate == Gate::CandidateInconsistent);
     return gate.has_value();
   };
-  EXPECT_TRUE(with_shift(0.0021, 1.8));   // the nine-set-up strong offset's 128 -> 256 shift at 5e7e13c
-  EXPECT_TRUE(with_shift(0.05, 1.8));     // converged, but within the draw's reach
-  EXPECT_FALSE(with_shift(5e-12, 4.0));   // lab-like case-08's 64 -> 128 at 48 replays
-  EXPECT_FALSE(with_shift(0.0021, 0.6));  // real, but under a recorded standard error: it does not matter
-  EXPECT_FALSE(with_shift(0.5, 1.2));
+  EXPECT_TRUE(with_fit(160.0, true));
+  EXPECT_FALSE(with_fit(30.0, true));    // consistent: it passes, no gate
+  EXPECT_FALSE(with_fit(160.0, false));  // implausible: nothing to name
 }
 
 // Every gate a comparison decided at is found, each with what decided there, so that its decision
-// alone can be judged again (gates_hold): the spreads' tail, the candidate and its rival, the rung.
+// alone can be judged again (gates_hold): the spreads' tail, the candidate and its rival, the
+// inconsistent candidate.
 TEST(EnsembleGate, EveryGateIsFoundWithWhatDecidedThere) {
   DiagnoseResult result;
   EnsembleReport e;
@@ -938,13 +965,14 @@ TEST(EnsembleGate, EveryGateIsFoundWithWhatDecidedThere) {
   rival.fresh_delta_bic = 20.0;  // its higher draw 10 below the best's lower one
   e.hypotheses = {best, rival};
   result.ensemble = e;
-  ParticleModelCheck check;
-  check.rungs.resize(4);
-  check.rungs[2].name = "adaptive-128";
-  check.rungs[2].outcome_shift = OutcomeShift{.means = 16, .chi2 = 30.0, .p = 0.02, .largest = 1.5};
-  check.rungs[3].name = "adaptive-256";
-  check.rungs[3].outcome_shift = OutcomeShift{.means = 16, .chi2 = 90.0, .p = 1e-9, .largest = 3.0};
-  result.particle_model = check;
+  EnsembleHypothesis offset;  // past the margin, its outcomes inconsistent
+  offset.effect = Effect::ComOffset;
+  offset.plausible = true;
+  offset.first_delta_bic = offset.fresh_delta_bic = 25.0;
+  offset.values = {0.001};
+  for (int o = 0; o < 36; ++o)
+    offset.comparisons.push_back({.statistic = o < 18 ? Statistic::Mean : Statistic::Spread, .z = 2.0});
+  result.ensemble->hypotheses.push_back(offset);
 
   const auto gates = diagnosis::gates_at(result, 10.0);
   ASSERT_EQ(gates.size(), 3u);
@@ -955,12 +983,9 @@ TEST(EnsembleGate, EveryGateIsFoundWithWhatDecidedThere) {
   ASSERT_TRUE(gates[1].rival.has_value());
   EXPECT_EQ(*gates[1].rival, Effect::ElasticPlasticRestitution);
   EXPECT_NEAR(gates[1].retry.value, 10.0, 1e-12);
-  EXPECT_EQ(gates[2].retry.gate, Gate::Convergence);
-  EXPECT_EQ(gates[2].rung, 2u);  // 256's move, at p = 1e-9, is real by far
-  // at_a_gate reports the first.
-  const auto first = diagnosis::at_a_gate(result, 10.0);
-  ASSERT_TRUE(first);
-  EXPECT_EQ(first->gate, Gate::NullConsistency);
+  EXPECT_EQ(gates[2].retry.gate, Gate::CandidateInconsistent);
+  EXPECT_EQ(gates[2].best, Effect::ComOffset);
+  EXPECT_LT(gates[2].retry.value, gates[2].retry.threshold);  // its means at 72 over 17 degrees of freedom
 }
 
 // A restitution candidate's tilt replays start from a level plate, as the generator's do; other
