@@ -9,14 +9,8 @@
 # a held retry adds no replay to the first comparison's and says so in a note, and its time
 # after the first comparison is its checks'.
 set -u
-bench=$1 clumpforge=$2 library=$3
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-"$bench" --nine-set-ups --trials 8 --controls 0 --effects viscoelastic_restitution --generate-only -o "$dir/gen" \
-  >"$dir/gen.log" 2>&1 || { cat "$dir/gen.log"; exit 1; }
-case=$dir/gen/viscoelastic_restitution-realistic
-"$clumpforge" diagnose --recordings "$case/recordings" --library "$library" --clump adaptive-32 --finer-clumps 3 \
-  --output "$dir/out" --json >"$dir/report.json" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+source "$(dirname "$0")/generated_case.sh"
+diagnose_generated_case "$1" "$2" "$3" viscoelastic_restitution realistic || exit 1
 python3 - "$dir/out/report.json" <<'PY' || exit 1
 import json, sys
 r = json.load(open(sys.argv[1]))

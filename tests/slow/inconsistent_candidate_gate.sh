@@ -7,14 +7,8 @@
 # over 36 means and spreads (tail 1.8e-5); with 48 it is calibrated to consistency and named.
 # Each finer clump's move is measured on 48 replays from the start, so no move is a gate.
 set -u
-bench=$1 clumpforge=$2 library=$3
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-"$bench" --nine-set-ups --trials 8 --controls 0 --effects static_kinetic_friction --generate-only -o "$dir/gen" \
-  >"$dir/gen.log" 2>&1 || { cat "$dir/gen.log"; exit 1; }
-case=$dir/gen/static_kinetic_friction-realistic
-"$clumpforge" diagnose --recordings "$case/recordings" --library "$library" --clump adaptive-32 --finer-clumps 3 \
-  --output "$dir/out" --json >"$dir/report.json" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+source "$(dirname "$0")/generated_case.sh"
+diagnose_generated_case "$1" "$2" "$3" static_kinetic_friction realistic || exit 1
 python3 - "$dir/out/report.json" <<'PY' || exit 1
 import json, sys
 r = json.load(open(sys.argv[1]))
