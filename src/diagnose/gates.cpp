@@ -208,7 +208,7 @@ std::vector<GateFound> gates_at(const DiagnoseResult& result, double min_delta_b
   const EnsembleReport& e = *result.ensemble;
   if (auto g = consistency_at_gate(e)) found.push_back(std::move(*g));
   if (auto g = margin_at_gate(e, min_delta_bic)) found.push_back(std::move(*g));
-  // Last: its check calibrates a candidate afresh, the dearest.
+  // Last: it has no check (ensemble_stage compares again whole at once).
   if (auto g = inconsistent_candidate_at_gate(e, min_delta_bic)) found.push_back(std::move(*g));
   return found;
 }
@@ -230,6 +230,8 @@ Result<bool> gates_hold(Context& c, const DiagnoseResult& result, const Model& b
     return &*null;
   };
   auto check_gate = [&](const GateFound& g) -> Result<GateCheck> {
+    if (g.retry.gate == Gate::CandidateInconsistent)
+      return fail(ErrorCode::InvalidArgument, "an inconsistent candidate's gate has no check");
     auto n = null_replayed();
     if (!n) return std::unexpected(n.error());
     const auto& [at, cmp] = **n;
