@@ -289,6 +289,13 @@ Margin margin_over_null(double null_chi2, double chi2, int outcomes, std::size_t
           (null_chi2 - chi2) / dispersion - static_cast<double>(parameters) * std::log(std::max(1, outcomes))};
 }
 
+Model with_hypothesis(Model m, const EnsembleHypothesis& h) {
+  m.base = h.base;
+  m.effect = h.effect;
+  m.values = h.values;
+  return m;
+}
+
 double chi2_of(const std::vector<OutcomeComparison>& c) {
   double sum = 0.0;
   for (const auto& x : c) sum += x.z * x.z;
@@ -1032,11 +1039,8 @@ Result<void> replay_afresh(const Evaluator& ev, const std::vector<TrialScore>& s
       if (!out) return std::unexpected(out.error());
       null_chi2 = chi2_of(compare_all(fresh, *out, options.impact_accuracy));
     }
-    Model m = null_model;
-    m.base = h.base;
-    m.effect = h.effect;
-    m.values = h.values;
-    auto out = replay_outcomes(ev, m, fresh, std::vector<bool>(fresh.size(), true), nullptr, result.replays);
+    auto out = replay_outcomes(ev, with_hypothesis(null_model, h), fresh, std::vector<bool>(fresh.size(), true),
+                               nullptr, result.replays);
     if (!out) return std::unexpected(out.error());
     const double chi2 = chi2_of(compare_all(fresh, *out, options.impact_accuracy));
     h.fresh_delta_bic = margin_over_null(*null_chi2, chi2, result.outcomes, free, h.values.size()).delta_bic;

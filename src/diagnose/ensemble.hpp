@@ -358,6 +358,9 @@ Result<std::vector<OutcomeComparison>> compare_model(const Evaluator& ev, const 
                                                      const EnsembleOptions& options, int& replays,
                                                      std::uint64_t stream = kNullStream);
 
+/// `m` with a hypothesis's coefficients, effect and parameters: the model it was calibrated as.
+Model with_hypothesis(Model m, const EnsembleHypothesis& h);
+
 /// The chi^2 of comparisons (each z squared).
 double chi2_of(const std::vector<OutcomeComparison>& c);
 

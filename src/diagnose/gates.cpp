@@ -145,14 +145,6 @@ Result<std::vector<OutcomeComparison>> replayed(Context& c, const RungModel& at,
   return out;
 }
 
-/// The report's model with a hypothesis's coefficients and effect.
-Model with_hypothesis(Model m, const EnsembleHypothesis& h) {
-  m.base = h.base;
-  m.effect = h.effect;
-  m.values = h.values;
-  return m;
-}
-
 const EnsembleHypothesis* hypothesis_of(const EnsembleReport& e, Effect effect) {
   const auto it = std::find_if(e.hypotheses.begin(), e.hypotheses.end(),
                                [&](const EnsembleHypothesis& h) { return h.effect == effect; });

@@ -327,11 +327,9 @@ struct LetThrough {
   Effect effect = Effect::AirDrag;
   double delta_bic = 0.0;
 };
-void report_ensemble(EnsembleReport& report, const EnsembleResult& ens);
-/// The coefficients the comparison beyond the release horizon calibrates: those the frames leave
-/// unpinned (Context::unpinned) or that part the trials (Context::parted), a tilt's static
-/// friction only when its slip angles are compared.
-std::vector<FreeCoefficient> calibrated_beyond_horizon(const Context& c, const Model& baseline);
+/// The report of a comparison beyond the release horizon made with the particle-model rung `rung`
+/// (0: the diagnosed clump).
+void report_ensemble(EnsembleReport& report, const EnsembleResult& ens, std::size_t rung);
 Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
                                            const std::vector<TrialScore>& full_scores,
                                            const std::vector<FreeCoefficient>& free,
