@@ -411,7 +411,7 @@ Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, 
       : setup.test == LabTest::Roll
           ? std::sqrt(2 * 9.81 * setup.start_distance * std::sin(setup.incline_deg * kPi / 180.0)) + 0.2
           : 0.1;
-  lab.estimate = estimate_time_step(world, impact_speed, options.steps_per_contact);
+  lab.estimate = estimate_time_step(world, impact_speed, options.steps_per_contact, options.time_step_rule);
   lab.time_step = options.time_step.value_or(lab.estimate.chosen);
   if (auto ok = check_time_step(lab.time_step, lab.estimate); !ok) return std::unexpected(ok.error());
   lab.interaction = interaction;

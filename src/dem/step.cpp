@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <string>
 
 #include "dem/contact.hpp"
 
@@ -326,7 +328,7 @@ void step(World& world, double dt) {
   }
 }
 
-TimeStepEstimate estimate_time_step(const World& world, double impact_speed, int steps_per_contact) {
+TimeStepEstimate estimate_time_step(const World& world, double impact_speed, int steps_per_contact, TimeStepRule rule) {
   TimeStepEstimate estimate;
   estimate.rayleigh = std::numeric_limits<double>::infinity();
   estimate.hertz = std::numeric_limits<double>::infinity();
@@ -349,9 +351,12 @@ TimeStepEstimate estimate_time_step(const World& world, double impact_speed, int
   // EDEM's guidance: 20 % of the Rayleigh time for coordination numbers of 4 or more, 40 %
   // below; one body on walls (the lab tests) is the sparse case.
   estimate.rayleigh_fraction = world.bodies.size() <= 1 ? 0.4 : 0.2;
-  estimate.chosen =
-      std::min(estimate.rayleigh_fraction * estimate.rayleigh, estimate.hertz / std::max(20, steps_per_contact));
-  estimate.largest_allowed = std::min(0.4 * estimate.rayleigh, estimate.hertz / 20.0);
+  estimate.rule = rule;
+  const bool rayleigh = rule == TimeStepRule::RayleighAndHertz;
+  const double unbounded = std::numeric_limits<double>::infinity();
+  estimate.chosen = std::min(rayleigh ? estimate.rayleigh_fraction * estimate.rayleigh : unbounded,
+                             estimate.hertz / std::max(20, steps_per_contact));
+  estimate.largest_allowed = std::min(rayleigh ? 0.4 * estimate.rayleigh : unbounded, estimate.hertz / 20.0);
   return estimate;
 }
 
@@ -359,11 +364,13 @@ Result<void> check_time_step(double dt, const TimeStepEstimate& estimate) {
   if (!(dt > 0.0) || !std::isfinite(dt))
     return fail(ErrorCode::InvalidArgument, fmt::format("time step {} s must be positive", dt));
   if (dt > estimate.largest_allowed) {
-    return fail(
-        ErrorCode::InvalidArgument,
-        fmt::format("time step {:.3g} s is above the stable limit {:.3g} s (0.4 of the Rayleigh time {:.3g} s, or 1/20 "
-                    "of the Hertz contact time {:.3g} s)",
-                    dt, estimate.largest_allowed, estimate.rayleigh, estimate.hertz));
+    const std::string rayleigh = estimate.rule == TimeStepRule::RayleighAndHertz
+                                     ? fmt::format("0.4 of the Rayleigh time {:.3g} s, or ", estimate.rayleigh)
+                                     : std::string();
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("time step {:.3g} s is above the stable limit {:.3g} s ({}1/20 of the Hertz contact time "
+                            "{:.3g} s)",
+                            dt, estimate.largest_allowed, rayleigh, estimate.hertz));
   }
   return {};
 }

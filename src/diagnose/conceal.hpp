@@ -18,10 +18,12 @@
 
 namespace clumpforge {
 
-/// The generator's DEM: 100 steps per Hertz contact, finer than the diagnosis's.
+/// The generator's DEM: 100 steps per Hertz contact, finer than the diagnosis's, and bounded
+/// by the smallest sphere's Rayleigh time too (the diagnosis's by the contacts alone).
 inline LabOptions generator_lab_options() {
   LabOptions lab = diagnosis_lab_options();
   lab.steps_per_contact = 100;
+  lab.time_step_rule = TimeStepRule::RayleighAndHertz;
   return lab;
 }
 

@@ -112,10 +112,15 @@ inline std::string_view coefficient_name(Coefficient c) {
 }
 
 /// The diagnosis's lab options: 25 steps per Hertz contact (the replays run thousands of
-/// times; drops get 50, see Evaluator). The generator steps finer (generator_lab_options).
+/// times; drops get 50, see Evaluator), bounded by the contacts alone (TimeStepRule::Hertz;
+/// tilts keep the Rayleigh bound, lab_options_for): a finer clump's smallest sphere does not
+/// shorten the step, so that the particle-model ladder's moves are the resolution's, not a time
+/// step's, and its finest rung is cheaper (docs/diagnose.md, "The
+/// time step of a finer clump"). The generator steps finer, by both rules (generator_lab_options).
 inline LabOptions diagnosis_lab_options() {
   LabOptions lab;
   lab.steps_per_contact = 25;
+  lab.time_step_rule = TimeStepRule::Hertz;
   return lab;
 }
 

@@ -409,4 +409,43 @@ TEST(PhysicsTerms, RollingTermsScaleTheTorque) {
   EXPECT_EQ(none.rolling, RollingModel::ConstantTorque);
 }
 
+TEST(TimeStep, TheHertzRuleStepsByTheContactsAloneAndResolvesThem) {
+  // A 1 mm sphere carrying a 1 g body (a clump's small sphere: every sphere of a clump carries
+  // its mass against a wall): 0.4 of its Rayleigh time, 22 us, is shorter than 1/25 of the
+  // Hertz contact, so it bounds the RayleighAndHertz step; the Hertz rule takes t_H / 25.
+  const double r = 1e-3, v = 1.0;
+  World world = soft_sphere_world({1.0, 0.0, 0.0}, r);
+  world.bodies[0].mass = 1e-3;
+  const auto both = estimate_time_step(world, v, 25);
+  const auto hertz = estimate_time_step(world, v, 25, TimeStepRule::Hertz);
+  EXPECT_DOUBLE_EQ(hertz.rayleigh, both.rayleigh);
+  EXPECT_DOUBLE_EQ(hertz.hertz, both.hertz);
+  ASSERT_DOUBLE_EQ(both.chosen, 0.4 * both.rayleigh);  // the case where the rules differ
+  EXPECT_DOUBLE_EQ(hertz.chosen, hertz.hertz / 25.0);
+  EXPECT_GT(hertz.chosen, 1.5 * both.chosen);
+  EXPECT_DOUBLE_EQ(hertz.largest_allowed, hertz.hertz / 20.0);
+  EXPECT_TRUE(check_time_step(hertz.chosen, hertz));
+  const auto refused = check_time_step(hertz.chosen, both);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("Rayleigh"), std::string::npos) << refused.error().message;
+  const auto above = check_time_step(1.1 * hertz.largest_allowed, hertz);
+  ASSERT_FALSE(above);
+  EXPECT_EQ(above.error().message.find("Rayleigh"), std::string::npos) << above.error().message;
+  // The step resolves the contact: with e = 1 the body leaves at its impact speed (within
+  // 0.5 %) after the Hertz duration 2.87 (m^2 / (R E*^2 v))^(1/5) (within 2 %).
+  world.bodies[0].position = {0, 0, r};
+  world.bodies[0].velocity = {0, 0, -v};
+  double touched = -1.0, left = -1.0;
+  for (int i = 0; i < 100000 && left < 0.0; ++i) {
+    step(world, hertz.chosen);
+    const bool in_contact = world.bodies[0].position.z() < r;
+    if (in_contact && touched < 0.0) touched = world.time;
+    if (!in_contact && touched >= 0.0) left = world.time;
+  }
+  ASSERT_GT(left, 0.0);
+  EXPECT_NEAR(world.bodies[0].velocity.z(), v, 0.005 * v);
+  const double duration = test::hertz_theory(1e-3, r, effective_youngs_modulus(kSoft, kSteel), v).duration;
+  EXPECT_NEAR(left - touched, duration, 0.02 * duration);
+}
+
 }  // namespace clumpforge
