@@ -3,8 +3,8 @@
 // The diagnosis's replays (25 steps per Hertz contact, drops 50) of a clump of the default
 // tuber's ladder (clumps/tuber-default-ladder.h5, adaptive-256 by default), under both time-step
 // rules (dem/step.hpp): RayleighAndHertz, where the smallest sphere's Rayleigh time can bound the
-// step, and Hertz, the contacts alone (the diagnosis's for drops and rolls; its tilts keep the
-// default: their contacts rest, and a friction drop's stick-slip moved with the longer step).
+// step, and Hertz, the contacts alone (the diagnosis's; a tilt, whose contacts rest, keeps the
+// Rayleigh bound under both, make_lab_world).
 // The same trials (seed, release orientations) under both; per set-up of the generated
 // nine-set-up benchmark, the outcomes a diagnosis compares as a sample (a drop's rebound height
 // and drift, a roll's distance, a tilt's slip angle): their means under each rule, the paired
@@ -21,6 +21,7 @@
 #include <filesystem>
 
 #include "dem/lab.hpp"
+#include "diagnose/model.hpp"
 #include "io/clump_library.hpp"
 #include "numerics/statistics.hpp"
 
@@ -97,10 +98,10 @@ struct Run {
 };
 
 Run run(const Clump& clump, const Recording& setup, int trials, TimeStepRule rule) {
-  LabOptions options;
+  LabOptions options = diagnosis_lab_options();
   options.trials = trials;
   options.seed = 7;
-  options.steps_per_contact = setup.test == LabTest::Drop ? 50 : 25;  // the diagnosis's (Evaluator)
+  if (setup.test == LabTest::Drop) options.steps_per_contact = Evaluator{}.drop_steps_per_contact;
   options.time_step_rule = rule;
   const auto start = std::chrono::steady_clock::now();
   auto result = run_lab_test(clump, default_material_table(), setup, options);

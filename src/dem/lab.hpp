@@ -22,9 +22,10 @@ struct LabOptions {
   /// Default time step: at least this many steps per Hertz contact (50 = the estimate's
   /// choice; the diagnosis, which replays trials thousands of times, uses 25).
   int steps_per_contact = 50;
-  /// What bounds the default time step: the diagnosis replays a rigid clump's drops and rolls
-  /// by their contacts alone (TimeStepRule::Hertz), so that a finer fill's smallest sphere does
-  /// not shorten the step (docs/diagnose.md, "The time step of a finer clump").
+  /// What bounds the default time step of a drop or roll (a tilt's contacts rest on the plate:
+  /// it keeps the Rayleigh bound, make_lab_world): the diagnosis replays a rigid clump by its
+  /// contacts alone (TimeStepRule::Hertz), so that a finer fill's smallest sphere does not
+  /// shorten the step (docs/diagnose.md, "The time step of a finer clump").
   TimeStepRule time_step_rule = TimeStepRule::RayleighAndHertz;
   double frame_rate_hz = 1000.0;     ///< track sampling, like a high-speed camera
   double tilt_rate_deg_per_s = 5.0;  ///< used when the recording has none

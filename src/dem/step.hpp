@@ -19,7 +19,7 @@ enum class TimeStepRule {
   /// body's mass; a contact off the centre of mass turns the body too and oscillates faster, up
   /// to sqrt(1 + r^2 m / I) times (2.4 for the tuber: r its bounding radius, I its smallest
   /// principal moment), so omega dt stays near 0.3 at n = 25, a sixth of velocity Verlet's
-  /// stability limit of 2.
+  /// stability limit of 2. The lab's tilts keep the Rayleigh bound (make_lab_world).
   Hertz,
 };
 

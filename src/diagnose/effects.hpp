@@ -113,7 +113,7 @@ inline std::string_view coefficient_name(Coefficient c) {
 
 /// The diagnosis's lab options: 25 steps per Hertz contact (the replays run thousands of
 /// times; drops get 50, see Evaluator), bounded by the contacts alone (TimeStepRule::Hertz;
-/// tilts keep the Rayleigh bound, lab_options_for): a finer clump's smallest sphere does not
+/// a tilt keeps the Rayleigh bound, make_lab_world): a finer clump's smallest sphere does not
 /// shorten the step, so that the particle-model ladder's moves are the resolution's, not a time
 /// step's, and its finest rung is cheaper (docs/diagnose.md, "The
 /// time step of a finer clump"). The generator steps finer, by both rules (generator_lab_options).

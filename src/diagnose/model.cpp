@@ -23,13 +23,6 @@ LabOptions lab_options_for(const Evaluator& ev, const Model& model, const Record
   if (recording.tilt_rate_deg_per_s) options.tilt_rate_deg_per_s = *recording.tilt_rate_deg_per_s;
   if (recording.test == LabTest::Drop)
     options.steps_per_contact = std::max(options.steps_per_contact, ev.drop_steps_per_contact);
-  // A tilt's contacts rest on the plate: its Hertz duration (at a nominal 0.1 m/s) is no
-  // collision's, and without the Rayleigh bound its step grows by half or more (about 200 us for
-  // the 32-sphere four-square, against 0.4 of the Rayleigh time, 128 us), which moved a friction
-  // drop's stick-slip (test DiagnoseBlind.TheSmallestDetectableEffectIsOneAReplayShowed: a limit
-  // of 0.039 claimed where 0.1 was concealed). Tilts keep the bound: their replays are the same
-  // bits as before the Hertz rule on every clump.
-  if (recording.test == LabTest::Tilt) options.time_step_rule = TimeStepRule::RayleighAndHertz;
   return options;
 }
 
