@@ -840,9 +840,6 @@ std::vector<Case> interleaved(const std::vector<Case>& cases) {
   return out;
 }
 
-/// Seeds of a case's second surface (--nine-set-ups): its own release orientations and noise.
-constexpr std::uint64_t kSecondSurfaceSeed = 1'000'000;
-
 /// The generated cases: every effect of the library (or --effects) at its realistic and
 /// strong magnitude, then the controls with varied base coefficients, interleaved. Each case
 /// records on one surface, or on two with --nine-set-ups (each concealed on its own, as each
@@ -866,15 +863,7 @@ Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialT
       }
       return std::vector<ConcealOptions>{c};
     }
-    ConcealOptions steel = c, soil = c;
-    steel.surface = "Q235";
-    steel.roll_starts = {0.035, 0.07};
-    soil.surface = "soil";
-    soil.drop_heights = {0.2, 0.5};
-    soil.roll_starts = {0.035};
-    soil.tilt = false;
-    soil.seed = case_seed + kSecondSurfaceSeed;
-    return std::vector<ConcealOptions>{steel, soil};
+    return nine_set_up_parts(c);
   };
   std::vector<Case> cases;
   std::uint64_t k = 0;

@@ -16,11 +16,13 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 
 #include "dem/lab.hpp"
+#include "diagnose/conceal.hpp"
 #include "diagnose/model.hpp"
 #include "io/clump_library.hpp"
 #include "numerics/statistics.hpp"
@@ -35,22 +37,24 @@ struct SetUp {
   Recording recording;
 };
 
+std::string label(const Recording& r) {
+  if (r.test == LabTest::Drop) return fmt::format("drop {:g} m", r.release_height);
+  if (r.test == LabTest::Roll) return fmt::format("roll {:.0f} mm", r.start_distance * 1e3);
+  return "tilt";
+}
+
+/// The generated nine-set-up benchmark's set-ups (diagnose/conceal.hpp), each labelled by its
+/// surface and recording, in the order docs/diagnose.md shows them.
 std::vector<SetUp> nine_set_ups() {
   std::vector<SetUp> out;
-  auto add = [&](std::string label, LabTest test, std::string surface, double value) {
-    Recording r;
-    r.test = test;
-    r.surface = std::move(surface);
-    if (test == LabTest::Drop) r.release_height = value;
-    if (test == LabTest::Roll) r.start_distance = value;
-    if (test == LabTest::Tilt) r.composite = Composite::FourSquare;
-    out.push_back({std::move(label), std::move(r)});
+  for (const ConcealOptions& part : nine_set_up_parts(ConcealOptions{}))
+    for (ConcealedSetUp& s : concealed_set_ups(part))
+      out.push_back({fmt::format("{} {}", part.surface, label(s.recording)), std::move(s.recording)});
+  // By test, then surface: the drops, the rolls, the tilt.
+  auto rank = [](const SetUp& s) {
+    return s.recording.test == LabTest::Drop ? 0 : s.recording.test == LabTest::Roll ? 1 : 2;
   };
-  for (double h : {0.2, 0.5, 1.0}) add(fmt::format("Q235 drop {} m", h), LabTest::Drop, "Q235", h);
-  for (double h : {0.2, 0.5}) add(fmt::format("soil drop {} m", h), LabTest::Drop, "soil", h);
-  for (double d : {0.035, 0.07}) add(fmt::format("Q235 roll {:.0f} mm", d * 1e3), LabTest::Roll, "Q235", d);
-  add("soil roll 35 mm", LabTest::Roll, "soil", 0.035);
-  add("Q235 tilt", LabTest::Tilt, "Q235", 0.0);
+  std::stable_sort(out.begin(), out.end(), [&](const SetUp& a, const SetUp& b) { return rank(a) < rank(b); });
   return out;
 }
 

@@ -14,15 +14,10 @@
 #include "numerics/statistics.hpp"
 
 namespace clumpforge {
-namespace {
+namespace {}  // namespace
 
-struct Setup {
-  Recording recording;
-  std::string name;
-};
-
-std::vector<Setup> setups(const ConcealOptions& o) {
-  std::vector<Setup> out;
+std::vector<ConcealedSetUp> concealed_set_ups(const ConcealOptions& o) {
+  std::vector<ConcealedSetUp> out;
   for (double h : o.drop_heights) {
     Recording r;
     r.test = LabTest::Drop;
@@ -48,6 +43,22 @@ std::vector<Setup> setups(const ConcealOptions& o) {
   }
   return out;
 }
+
+std::vector<ConcealOptions> nine_set_up_parts(const ConcealOptions& base) {
+  ConcealOptions steel = base, soil = base;
+  steel.surface = "Q235";
+  steel.drop_heights = {0.2, 0.5, 1.0};
+  steel.roll_starts = {0.035, 0.07};
+  steel.tilt = true;
+  soil.surface = "soil";
+  soil.drop_heights = {0.2, 0.5};
+  soil.roll_starts = {0.035};
+  soil.tilt = false;
+  soil.seed = base.seed + kSecondSurfaceSeed;
+  return {steel, soil};
+}
+
+namespace {
 
 // How the lab sets the particle down: any way for a drop, on its rim for a roll when asked
 // and the body has one, lying as it rests (a random heading) for a tilt.
@@ -399,7 +410,7 @@ Result<ConcealResult> make_concealed_recordings(const Clump& clump, const Materi
     if (!pair) return std::unexpected(pair.error());
     result.baseline = *pair;
   }
-  auto all = setups(options);
+  auto all = concealed_set_ups(options);
   std::vector<std::vector<Eigen::Quaterniond>> orientations(all.size());
   for (std::size_t r = 0; r < all.size(); ++r) {
     Rng rng(options.seed, 1000 + r);

@@ -87,6 +87,26 @@ struct ConcealResult {
   std::vector<std::vector<double>> twin_summaries;
 };
 
+/// One recording of a generated set: its set-up (test, surface, height or start) and the
+/// directory it is written to.
+struct ConcealedSetUp {
+  Recording recording;
+  std::string name;  ///< e.g. "drop-0.2m", "roll-35mm", "tilt"
+};
+
+/// The recordings `options` asks for, in the order they are made: its drops, its rolls, and
+/// its tilt if asked, on its surface.
+std::vector<ConcealedSetUp> concealed_set_ups(const ConcealOptions& options);
+
+/// What a second surface's recordings add to a case's seed, so that its trials do not repeat
+/// the first surface's releases.
+inline constexpr std::uint64_t kSecondSurfaceSeed = 1'000'000;
+
+/// The generated nine-set-up design, as two parts of `base` (its trials, camera and seed): on
+/// Q235 drops from 0.2, 0.5 and 1 m, rolls from 35 and 70 mm and the tilt; on soil drops from
+/// 0.2 and 0.5 m and a roll from 35 mm, seeded `kSecondSurfaceSeed` further.
+std::vector<ConcealOptions> nine_set_up_parts(const ConcealOptions& base);
+
 /// Reads what the camera tracks: "silhouette" (its centroid, with rows `pixel_mm` apart) or
 /// "body-point" into `options`.
 Result<void> parse_camera(std::string_view text, double pixel_mm, ConcealOptions& options);
