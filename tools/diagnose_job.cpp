@@ -53,7 +53,8 @@ nlohmann::json outcome_shift_json(const std::optional<OutcomeShift>& shift, cons
           {"from", finite_or_null(shift->from)},
           {"to", finite_or_null(shift->to)},
           {"replays", shift->replays},
-          {"converged", shift->converged()}};
+          {"judged", shift->judged},
+          {"converged", shift->judged ? nlohmann::json(shift->converged()) : nlohmann::json()}};
 }
 
 nlohmann::json coefficients_json(const std::vector<SurfaceParameters>& base) {

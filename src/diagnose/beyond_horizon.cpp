@@ -546,6 +546,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
       auto shift = last ? move() : measure_move(c, from, previous_model, previous, refit.scores, first_draw);
       if (!shift) return std::unexpected(shift.error());
       rung.outcome_shift = *shift;
+      rung.outcome_shift->judged = last;
     }
     previous = fine->null_comparisons;
     previous_model = refit.fitted.model;

@@ -104,6 +104,11 @@ struct OutcomeShift {
   Outcome outcome = Outcome::ReboundHeight;  ///< and outcome
   double from = 0.0, to = 0.0;               ///< its replayed value with each clump
   int replays = 0;                           ///< replays per recording it was measured with
+  /// Whether a verdict may read it: false for a rung that neither explains the outcomes nor is
+  /// the last, whose move is only reported, on the first draw's replays (too few to call a
+  /// move converged: the strong elastic-plastic case's 64-sphere rung, p = 0.30 on 12 replays
+  /// and 0.00066 on 48 at 11c5051).
+  bool judged = true;
   bool converged() const { return !(means > 0 && p < kReal && largest >= kMatters); }
 };
 /// The shift from `coarse` to `fine` (comparisons of the same recordings, compare_model); only

@@ -406,6 +406,15 @@ TEST(DiagnoseCli, AnAgreementThatMovesWithTheResolutionNamesNothingAndClaimsNoAb
     EXPECT_LE(rung["seconds_refit"].get<double>(), rung["seconds"].get<double>()) << rung.dump();
   }
   ASSERT_TRUE(rungs[2]["outcome_shift"].is_object()) << pm.dump();
+  // The last rung's move is read by the verdict; a move only reported (a rung before the last
+  // that did not explain the outcomes, on the first draw's replays) is not called converged.
+  EXPECT_TRUE(rungs[2]["outcome_shift"]["judged"].get<bool>()) << pm.dump();
+  for (const auto& rung : rungs) {
+    const auto& shift = rung["outcome_shift"];
+    if (!shift.is_object() || shift["judged"].get<bool>()) continue;
+    EXPECT_TRUE(shift["converged"].is_null()) << rung.dump();
+    EXPECT_FALSE(rung["explains"].get<bool>()) << rung.dump();
+  }
   const bool converged = rungs[2]["outcome_shift"]["converged"].get<bool>();
   if (verdict == "elastic_plastic_restitution" || verdict == "viscoelastic_restitution") {
     if (pm["resolution_needed_spheres"] == 128) {
