@@ -4,7 +4,9 @@
 Generates the same trials (seed, coefficients, release orientations) with each clump given,
 by `clumpforge-conceal` (no effect, orientation none), and prints per recording the mean and
 sd over the trials of the distance from the first tracked point to the rest point (the
-median of the last ten frames): a drop's drift, a roll's distance. The diagnosis's step 0
+median of the last ten frames: a drop's drift, a roll's path) and of the summary the
+recording states (a drop's rebound height, a roll's distance on the flat), with each clump's
+move from the one before in standard errors of a recorded mean of 8 trials. The diagnosis's step 0
 chooses the resolution inside the fitted windows; this shows how far the outcomes beyond them
 are from converged (docs/diagnose.md, Limits).
 
@@ -38,6 +40,31 @@ def rest_distance(track: pathlib.Path) -> float:
     return abs(statistics.median(rows[-10:]) - rows[0])
 
 
+# Each recording's summary as the recording states it (recording-format.md), in mm.
+SUMMARY = {"drop-0.2m": ("rebound height", "rebound_height_m"), "drop-1m": ("rebound height", "rebound_height_m"),
+           "roll-100mm": ("roll distance", "roll_distance_m")}
+
+
+def summaries(folder: pathlib.Path, key: str) -> list:
+    recording = json.loads((folder / "recording.json").read_text())
+    return [t.get("summary", {}).get(key, math.nan) for t in recording["trials"]]
+
+
+def add(results: dict, row: str, name: str, values_m: list) -> None:
+    values = [v for v in values_m if math.isfinite(v)]
+    results.setdefault(row, {})[name] = {
+        "mean_mm": 1e3 * statistics.mean(values),
+        "sd_mm": 1e3 * statistics.stdev(values) if len(values) > 1 else math.nan,
+        "trials": len(values),
+    }
+
+
+def move_in_se(a: dict, b: dict, trials: int = 8) -> float:
+    """b's mean from a's in standard errors of a recorded mean of `trials` trials (the spreads pooled)."""
+    se = math.sqrt((a["sd_mm"] ** 2 + b["sd_mm"] ** 2) / 2.0 / trials)
+    return (b["mean_mm"] - a["mean_mm"]) / se if se > 0 else math.nan
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("clumps", nargs="+", help="LIBRARY.h5:NAME, coarsest first")
@@ -67,21 +94,20 @@ def main() -> int:
                 return 1
             for rec in ("drop-0.2m", "drop-1m", "roll-100mm"):
                 values = [rest_distance(t) for t in sorted((out / rec).glob("trial-*.csv"))]
-                values = [v for v in values if math.isfinite(v)]
-                results.setdefault(rec, {})[name] = {
-                    "mean_mm": 1e3 * statistics.mean(values),
-                    "sd_mm": 1e3 * statistics.stdev(values) if len(values) > 1 else math.nan,
-                    "trials": len(values),
-                }
+                add(results, f"{rec} rest distance", name, values)
+                add(results, f"{rec} {SUMMARY[rec][0]}", name, summaries(out / rec, SUMMARY[rec][1]))
     if a.json:
         print(json.dumps(results, indent=2))
         return 0
     names = [s.rpartition(":")[2] for s in a.clumps]
-    print("| recording (rest distance, mm) | " + " | ".join(names) + " |")
+    print("| recording, outcome (mm) | " + " | ".join(names) + " |")
     print("|---|" + "---:|" * len(names))
     for rec, by in results.items():
-        cells = " | ".join(f"{by[n]['mean_mm']:.0f} +- {by[n]['sd_mm']:.0f}" for n in names)
-        print(f"| {rec} | {cells} |")
+        cells = [f"{by[names[0]]['mean_mm']:.1f} +- {by[names[0]]['sd_mm']:.1f}"]
+        for before, here in zip(names, names[1:]):
+            cells.append(f"{by[here]['mean_mm']:.1f} +- {by[here]['sd_mm']:.1f} ({move_in_se(by[before], by[here]):+.1f})")
+        print(f"| {rec} | " + " | ".join(cells) + " |")
+    print("(in brackets: the move from the clump before, in standard errors of a recorded mean of 8 trials)")
     return 0
 
 
