@@ -105,9 +105,9 @@ struct OutcomeShift {
   double from = 0.0, to = 0.0;               ///< its replayed value with each clump
   int replays = 0;                           ///< replays per recording it was measured with
   /// Whether a verdict may read it: false for a rung that neither explains the outcomes nor is
-  /// the last, whose move is only reported, on the first draw's replays (too few to call a
-  /// move converged: the strong elastic-plastic case's 64-sphere rung, p = 0.30 on 12 replays
-  /// and 0.00066 on 48 at 11c5051).
+  /// the last, whose move is only reported, on its comparison's own replays (12 in a first
+  /// comparison: too few to call a move converged; the strong elastic-plastic case's 64-sphere
+  /// rung, p = 0.30 on 12 replays and 0.00066 on 48 at 11c5051).
   bool judged = true;
   bool converged() const { return !(means > 0 && p < kReal && largest >= kMatters); }
 };
