@@ -37,24 +37,13 @@ struct SetUp {
   Recording recording;
 };
 
-std::string label(const Recording& r) {
-  if (r.test == LabTest::Drop) return fmt::format("drop {:g} m", r.release_height);
-  if (r.test == LabTest::Roll) return fmt::format("roll {:.0f} mm", r.start_distance * 1e3);
-  return "tilt";
-}
-
 /// The generated nine-set-up benchmark's set-ups (diagnose/conceal.hpp), each labelled by its
-/// surface and recording, in the order docs/diagnose.md shows them.
+/// surface and recording.
 std::vector<SetUp> nine_set_ups() {
   std::vector<SetUp> out;
   for (const ConcealOptions& part : nine_set_up_parts(ConcealOptions{}))
     for (ConcealedSetUp& s : concealed_set_ups(part))
-      out.push_back({fmt::format("{} {}", part.surface, label(s.recording)), std::move(s.recording)});
-  // By test, then surface: the drops, the rolls, the tilt.
-  auto rank = [](const SetUp& s) {
-    return s.recording.test == LabTest::Drop ? 0 : s.recording.test == LabTest::Roll ? 1 : 2;
-  };
-  std::stable_sort(out.begin(), out.end(), [&](const SetUp& a, const SetUp& b) { return rank(a) < rank(b); });
+      out.push_back({fmt::format("{} {}", part.surface, s.name), std::move(s.recording)});
   return out;
 }
 

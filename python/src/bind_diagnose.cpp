@@ -135,7 +135,7 @@ void bind_parts(py::module_& m) {
       .def_readonly("to_value", &OutcomeShift::to)
       .def_readonly("replays", &OutcomeShift::replays)
       .def_readonly("judged", &OutcomeShift::judged,
-                    "whether a verdict reads it (false: reported only, on the first draw's replays)")
+                    "whether a verdict reads it (false: reported only, on its comparison's own replays)")
       .def("converged", &OutcomeShift::converged);
   py::class_<ParticleModelRung>(m, "ParticleModelRung", "One clump the particle-model check tried.")
       .def_readonly("name", &ParticleModelRung::name)

@@ -538,9 +538,9 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     if (!rung.explains && !rung.outcome_shift) {
       // The move of a rung that neither explains nor is the last decides nothing (a finer clump
       // is tried next, and only the last rung's move is judged: particle_model_unconverged,
-      // judge_on_converged_clump): it is reported on the first draw's replays, against this
-      // rung's own comparisons at the same release orientations, at an eighth of the 48-replay
-      // measurement's replays.
+      // judge_on_converged_clump): it is reported on this comparison's own replays (12 in a first
+      // comparison, a quarter of the 48 a judged move takes), against this rung's own comparisons
+      // at the same release orientations, and marked not judged.
       EnsembleOptions first_draw = eo;
       first_draw.move_replays = eo.replays;
       auto shift = last ? move() : measure_move(c, from, previous_model, previous, refit.scores, first_draw);

@@ -14,7 +14,6 @@
 #include "numerics/statistics.hpp"
 
 namespace clumpforge {
-namespace {}  // namespace
 
 std::vector<ConcealedSetUp> concealed_set_ups(const ConcealOptions& o) {
   std::vector<ConcealedSetUp> out;

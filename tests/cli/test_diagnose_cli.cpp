@@ -407,7 +407,7 @@ TEST(DiagnoseCli, AnAgreementThatMovesWithTheResolutionNamesNothingAndClaimsNoAb
   }
   ASSERT_TRUE(rungs[2]["outcome_shift"].is_object()) << pm.dump();
   // The last rung's move is read by the verdict; a move only reported (a rung before the last
-  // that did not explain the outcomes, on the first draw's replays) is not called converged.
+  // that did not explain the outcomes, on its comparison's own replays) is not called converged.
   EXPECT_TRUE(rungs[2]["outcome_shift"]["judged"].get<bool>()) << pm.dump();
   for (const auto& rung : rungs) {
     const auto& shift = rung["outcome_shift"];
