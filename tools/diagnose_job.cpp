@@ -44,6 +44,14 @@ nlohmann::json preferred_json(const std::vector<SetUpShare>& shares) {
 // How a rung's replayed outcomes moved from the previous clump's (null when not compared).
 nlohmann::json outcome_shift_json(const std::optional<OutcomeShift>& shift, const std::vector<std::string>& names) {
   if (!shift) return nlohmann::json();
+  nlohmann::json moves = nlohmann::json::array();
+  for (const MeanMove& m : shift->moves)
+    moves.push_back({{"recording", m.recording < names.size() ? nlohmann::json(names[m.recording]) : nlohmann::json()},
+                     {"outcome", std::string(outcome_name(m.outcome))},
+                     {"from", finite_or_null(m.from)},
+                     {"to", finite_or_null(m.to)},
+                     {"noise", finite_or_null(m.noise)},
+                     {"recorded_se", finite_or_null(m.se)}});
   return {{"means", shift->means},
           {"chi2", finite_or_null(shift->chi2)},
           {"p", finite_or_null(shift->p)},
@@ -54,7 +62,8 @@ nlohmann::json outcome_shift_json(const std::optional<OutcomeShift>& shift, cons
           {"to", finite_or_null(shift->to)},
           {"replays", shift->replays},
           {"judged", shift->judged},
-          {"converged", shift->judged ? nlohmann::json(shift->converged()) : nlohmann::json()}};
+          {"converged", shift->judged ? nlohmann::json(shift->converged()) : nlohmann::json()},
+          {"moves", moves}};
 }
 
 nlohmann::json coefficients_json(const std::vector<SurfaceParameters>& base) {

@@ -122,6 +122,15 @@ void bind_parts(py::module_& m) {
   for (Outcome o : {Outcome::ReboundHeight, Outcome::Drift, Outcome::RollDistance, Outcome::RollTime,
                     Outcome::SlipAngle, Outcome::SlideTime})
     outcome.value(std::string(outcome_name(o)).c_str(), o);
+  py::class_<MeanMove>(m, "MeanMove", "One recorded mean's move from a clump to a finer one.")
+      .def_readonly("recording", &MeanMove::recording)
+      .def_readonly("outcome", &MeanMove::outcome)
+      .def_readonly("from_value", &MeanMove::from)
+      .def_readonly("to_value", &MeanMove::to)
+      .def_readonly("noise", &MeanMove::noise, "the replays' noise and the floor, as a standard error")
+      .def_readonly("recorded_se", &MeanMove::se, "the recorded mean's standard error")
+      .def("chi2", &MeanMove::chi2)
+      .def("matters", &MeanMove::matters, "the move in recorded standard errors");
   py::class_<OutcomeShift>(m, "OutcomeShift",
                            "How a finer clump's replayed outcomes moved from the previous clump's at the same "
                            "coefficients and orientations.")
@@ -136,6 +145,7 @@ void bind_parts(py::module_& m) {
       .def_readonly("replays", &OutcomeShift::replays)
       .def_readonly("judged", &OutcomeShift::judged,
                     "whether a verdict reads it (false: reported only, on its comparison's own replays)")
+      .def_readonly("moves", &OutcomeShift::moves, "each mean compared")
       .def("converged", &OutcomeShift::converged);
   py::class_<ParticleModelRung>(m, "ParticleModelRung", "One clump the particle-model check tried.")
       .def_readonly("name", &ParticleModelRung::name)

@@ -430,6 +430,58 @@ void undecided_by_resolution(DiagnoseResult& result, const ParticleModelRung& be
 
 }  // namespace
 
+/// The verdict while the particle model is not converged (its finest clump `spheres`): undecidable,
+/// and so is every candidate asked about (one hypothesis each), present or absent (the
+/// frame-by-frame and first-order claims of absence included); the experiment asks for finer
+/// clumps. The statement is the caller's.
+void undecidable_unconverged(DiagnoseResult& result, int spheres) {
+  supersede(result, Verdict::Undecidable, Basis::UnconvergedParticleModel);
+  result.undecidable.clear();
+  for (const auto& h : result.hypotheses) result.undecidable.push_back(h.name);
+  result.experiment = finer_clumps_experiment(spheres);
+}
+
+/// A candidate beat the diagnosed clump's null (`let_through`), no finer clump explained the
+/// outcomes, and the finest clump's outcomes still moved from the previous clump's at the same
+/// coefficients (particle_model_unconverged): the candidate was tried with the finest clump too
+/// (CandidatesTried::Pursued). Beating that clump's own null by the margin, it stands (named on the
+/// diagnosed clump's comparison, a note giving its delta-BIC with the finest); else its evidence may
+/// be the coarse clump's share, and the verdict is undecidable. Returns whether it said so. The
+/// generated noisy:15 control-07 at 65de5fc was named viscoelastic_restitution (delta-BIC 15.8 with
+/// 32 spheres) on the 1 m drop's drift, which each step of the ladder moved by 1.2-1.3 recorded
+/// standard errors the way the candidate did.
+bool let_through_on_unconverged_finest(DiagnoseResult& result, const EnsembleResult& finest,
+                                       const LetThrough& let_through, double min_delta_bic) {
+  const ParticleModelCheck& check = *result.particle_model;
+  const ParticleModelRung& last = check.rungs.back();
+  if (!last.outcome_shift || !last.outcome_shift->judged || last.outcome_shift->converged()) return false;
+  const auto h = std::find_if(finest.hypotheses.begin(), finest.hypotheses.end(),
+                              [&](const EnsembleHypothesis& x) { return x.effect == let_through.effect; });
+  const std::string name = effect_name(let_through.effect);
+  const std::string there = h == finest.hypotheses.end()
+                                ? std::string("was not tried there (no level of it was proposed)")
+                                : fmt::format("has delta-BIC {:.1f} against that clump's null{}", h->delta_bic(),
+                                              h->plausible ? "" : " at an implausible level");
+  if (h != finest.hypotheses.end() && h->plausible && h->delta_bic() >= min_delta_bic) {
+    result.notes.push_back(fmt::format("{} with {} ({} spheres), its coefficients refitted, {} (the margin is {:.0f})",
+                                       name, last.name, last.spheres, there, min_delta_bic));
+    return false;
+  }
+  undecidable_unconverged(result, last.spheres);
+  const ParticleModelRung& before = check.rungs[check.rungs.size() - 2];
+  const OutcomeShift& s = *last.outcome_shift;
+  result.statement = fmt::format(
+      "Not decidable with these clumps: with {} ({} spheres) {} beat the null calibrated on the recorded outcomes "
+      "over the unknown release orientation (delta-BIC {:.1f}); with {} ({} spheres), its coefficients refitted, it "
+      "{} (the margin is {:.0f}), and from {} to {} spheres, at the same coefficients and release orientations, the "
+      "replayed outcomes still moved (chi^2 {:.1f} over {} means, p = {:.2g}, up to {:.1f} recorded standard "
+      "errors). Whether {} is missing physics or the coarse clump's share hangs on a particle model that has not "
+      "converged.",
+      check.diagnosed, check.spheres, name, let_through.delta_bic, last.name, last.spheres, there, min_delta_bic,
+      before.spheres, last.spheres, s.chi2, s.means, s.p, s.largest, name);
+  return true;
+}
+
 /// The calibrated null leaves the recorded outcomes inconsistent with the replays
 /// (outcomes_consistent), or a candidate (`let_through`) beat a consistent one: before the mismatch is blamed on
 /// missing physics, each finer clump left is tried (its null calibrated afresh on the outcomes, from the same
@@ -513,11 +565,14 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
       return *moved;
     };
     const bool last = k + 1 == c.finer.size();
-    pursue.candidates_when_inconsistent = [&]() -> Result<bool> {
-      if (!last) return false;
+    // On an unconverged last rung the one a coarser clump let through is still tried: whether it is
+    // needed with the finest clump too (let_through_on_unconverged_finest).
+    pursue.candidates_when_inconsistent = [&]() -> Result<CandidatesTried> {
+      if (!last) return CandidatesTried::None;
       auto shift = move();
       if (!shift) return std::unexpected(shift.error());
-      return shift->converged();
+      if (shift->converged()) return CandidatesTried::All;
+      return let_through ? CandidatesTried::Pursued : CandidatesTried::None;
     };
     auto fine = compare_ensembles(c.ev, refit.fitted.model, refit.scores, free, candidates, pursue);
     if (!fine) return std::unexpected(fine.error());
@@ -557,7 +612,9 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     else
       finest = std::move(*fine);
   }
-  return finest && judge_on_converged_clump(result, check, *finest, eo.min_delta_bic);
+  if (!finest) return false;
+  if (judge_on_converged_clump(result, check, *finest, eo.min_delta_bic)) return true;
+  return let_through && let_through_on_unconverged_finest(result, *finest, *let_through, eo.min_delta_bic);
 }
 
 /// No finer clump explained a mismatch of the outcomes, but the finest one's replayed outcomes
@@ -578,12 +635,7 @@ bool particle_model_unconverged(const Context& c, DiagnoseResult& result) {
       ", most the mean {} of {} ({:.3g} -> {:.3g} {}, {:.1f} recorded standard errors)", outcome_name(shift.outcome),
       recording_label((*c.ev.recordings)[shift.recording], c.names[shift.recording]), shift.from * as.scale,
       shift.to * as.scale, as.unit, shift.largest);
-  supersede(result, Verdict::Undecidable, Basis::UnconvergedParticleModel);
-  // Nothing is decided while the particle model is not: every candidate asked about (one
-  // hypothesis each) is undecidable, present or absent (the frame-by-frame and first-order
-  // claims of absence included).
-  result.undecidable.clear();
-  for (const auto& h : result.hypotheses) result.undecidable.push_back(h.name);
+  undecidable_unconverged(result, last->spheres);
   result.statement = fmt::format(
       "Not decidable with these clumps: the recorded outcomes differ from replays over the unknown release "
       "orientation (chi^2 {:.1f} over {} recorded means and spreads with {}, {:.1f} with {}), but the particle "
@@ -594,7 +646,6 @@ bool particle_model_unconverged(const Context& c, DiagnoseResult& result) {
       "missing physics.",
       e.null_chi2, e.outcomes, result.particle_model->diagnosed, last->chi2_per_value * e.outcomes, last->name,
       before.spheres, last->spheres, shift.chi2, shift.means, shift.p, where);
-  result.experiment = finer_clumps_experiment(last->spheres);
   return true;
 }
 

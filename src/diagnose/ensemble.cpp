@@ -211,19 +211,19 @@ OutcomeShift outcome_shift(const std::vector<OutcomeComparison>& coarse, const s
       return x.statistic == Statistic::Mean && x.recording == b.recording && x.outcome == b.outcome;
     });
     if (a == coarse.end() || a->ensemble_n < 2 || b.ensemble_n < 2) continue;
-    const double moved = b.ensemble_mean - a->ensemble_mean;
     const double noise = std::sqrt(a->ensemble_sd * a->ensemble_sd / a->ensemble_n +
                                    b.ensemble_sd * b.ensemble_sd / b.ensemble_n + b.floor * b.floor);
     if (!(noise > 0.0)) continue;
+    const MeanMove m{b.recording, b.outcome, a->ensemble_mean, b.ensemble_mean, noise, comparison_se(b)};
+    shift.moves.push_back(m);
     ++shift.means;
-    shift.chi2 += moved * moved / (noise * noise);
-    const double se = comparison_se(b), matters = se > 0.0 ? std::abs(moved) / se : 0.0;
-    if (matters >= shift.largest) {
-      shift.largest = matters;
-      shift.recording = b.recording;
-      shift.outcome = b.outcome;
-      shift.from = a->ensemble_mean;
-      shift.to = b.ensemble_mean;
+    shift.chi2 += m.chi2();
+    if (m.matters() >= shift.largest) {
+      shift.largest = m.matters();
+      shift.recording = m.recording;
+      shift.outcome = m.outcome;
+      shift.from = m.from;
+      shift.to = m.to;
     }
   }
   shift.p = shift.means > 0 ? chi2_upper_tail(shift.chi2, shift.means) : 1.0;
@@ -1152,13 +1152,14 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   const auto library = effect_library();
   const bool unexplained = !outcomes_consistent(result.null_comparisons, free.size());
   std::vector<Proposal> proposals;
-  bool try_candidates = true;
+  CandidatesTried tried = CandidatesTried::All;
   if (unexplained && options.candidates_when_inconsistent) {
     auto asked = options.candidates_when_inconsistent();
     if (!asked) return std::unexpected(asked.error());
-    try_candidates = *asked;
+    tried = *asked;
   }
-  for (Effect e : try_candidates ? candidates : std::vector<Effect>{}) {
+  for (Effect e : candidates) {
+    if (tried == CandidatesTried::None || (tried == CandidatesTried::Pursued && options.pursue != e)) continue;
     auto proposal = propose(ev, plans, null_model, null_sample, null_means, recorded, inverse_se, scaling, jacobian,
                             free, effect_spec(library, e), options,
                             options.pursue == e ? Pursuit::Always

@@ -93,6 +93,18 @@ double comparison_se(const OutcomeComparison& c);
 /// below kReal; independent samples, though the orientations are shared) and it matters when it is a recorded standard
 /// error or more (comparison_se): a clump whose outcomes still move by that much with resolution cannot say whether a
 /// mismatch beyond the release horizon is missing physics or its own coarseness.
+/// One recorded mean's move from a clump to a finer one (OutcomeShift).
+struct MeanMove {
+  std::size_t recording = 0;
+  Outcome outcome = Outcome::ReboundHeight;
+  double from = 0.0, to = 0.0;  ///< its replayed mean with each clump
+  double noise = 0.0;           ///< the two replay samples' noise and the floor, as a standard error
+  double se = 0.0;              ///< the recorded mean's standard error (comparison_se)
+  double chi2() const { return (to - from) * (to - from) / (noise * noise); }
+  /// [recorded standard errors]
+  double matters() const { return se > 0.0 ? std::abs(to - from) / se : 0.0; }
+};
+
 struct OutcomeShift {
   static constexpr double kReal = 0.01;      ///< upper-tail probability below which the move is real
   static constexpr double kMatters = 1.0;    ///< [recorded standard errors] a move that matters
@@ -109,11 +121,19 @@ struct OutcomeShift {
   /// comparison: too few to call a move converged; the strong elastic-plastic case's 64-sphere
   /// rung, p = 0.30 on 12 replays and 0.00066 on 48 at 11c5051).
   bool judged = true;
+  std::vector<MeanMove> moves;  ///< each mean compared, in the fine comparisons' order
   bool converged() const { return !(means > 0 && p < kReal && largest >= kMatters); }
 };
 /// The shift from `coarse` to `fine` (comparisons of the same recordings, compare_model); only
 /// the means are compared (a spread's sampling noise is not the mean's).
 OutcomeShift outcome_shift(const std::vector<OutcomeComparison>& coarse, const std::vector<OutcomeComparison>& fine);
+
+/// Which candidates a comparison tries (EnsembleOptions::candidates_when_inconsistent).
+enum class CandidatesTried {
+  None,
+  Pursued,  ///< only EnsembleOptions::pursue, the one a coarser clump let through
+  All,
+};
 
 struct EnsembleOptions {
   /// Release orientations per recording, >= 4; a recording with more tracked trials is replayed
@@ -132,13 +152,13 @@ struct EnsembleOptions {
   /// outcomes would decide has its strong magnitude replayed with it too
   /// (Detectability::strong_resolution).
   const Clump* finer = nullptr;
-  /// Whether the candidates are tried when the calibrated null leaves the outcomes inconsistent,
-  /// asked only then (unset: they are). No for a rung of the particle-model check with a finer one
-  /// after it: there only whether its null explains the outcomes is asked (on the generated
-  /// nine-set-up strong adhesion case the 64-sphere rung's comparison took 14.2 s with its
-  /// candidates and 2.3 s without); the last rung answers once it knows whether its outcomes
-  /// moved from the previous clump's (finer_clump_explains_outcomes).
-  std::function<Result<bool>()> candidates_when_inconsistent;
+  /// Which candidates are tried when the calibrated null leaves the outcomes inconsistent, asked
+  /// only then (unset: all). None for a rung of the particle-model check with a finer one after
+  /// it: there only whether its null explains the outcomes is asked (on the generated nine-set-up
+  /// strong adhesion case the 64-sphere rung's comparison took 14.2 s with its candidates and
+  /// 2.3 s without); the last rung answers once it knows whether its outcomes moved from the
+  /// previous clump's (finer_clump_explains_outcomes).
+  std::function<Result<CandidatesTried>()> candidates_when_inconsistent;
 };
 
 /// Recorded outcomes are consistent with replays while their chi^2 tail is at least this (the

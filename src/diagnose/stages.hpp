@@ -336,6 +336,15 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
                                            const std::vector<Effect>& candidates, const EnsembleOptions& eo,
                                            int max_evaluations, std::optional<LetThrough> let_through);
 bool particle_model_unconverged(const Context& c, DiagnoseResult& result);
+/// The verdict while the particle model is not converged (its finest clump `spheres`): undecidable,
+/// every candidate asked about too; finer clumps asked for. The statement is the caller's.
+void undecidable_unconverged(DiagnoseResult& result, int spheres);
+/// A candidate that beat the diagnosed clump's null (`let_through`), tried on the finest clump
+/// (`finest`, its comparison) after that clump's outcomes moved from the previous one's: named
+/// (returns false, a note given) only when it beats that clump's null by the margin at a plausible
+/// level; else the verdict is undecidable (returns true).
+bool let_through_on_unconverged_finest(DiagnoseResult& result, const EnsembleResult& finest,
+                                       const LetThrough& let_through, double min_delta_bic);
 /// Once a finer clump explains the outcomes and nothing passes there: the absences the diagnosed
 /// clump's outcomes decided that the explaining clump's comparison (`fine`) does not decide go
 /// back to undecidable (advice ParticleModelDecides); returns their names.

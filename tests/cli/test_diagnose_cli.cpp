@@ -409,6 +409,14 @@ TEST(DiagnoseCli, AnAgreementThatMovesWithTheResolutionNamesNothingAndClaimsNoAb
   // The last rung's move is read by the verdict; a move only reported (a rung before the last
   // that did not explain the outcomes, on its comparison's own replays) is not called converged.
   EXPECT_TRUE(rungs[2]["outcome_shift"]["judged"].get<bool>()) << pm.dump();
+  // Each mean's move is listed, in recorded standard errors' units too.
+  const auto& moves = rungs[2]["outcome_shift"]["moves"];
+  ASSERT_EQ(moves.size(), rungs[2]["outcome_shift"]["means"].get<std::size_t>()) << pm.dump();
+  for (const auto& m : moves) {
+    EXPECT_TRUE(m["recording"].is_string()) << m.dump();
+    EXPECT_GT(m["recorded_se"].get<double>(), 0.0) << m.dump();
+    EXPECT_GT(m["noise"].get<double>(), 0.0) << m.dump();
+  }
   for (const auto& rung : rungs) {
     const auto& shift = rung["outcome_shift"];
     if (!shift.is_object() || shift["judged"].get<bool>()) continue;

@@ -523,6 +523,13 @@ TEST(EnsembleConvergence, AnOutcomeShiftCountsWhenItIsRealAndMatters) {
   EXPECT_NEAR(shift.from, 0.10, 1e-12);
   EXPECT_NEAR(shift.to, 0.12, 1e-12);
   EXPECT_FALSE(shift.converged());
+  // Each mean's move, in the fine comparisons' order; they add up to the chi^2.
+  ASSERT_EQ(shift.moves.size(), 2U);
+  EXPECT_EQ(shift.moves[0].recording, 0U);
+  EXPECT_NEAR(shift.moves[0].to - shift.moves[0].from, 0.02, 1e-12);
+  EXPECT_NEAR(shift.moves[0].matters(), shift.largest, 1e-12);
+  EXPECT_NEAR(shift.moves[1].chi2(), 0.0, 1e-12);
+  EXPECT_NEAR(shift.moves[0].chi2() + shift.moves[1].chi2(), shift.chi2, 1e-9);
   // The same move against recordings ten times as scattered: real, but under a recorded se.
   const OutcomeShift small = outcome_shift(comparisons(0.10, 0.1), comparisons(0.12, 0.1));
   EXPECT_LT(small.p, OutcomeShift::kReal);
@@ -786,6 +793,70 @@ TEST(EnsembleConvergedLadder, CandidatesAreJudgedOnTheFinestClumpOnlyOnceItHasCo
     } else {
       EXPECT_EQ(result.verdict, Verdict::None);
       EXPECT_FALSE(result.effect.has_value());
+    }
+  }
+}
+
+// A candidate that beat the diagnosed clump's null, tried again on the finest clump of a ladder
+// that has not converged (its last move real and a recorded standard error or more): it stands only
+// when it beats that clump's own null by the margin at a plausible level; otherwise the verdict is
+// undecidable on the unconverged particle model, every candidate asked about with it. A converged
+// ladder is not this rule's (judge_on_converged_clump). The generated noisy:15 control-07 at
+// 65de5fc: viscoelastic restitution at delta-BIC 15.8 with 32 spheres, -1.9 with 256.
+TEST(EnsembleUnconvergedLadder, ACandidateLetThroughMustBeNeededOnTheFinestClumpToo) {
+  const auto library = effect_library();
+  const std::size_t parameters = effect_spec(library, Effect::ViscoelasticRestitution).parameters.size();
+  struct Case {
+    double shift_p;
+    std::optional<double> delta_bic;  // none: the candidate was not tried on the finest clump
+    bool plausible, undecidable;
+  };
+  for (const Case& k : {Case{1e-4, 25.0, true, false}, Case{1e-4, -1.9, true, true}, Case{1e-4, 25.0, false, true},
+                        Case{1e-4, std::nullopt, true, true}, Case{0.4, -1.9, true, false}}) {
+    DiagnoseResult result;
+    result.verdict = Verdict::None;
+    result.hypotheses.push_back({.name = "viscoelastic_restitution"});
+    result.hypotheses.push_back({.name = "air_drag"});
+    ParticleModelCheck check;
+    check.diagnosed = "adaptive-32";
+    check.spheres = 32;
+    check.rungs.resize(4);
+    for (int r = 0; r < 4; ++r) {
+      check.rungs[r].name = "adaptive-" + std::to_string(32 << r);
+      check.rungs[r].spheres = 32 << r;
+      check.rungs[r].refitted = r > 0;
+    }
+    OutcomeShift shift;
+    shift.means = 8;
+    shift.p = k.shift_p;
+    shift.largest = 1.9;  // recorded standard errors: a move that matters, if real
+    check.rungs[3].outcome_shift = shift;
+    result.particle_model = check;
+    EnsembleResult finest;
+    finest.outcomes = 16;
+    if (k.delta_bic) {
+      EnsembleHypothesis h;
+      h.effect = Effect::ViscoelasticRestitution;
+      h.values.assign(parameters, 0.5);
+      h.plausible = k.plausible;
+      h.first_delta_bic = *k.delta_bic;
+      finest.hypotheses.push_back(h);
+    }
+    const std::size_t notes = result.notes.size();
+    const bool said = diagnosis::let_through_on_unconverged_finest(
+        result, finest, diagnosis::LetThrough{Effect::ViscoelasticRestitution, 15.8}, 10.0);
+    EXPECT_EQ(said, k.undecidable) << k.shift_p;
+    if (k.undecidable) {
+      EXPECT_EQ(result.verdict, Verdict::Undecidable);
+      EXPECT_EQ(result.basis, Basis::UnconvergedParticleModel);
+      EXPECT_EQ(result.undecidable, (std::vector<std::string>{"viscoelastic_restitution", "air_drag"}));
+      EXPECT_NE(result.experiment.find("more than 256 spheres"), std::string::npos) << result.experiment;
+      EXPECT_NE(result.statement.find("delta-BIC 15.8"), std::string::npos) << result.statement;
+    } else {
+      EXPECT_EQ(result.verdict, Verdict::None);  // left for the caller to name on the diagnosed clump
+      EXPECT_TRUE(result.undecidable.empty());
+      // Kept, the note gives its delta-BIC with the finest clump; a converged ladder is not asked.
+      EXPECT_EQ(result.notes.size(), notes + (k.shift_p < OutcomeShift::kReal ? 1U : 0U));
     }
   }
 }

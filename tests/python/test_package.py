@@ -174,7 +174,12 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
     assert cf.Basis.particle_model != cf.Basis.unexplained_outcomes
     # Beyond the release horizon a mismatch on a clump not converged there is undecidable.
     assert cf.Basis.unconverged_particle_model != cf.Basis.unexplained_outcomes
-    assert {"means", "chi2", "p", "largest", "outcome", "replays", "judged", "converged"} <= set(dir(cf.OutcomeShift))
+    assert {"means", "chi2", "p", "largest", "outcome", "replays", "judged", "converged", "moves"} <= set(
+        dir(cf.OutcomeShift)
+    )
+    assert {"recording", "outcome", "from_value", "to_value", "noise", "recorded_se", "chi2", "matters"} <= set(
+        dir(cf.MeanMove)
+    )
     assert "outcome_shift" in dir(cf.ParticleModelRung)
     assert "seconds" in dir(cf.ParticleModelRung) and "seconds_refit" in dir(cf.ParticleModelRung)
     # The drops' free flights: what they say about the tracked point, and the basis they name on.
