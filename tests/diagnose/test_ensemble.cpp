@@ -744,6 +744,31 @@ TEST(EnsembleDecided, TheReportedAdviceAgreesWithTheFinalVerdict) {
   EXPECT_FALSE(none.ensemble);
 }
 
+namespace {
+
+// A particle-model check of `rungs` adaptive clumps doubling from `spheres` (the first diagnosed,
+// the others refitted), the last one's move from the one before over `means` recorded means with
+// upper tail `p`, its largest `largest` recorded standard errors.
+ParticleModelCheck ladder(int spheres, int rungs, int means, double p, double largest) {
+  ParticleModelCheck check;
+  check.diagnosed = "adaptive-" + std::to_string(spheres);
+  check.spheres = spheres;
+  check.rungs.resize(static_cast<std::size_t>(rungs));
+  for (int r = 0; r < rungs; ++r) {
+    check.rungs[r].name = "adaptive-" + std::to_string(spheres << r);
+    check.rungs[r].spheres = spheres << r;
+    check.rungs[r].refitted = r > 0;
+  }
+  OutcomeShift shift;
+  shift.means = means;
+  shift.p = p;
+  shift.largest = largest;
+  check.rungs.back().outcome_shift = shift;
+  return check;
+}
+
+}  // namespace
+
 // A ladder of clumps whose finest one leaves the recorded outcomes inconsistent: the candidates
 // are judged on it only when its outcomes agree with the previous clump's (converged); before
 // that the mismatch may still be the particle model's, and nothing is named. A candidate that
@@ -759,18 +784,7 @@ TEST(EnsembleConvergedLadder, CandidatesAreJudgedOnTheFinestClumpOnlyOnceItHasCo
     DiagnoseResult result;
     result.verdict = Verdict::None;
     result.ensemble = EnsembleReport{};
-    ParticleModelCheck check;
-    check.rungs.resize(3);
-    for (int r = 0; r < 3; ++r) {
-      check.rungs[r].name = "adaptive-" + std::to_string(64 << r);
-      check.rungs[r].spheres = 64 << r;
-      check.rungs[r].refitted = r > 0;
-    }
-    OutcomeShift shift;
-    shift.means = 10;
-    shift.p = k.shift_p;
-    shift.largest = 2.4;  // recorded standard errors: a move that matters, if real
-    check.rungs[2].outcome_shift = shift;
+    const ParticleModelCheck check = ladder(64, 3, 10, k.shift_p, 2.4);
     EnsembleResult finest;
     finest.outcomes = 20;
     finest.null_chi2 = 73.0;
@@ -817,21 +831,7 @@ TEST(EnsembleUnconvergedLadder, ACandidateLetThroughMustBeNeededOnTheFinestClump
     result.verdict = Verdict::None;
     result.hypotheses.push_back({.name = "viscoelastic_restitution"});
     result.hypotheses.push_back({.name = "air_drag"});
-    ParticleModelCheck check;
-    check.diagnosed = "adaptive-32";
-    check.spheres = 32;
-    check.rungs.resize(4);
-    for (int r = 0; r < 4; ++r) {
-      check.rungs[r].name = "adaptive-" + std::to_string(32 << r);
-      check.rungs[r].spheres = 32 << r;
-      check.rungs[r].refitted = r > 0;
-    }
-    OutcomeShift shift;
-    shift.means = 8;
-    shift.p = k.shift_p;
-    shift.largest = 1.9;  // recorded standard errors: a move that matters, if real
-    check.rungs[3].outcome_shift = shift;
-    result.particle_model = check;
+    result.particle_model = ladder(32, 4, 8, k.shift_p, 1.9);
     EnsembleResult finest;
     finest.outcomes = 16;
     if (k.delta_bic) {
