@@ -739,6 +739,10 @@ struct BenchOptions {
   bool full_set = false, nine_set_ups = false, existing_only = false, generate_only = false;
   // The recordings come from a finer clump of the same scan than the one diagnosed (340 spheres
   // against the diagnosis's 32), as real data never comes from the diagnoser's own model.
+  /// The mass in each clump sphere's wall-contact damping, of the generator and the diagnosis alike
+  /// (ContactSettings::wall_mass; the recordings of --recordings-set keep their own).
+  std::string wall_mass = "whole";
+  ClumpWallMass contact_wall_mass() const { return parse_wall_mass(wall_mass).value_or(ClumpWallMass::Whole); }
   std::string recordings_set, orientation = "none",
                               generator_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default.h5",
                               generator_name = "adaptive-340";
@@ -804,6 +808,10 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "(default 3: 64, 128, 256); with --recordings-set, fills of the mesh with 2, 4, ... times the "
                  "spheres (default 2, as diagnose)")
       ->check(CLI::Range(0, 4));
+  app.add_option("--wall-mass", o.wall_mass,
+                 "The mass in each clump sphere's wall-contact damping, of the generator and the diagnosis: whole "
+                 "(the clump's, as LIGGGHTS and EDEM; default) or shared (among the spheres touching that wall)")
+      ->check(CLI::IsMember({"whole", "shared"}));
   app.add_option("--ensemble-replays-at-gate", o.replays_at_gate,
                  "Replays per recording of a case's second comparison beyond the release horizon when the first "
                  "decided at a gate (as diagnose's; 0: never)")
@@ -846,6 +854,7 @@ std::vector<Case> interleaved(const std::vector<Case>& cases) {
 /// surface's coefficients are calibrated on its own).
 Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialTable& table) {
   ConcealOptions camera;
+  camera.lab.contact.wall_mass = o.contact_wall_mass();
   camera.frame_rate_hz = o.fps;
   camera.noise_m = o.noise;
   camera.pre_roll = !o.no_pre_roll;
@@ -932,6 +941,7 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
                        .clump_name = o.clump_name,
                        .finer_clumps = o.finer_clumps.value_or(3)};
   job.options.ensemble_replays_at_gate = o.replays_at_gate;
+  job.options.lab.contact.wall_mass = o.contact_wall_mass();
   // Recordings already made (their answer is written last) are diagnosed as they are: delete a
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
@@ -1055,6 +1065,7 @@ int main(int argc, char** argv) {
   if (!o.recordings_set.empty()) {
     cli::DiagnoseJob job{.spheres = o.spheres, .finer_clumps = o.finer_clumps.value_or(2)};
     job.options.ensemble_replays_at_gate = o.replays_at_gate;
+    job.options.lab.contact.wall_mass = o.contact_wall_mass();
     return compared(run_recordings_set(o.recordings_set, o.out, job, o.existing_only, *team));
   }
   const MaterialTable table = default_material_table();

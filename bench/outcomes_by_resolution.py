@@ -75,6 +75,8 @@ def main() -> int:
     p.add_argument("--restitution", type=float, default=0.634823744)
     p.add_argument("--static-friction", type=float, default=0.405234611)
     p.add_argument("--rolling-friction", type=float, default=0.0252642907)
+    p.add_argument("--wall-mass", choices=["whole", "shared"], default="whole",
+                   help="the mass in each sphere's wall-contact damping (clumpforge-conceal --wall-mass)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     a = p.parse_args()
     results = {}
@@ -87,7 +89,8 @@ def main() -> int:
             out = pathlib.Path(tmp) / name
             cmd = [a.conceal, library, "--clump", name, "--effect", "none", "--seed", str(a.seed), "--surface",
                    a.surface, "--restitution", str(a.restitution), "--static-friction", str(a.static_friction),
-                   "--rolling-friction", str(a.rolling_friction), "--small", "--trials", str(a.trials), "-o", str(out)]
+                   "--rolling-friction", str(a.rolling_friction), "--small", "--trials", str(a.trials),
+                   "--wall-mass", a.wall_mass, "-o", str(out)]
             done = subprocess.run(cmd, capture_output=True, text=True)
             if done.returncode != 0:
                 print(f"outcomes_by_resolution: {spec}: {done.stderr.strip()}", file=sys.stderr)

@@ -26,7 +26,7 @@ namespace {
 struct DiagnoseArgs {
   std::vector<std::string> recordings, effects;
   std::string mesh, clump, clump_name, out, materials, units = "mm";
-  std::string roll_release = "on-edge";
+  std::string roll_release = "on-edge", wall_mass = "whole";
   double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3, impact_accuracy_pct = 1.0;
   int ensemble_replays = 12, ensemble_replays_at_gate = 48;
   int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
@@ -112,6 +112,12 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.max_evaluations = args.max_evaluations;
   options.orientation_prior_deg = args.orientation_prior_deg;
   options.roll_release = parse_roll_posture(args.roll_release).value_or(RollPosture::OnEdge);  // CLI11 checked it
+  const auto wall_mass = parse_wall_mass(args.wall_mass);
+  if (!wall_mass) {
+    return report_error(kCommand, {ErrorCode::InvalidArgument,
+                                   fmt::format("--wall-mass '{}': expected whole or shared", args.wall_mass)});
+  }
+  options.lab.contact.wall_mass = *wall_mass;
   options.model_accuracy_m = args.model_accuracy_mm * 1e-3;
   options.impact_accuracy = args.impact_accuracy_pct / 100.0;
   options.ensemble_replays = args.ensemble_replays;
@@ -180,6 +186,10 @@ Command add_diagnose_command(CLI::App& app) {
                   "the turn nearest it; a sphere or equant body anyhow) or any (uniform over all orientations)")
       ->check(CLI::IsMember({"on-edge", "any"}))
       ->capture_default_str();
+  sub->add_option("--wall-mass", args->wall_mass,
+                  "The mass in each clump sphere's wall-contact damping: whole (the clump's, as LIGGGHTS and EDEM; "
+                  "default; the calibrated coefficients carry over to those engines) or shared (among the clump's "
+                  "spheres touching that wall: a clump's drops rebound the same at any resolution)");
   sub->add_option("--model-accuracy", args->model_accuracy_mm,
                   "How closely the particle model can follow a real particle [mm]; residuals are weighed against it "
                   "and the camera noise together");

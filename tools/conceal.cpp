@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   double noise = 1e-4, fps = 1000.0;
   int steps_per_contact = generator_lab_options().steps_per_contact;
-  std::string orientation = "none", camera = "silhouette", roll_release = "on-edge";
+  std::string orientation = "none", camera = "silhouette", roll_release = "on-edge", wall_mass = "whole";
   double pixel_mm = 0.1;
   bool no_conceal = false, small = false, no_pre_roll = false;
   std::optional<double> restitution, static_friction, rolling_friction;
@@ -84,6 +84,9 @@ int main(int argc, char** argv) {
   app.add_option("--pixel", pixel_mm, "Silhouette camera: the image's pixel size [mm]");
   app.add_option("--steps-per-contact", steps_per_contact,
                  "Time steps per Hertz contact of the generating DEM (finer than the diagnosis's)");
+  app.add_option("--wall-mass", wall_mass,
+                 "The mass in each clump sphere's wall-contact damping: whole (the clump's, as LIGGGHTS and EDEM; "
+                 "default) or shared (among the clump's spheres touching that wall)");
   app.add_option("--restitution", restitution, "Baseline e (default: the table's)");
   app.add_option("--static-friction", static_friction, "Baseline mu_s");
   app.add_option("--rolling-friction", rolling_friction, "Baseline mu_r");
@@ -105,6 +108,12 @@ int main(int argc, char** argv) {
                              {ErrorCode::InvalidArgument, "--steps-per-contact must be between 20 and 10000"});
   }
   options.lab.steps_per_contact = steps_per_contact;
+  const auto mass = parse_wall_mass(wall_mass);
+  if (!mass) {
+    return cli::report_error(
+        kCommand, {ErrorCode::InvalidArgument, fmt::format("--wall-mass '{}': expected whole or shared", wall_mass)});
+  }
+  options.lab.contact.wall_mass = *mass;
   if (auto ok = parse_orientation_record(orientation, options); !ok) return cli::report_error(kCommand, ok.error());
   options.roll_release = parse_roll_posture(roll_release).value_or(RollPosture::OnEdge);  // CLI11 checked it
   if (auto ok = parse_camera(camera, pixel_mm, options); !ok) return cli::report_error(kCommand, ok.error());

@@ -434,6 +434,7 @@ Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& c
   }
   DiagnoseRun run{.result = std::move(*result), .clump = std::move(clump), .report = {}};
   run.report = diagnosis_report_json(run.result, run.clump.name);
+  run.report["wall_mass"] = std::string(wall_mass_name(job.options.lab.contact.wall_mass));
   return run;
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 
 #include "dem/contact.hpp"
@@ -109,18 +110,45 @@ struct BodyFrame {
   Eigen::Vector3d omega;
 };
 
+// Where a body's sphere overlaps a wall: its centre, and the overlap [m].
+struct WallTouch {
+  Eigen::Vector3d centre;
+  double overlap = 0.0;
+};
+
+// The sphere's overlap with the wall, none when it does not touch it (or touches the wall's
+// plane beyond a finite plate's edge).
+std::optional<WallTouch> wall_touch(const RigidBody& body, const Sphere& sphere, const Wall& wall,
+                                    const Eigen::Matrix3d& rotation) {
+  const Eigen::Vector3d centre = body.position + rotation * sphere.centre;
+  const double height = (centre - wall.point).dot(wall.normal);
+  const double overlap = sphere.radius - height;
+  if (overlap <= 0.0) return std::nullopt;
+  const Eigen::Vector3d foot = centre - height * wall.normal;
+  if (wall.half_u > 0.0 && std::abs((foot - wall.point).dot(wall.u_axis)) > wall.half_u) return std::nullopt;
+  if (wall.half_v > 0.0 && std::abs((foot - wall.point).dot(wall.v_axis())) > wall.half_v) return std::nullopt;
+  return WallTouch{centre, overlap};
+}
+
+// The mass each of the body's spheres touching wall `w` carries in its contact's damping
+// (ContactSettings::wall_mass): the body's, or its share among the spheres touching.
+double wall_contact_mass(const World& world, const RigidBody& body, const std::vector<int>& listed, const Wall& wall,
+                         const Eigen::Matrix3d& rotation) {
+  if (world.contact.wall_mass == ClumpWallMass::Whole) return body.mass;
+  int touching = 0;
+  for (int k : listed) touching += wall_touch(body, body.spheres[static_cast<std::size_t>(k)], wall, rotation) ? 1 : 0;
+  return body.mass / std::max(1, touching);
+}
+
 void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, double dt, const BodyFrame& frame,
-                  const PairConstants& pair) {
+                  const PairConstants& pair, double effective_mass) {
   RigidBody& body = world.bodies[b];
   const Wall& wall = world.walls[w];
   const Sphere& sphere = body.spheres[k];
-  const Eigen::Vector3d centre = body.position + frame.rotation * sphere.centre;
-  const double height = (centre - wall.point).dot(wall.normal);
-  const double overlap = sphere.radius - height;
-  if (overlap <= 0.0) return;
-  const Eigen::Vector3d foot = centre - height * wall.normal;
-  if (wall.half_u > 0.0 && std::abs((foot - wall.point).dot(wall.u_axis)) > wall.half_u) return;
-  if (wall.half_v > 0.0 && std::abs((foot - wall.point).dot(wall.v_axis())) > wall.half_v) return;
+  const auto touch = wall_touch(body, sphere, wall, frame.rotation);
+  if (!touch) return;
+  const Eigen::Vector3d& centre = touch->centre;
+  const double overlap = touch->overlap;
   const Eigen::Vector3d point = centre - (sphere.radius - 0.5 * overlap) * wall.normal;
   const Eigen::Vector3d arm = point - body.position;
   const Eigen::Vector3d& omega = frame.omega;
@@ -130,7 +158,7 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
   in.relative_velocity = body.velocity + omega.cross(arm) - wall.velocity_at(point);
   in.relative_spin = omega - wall.spin;
   in.effective_radius = sphere.radius;  // a wall has no curvature
-  in.effective_mass = body.mass;        // every sphere of a clump carries the clump's mass (LIGGGHTS)
+  in.effective_mass = effective_mass;   // the clump's mass (LIGGGHTS), or its share (ClumpWallMass)
   in.rolling_arm = world.contact.rolling_arm == RollingArm::SphereRadius ? sphere.radius : arm.norm();
   in.rolling_inertia = 1.4 * body.mass * sphere.radius * sphere.radius;
   in.youngs = pair.youngs;
@@ -286,7 +314,8 @@ void compute_forces(World& world, double dt) {
       if (lists[w].empty()) continue;
       // Looked up once per wall, not per sphere listed (3 % of a replay's time under perf).
       const PairConstants pair = pair_constants(world, body.material, world.walls[w].material);
-      for (int k : lists[w]) wall_contact(world, b, static_cast<std::size_t>(k), w, dt, frame, pair);
+      const double mass = wall_contact_mass(world, body, lists[w], world.walls[w], rotation);
+      for (int k : lists[w]) wall_contact(world, b, static_cast<std::size_t>(k), w, dt, frame, pair, mass);
     }
   }
   for (std::size_t i = 0; i < n; ++i) {

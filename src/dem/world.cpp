@@ -17,6 +17,16 @@ void update_bounding_radius(RigidBody& body) {
   for (const auto& s : body.spheres) body.bounding_radius = std::max(body.bounding_radius, s.centre.norm() + s.radius);
 }
 
+std::string_view wall_mass_name(ClumpWallMass mass) {
+  return mass == ClumpWallMass::Shared ? "shared" : "whole";
+}
+
+std::optional<ClumpWallMass> parse_wall_mass(std::string_view text) {
+  if (text == "whole") return ClumpWallMass::Whole;
+  if (text == "shared") return ClumpWallMass::Shared;
+  return std::nullopt;
+}
+
 RigidBody make_body(const Clump& clump, int material) {
   RigidBody body;
   body.spheres = clump.spheres;

@@ -4,6 +4,8 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -82,6 +84,22 @@ enum class RollingArm {
   ContactToCentre,  ///< EDEM: distance from the contact point to the clump's centre of mass
 };
 
+/// The mass a clump's sphere carries in the damping of its contact with a wall.
+enum class ClumpWallMass {
+  /// The whole clump's (LIGGGHTS and EDEM): N spheres touching together damp like one contact
+  /// with sqrt(N) times the damping ratio, so a finer clump, with more spheres touching, rebounds
+  /// less (docs/diagnose.md, "Why the ladder does not converge").
+  Whole,
+  /// The clump's mass shared among its spheres touching that wall in the step: N equal contacts
+  /// damp like one with the restitution asked (a scaling by the number of contacts, as Kodam et
+  /// al., Chem. Eng. Sci. 64 (2009) 3466, propose for glued spheres).
+  Shared,
+};
+
+/// "whole" or "shared" (reports and command lines).
+std::string_view wall_mass_name(ClumpWallMass mass);
+std::optional<ClumpWallMass> parse_wall_mass(std::string_view text);
+
 struct ContactSettings {
   bool limit_force = false;        ///< LIGGGHTS `limitForce`: clip attractive damped Fn (default off, as LIGGGHTS)
   bool tangential_damping = true;  ///< LIGGGHTS default
@@ -93,6 +111,7 @@ struct ContactSettings {
   /// EDEM's standard model (the convention of the study's mu_r values); LIGGGHTS uses the sphere radius.
   RollingArm rolling_arm = RollingArm::ContactToCentre;
   double rolling_damping = 0.3;  ///< eta_r of EPSD (Ai et al. suggest 0.3)
+  ClumpWallMass wall_mass = ClumpWallMass::Whole;
 };
 
 /// Whose conventions the contact law follows where engines differ: EDEM's (clumpforge's

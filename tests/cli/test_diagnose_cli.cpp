@@ -100,11 +100,22 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   EXPECT_NE(run.err.find("--roll-release"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("flat"), std::string::npos) << run.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "posture"));
-  // A track too short to decide anything: that verdict, not a guess.
-  run = test::run_clumpforge(
-      fmt::format("diagnose --recordings '{}' --library '{}' --json", (dir / "rec").string(), clump()));
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  EXPECT_EQ(nlohmann::json::parse(run.out)["verdict"], "undecidable");
+  // A wall-contact mass the DEM does not know: refused by name, nothing written.
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --wall-mass half --output '{}'",
+                                         (dir / "rec").string(), clump(), (dir / "mass").string()));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("--wall-mass 'half': expected whole or shared"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "mass"));
+  // A track too short to decide anything: that verdict, not a guess; the report says which
+  // wall-contact mass its coefficients are under.
+  for (const std::string mass : {"whole", "shared"}) {
+    run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --wall-mass {} --json",
+                                           (dir / "rec").string(), clump(), mass));
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto j = nlohmann::json::parse(run.out);
+    EXPECT_EQ(j["verdict"], "undecidable");
+    EXPECT_EQ(j["wall_mass"], mass);
+  }
 }
 
 // Hostile recordings (issue 12, item 5) through the command: a clean message naming the
@@ -171,6 +182,7 @@ TEST(ConcealCli, BadOptionsAreRefusedAndNothingIsWritten) {
       {"--camera fisheye", "camera 'fisheye': expected silhouette or body-point"},
       {"--pixel 0", "pixel size 0 mm is not in (0, 5]"},
       {"--steps-per-contact 5", "--steps-per-contact must be between 20 and 10000"},
+      {"--wall-mass half", "--wall-mass 'half': expected whole or shared"},
       {"--surface marble", "tuber - marble"},
   };
   for (const auto& [options, message] : cases) {

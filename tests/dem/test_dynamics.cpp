@@ -55,6 +55,34 @@ TEST(Dynamics, ReboundApexIsRestitutionSquaredTimesDropHeight) {
   }
 }
 
+TEST(Dynamics, ARaftOfFourSpheresLandingFlatDampsAsItsWallMassSays) {
+  // Four equal spheres of one rigid body, their centres in a square, land flat on a plane at
+  // 1 m/s without gravity. Each sphere's dashpot sized with the whole body's mass: the four
+  // damp like one contact with twice the damping ratio, and e = 0.728 asked gives 0.525 (Hertz,
+  // N = 4: ../shared/reference/dem-model-facts.md, section 1.4). Sized with a quarter of it
+  // each (ClumpWallMass::Shared): the restitution asked. Within 0.01 (the contact resolved by
+  // 1000 steps; a single sphere's rebound at these settings is within 0.2 % of e).
+  const double r = 5e-3, a = 6e-3, e = 0.728, speed = 1.0;
+  for (const ClumpWallMass wall_mass : {ClumpWallMass::Whole, ClumpWallMass::Shared}) {
+    World world = test::sphere_over_plane(kSoft, kSteel, {e, 0.0, 0.0}, r);
+    world.contact.wall_mass = wall_mass;
+    RigidBody& raft = world.bodies[0];
+    const double one = raft.mass;
+    raft.spheres = {{{a, a, 0}, r}, {{-a, a, 0}, r}, {{a, -a, 0}, r}, {{-a, -a, 0}, r}};
+    raft.mass = 4.0 * one;
+    raft.inertia = Eigen::Vector3d(4.0 * one * (0.4 * r * r + a * a), 4.0 * one * (0.4 * r * r + a * a),
+                                   4.0 * one * (0.4 * r * r + 2.0 * a * a));
+    raft.position = {0, 0, r + 1e-7};
+    raft.velocity = {0, 0, -speed};
+    const double dt = test::hertz_theory(one, r, effective_youngs_modulus(kSoft, kSteel), speed).duration / 1000.0;
+    for (int i = 0; i < 100000 && raft.position.z() < r + 1e-6; ++i) step(world, dt);
+    const double restitution = raft.velocity.z() / speed;
+    EXPECT_NEAR(restitution, wall_mass == ClumpWallMass::Whole ? 0.525 : e, 0.01)
+        << (wall_mass == ClumpWallMass::Whole ? "whole" : "shared");
+    EXPECT_NEAR(raft.velocity.x(), 0.0, 1e-9);  // flat: no sphere first
+  }
+}
+
 TEST(Dynamics, SphereRollsDownAnInclineAtFiveSeventhsGSinTheta) {
   // No slip needs mu_s >= 2/7 tan(theta); a = 5/7 g sin(theta) within 1 %.
   const double r = 5e-3, degrees = 15.0;
