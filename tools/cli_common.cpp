@@ -185,6 +185,11 @@ std::vector<std::string> split_list(const std::string& text) {
   return items;
 }
 
+Result<ClumpWallMass> parse_wall_mass_option(const std::string& text) {
+  if (auto mass = parse_wall_mass(text)) return *mass;
+  return fail(ErrorCode::InvalidArgument, fmt::format("--wall-mass '{}': expected whole or shared", text));
+}
+
 Result<std::vector<double>> parse_diameter_list(const std::string& text) {
   const std::vector<std::string> items = split_list(text);
   std::string unit;

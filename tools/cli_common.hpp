@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "dem/world.hpp"
 #include "fill/body.hpp"
 #include "mesh/mass_properties.hpp"
 #include "mesh/topology.hpp"
@@ -70,6 +71,9 @@ inline constexpr const char* kSharedOptions = "Shared options";
 std::vector<std::string> split_list(const std::string& text);
 /// "1,2,4mm" or "1mm,2mm" -> metres; the unit of the last item applies to bare numbers.
 Result<std::vector<double>> parse_diameter_list(const std::string& text);
+
+/// `--wall-mass` (whole or shared) as the DEM's ClumpWallMass; anything else refused by name.
+Result<ClumpWallMass> parse_wall_mass_option(const std::string& text);
 
 /// The study's Corydalis tuber density, used when a command is given none [kg/m^3].
 inline constexpr double kStudyDensity = 1085.0;

@@ -112,11 +112,8 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.max_evaluations = args.max_evaluations;
   options.orientation_prior_deg = args.orientation_prior_deg;
   options.roll_release = parse_roll_posture(args.roll_release).value_or(RollPosture::OnEdge);  // CLI11 checked it
-  const auto wall_mass = parse_wall_mass(args.wall_mass);
-  if (!wall_mass) {
-    return report_error(kCommand, {ErrorCode::InvalidArgument,
-                                   fmt::format("--wall-mass '{}': expected whole or shared", args.wall_mass)});
-  }
+  const auto wall_mass = parse_wall_mass_option(args.wall_mass);
+  if (!wall_mass) return report_error(kCommand, wall_mass.error());
   options.lab.contact.wall_mass = *wall_mass;
   options.model_accuracy_m = args.model_accuracy_mm * 1e-3;
   options.impact_accuracy = args.impact_accuracy_pct / 100.0;

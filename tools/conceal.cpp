@@ -108,11 +108,8 @@ int main(int argc, char** argv) {
                              {ErrorCode::InvalidArgument, "--steps-per-contact must be between 20 and 10000"});
   }
   options.lab.steps_per_contact = steps_per_contact;
-  const auto mass = parse_wall_mass(wall_mass);
-  if (!mass) {
-    return cli::report_error(
-        kCommand, {ErrorCode::InvalidArgument, fmt::format("--wall-mass '{}': expected whole or shared", wall_mass)});
-  }
+  const auto mass = cli::parse_wall_mass_option(wall_mass);
+  if (!mass) return cli::report_error(kCommand, mass.error());
   options.lab.contact.wall_mass = *mass;
   if (auto ok = parse_orientation_record(orientation, options); !ok) return cli::report_error(kCommand, ok.error());
   options.roll_release = parse_roll_posture(roll_release).value_or(RollPosture::OnEdge);  // CLI11 checked it

@@ -448,7 +448,7 @@ void undecidable_unconverged(DiagnoseResult& result, int spheres) {
 /// diagnosed clump's comparison, a note giving its delta-BIC with the finest); else its evidence may
 /// be the coarse clump's share, and the verdict is undecidable. Returns whether it said so. The
 /// generated noisy:15 control-07 at 65de5fc was named viscoelastic_restitution (delta-BIC 15.8 with
-/// 32 spheres) on the 1 m drop's drift, which each step of the ladder moved by 1.2-1.3 recorded
+/// 32 spheres) on the 1 m drop's drift, which each step of the ladder moved by 0.9-1.2 recorded
 /// standard errors the way the candidate did.
 bool let_through_on_unconverged_finest(DiagnoseResult& result, const EnsembleResult& finest,
                                        const LetThrough& let_through, double min_delta_bic) {

@@ -86,13 +86,6 @@ OutcomeComparison compare_spread(const std::vector<double>& recorded, const std:
 /// (compare_outcome; a spread's comparison keeps the values' sds, not the deviations').
 double comparison_se(const OutcomeComparison& c);
 
-/// How the replayed outcomes move from one clump to a finer one of the same body: both
-/// replayed at the same coefficients (the first clump's calibrated null) from the same release
-/// orientations, compared recorded mean by recorded mean. The move is real when it stands out of the two replay
-/// samples' noise and the floor (chi^2 of shift / sqrt(s_a^2/K_a + s_b^2/K_b + floor^2) over the means, upper tail
-/// below kReal; independent samples, though the orientations are shared) and it matters when it is a recorded standard
-/// error or more (comparison_se): a clump whose outcomes still move by that much with resolution cannot say whether a
-/// mismatch beyond the release horizon is missing physics or its own coarseness.
 /// One recorded mean's move from a clump to a finer one (OutcomeShift).
 struct MeanMove {
   std::size_t recording = 0;
@@ -105,6 +98,13 @@ struct MeanMove {
   double matters() const { return se > 0.0 ? std::abs(to - from) / se : 0.0; }
 };
 
+/// How the replayed outcomes move from one clump to a finer one of the same body: both
+/// replayed at the same coefficients (the first clump's calibrated null) from the same release
+/// orientations, compared recorded mean by recorded mean. The move is real when it stands out of the two replay
+/// samples' noise and the floor (chi^2 of shift / sqrt(s_a^2/K_a + s_b^2/K_b + floor^2) over the means, upper tail
+/// below kReal; independent samples, though the orientations are shared) and it matters when it is a recorded standard
+/// error or more (comparison_se): a clump whose outcomes still move by that much with resolution cannot say whether a
+/// mismatch beyond the release horizon is missing physics or its own coarseness.
 struct OutcomeShift {
   static constexpr double kReal = 0.01;      ///< upper-tail probability below which the move is real
   static constexpr double kMatters = 1.0;    ///< [recorded standard errors] a move that matters
