@@ -482,6 +482,73 @@ bool let_through_on_unconverged_finest(DiagnoseResult& result, const EnsembleRes
   return true;
 }
 
+namespace {
+/// The outcomes a null leaves three standard errors or more from the recorded ones, each added to
+/// the verdict's unexplained phases; returns how each reads in a statement.
+std::vector<std::string> unexplained_outcomes(DiagnoseResult& result, const std::vector<OutcomeComparison>& null,
+                                              const std::vector<Recording>& recordings,
+                                              const std::vector<std::string>& names) {
+  std::vector<std::string> far;
+  for (const auto& o : null) {
+    if (std::abs(o.z) < 3.0) continue;
+    const bool drop = o.outcome == Outcome::ReboundHeight || o.outcome == Outcome::Drift;
+    const Shown as = shown(o.outcome);
+    const std::string where =
+        fmt::format("{} {} of {} (recorded {:.3g}, replayed {:.3g} {}, z = {:.1f})", statistic_name(o.statistic),
+                    outcome_name(o.outcome), recording_label(recordings[o.recording], names[o.recording]),
+                    o.recorded_value * as.scale, o.ensemble_value * as.scale, as.unit, o.z);
+    result.unexplained.push_back({names[o.recording], drop ? Phase::Rebound : Phase::Rest, o.z * o.z, where});
+    far.push_back(where);
+  }
+  return far;
+}
+}  // namespace
+
+/// A candidate beat the diagnosed clump's null (`let_through`), no finer clump explained the
+/// outcomes, the finest one's replayed outcomes agree with the previous clump's at the same
+/// coefficients (OutcomeShift::converged), and judged on that clump's comparison no candidate passes
+/// (judge_on_converged_clump): on the converged particle model the candidate is not needed, so
+/// what it explained with the diagnosed clump was that clump's share, and the converged clump's
+/// null still misses the recorded outcomes. The verdict is unexplained, on the finest clump's
+/// comparison. Returns whether it said so (false when the ladder has not converged:
+/// let_through_on_unconverged_finest). Before, the candidate kept its name from the diagnosed
+/// clump's comparison; no stored report of the generated or lab-like sets reached this (edc7eae).
+bool let_through_unneeded_on_converged_finest(DiagnoseResult& result, const EnsembleResult& finest,
+                                              const LetThrough& let_through, double min_delta_bic,
+                                              const std::vector<Recording>& recordings,
+                                              const std::vector<std::string>& names) {
+  const ParticleModelCheck& check = *result.particle_model;
+  if (check.rungs.size() < 2) return false;
+  const ParticleModelRung& last = check.rungs.back();
+  if (!last.outcome_shift || !last.outcome_shift->converged()) return false;
+  const ParticleModelRung& before = check.rungs[check.rungs.size() - 2];
+  const auto h = std::find_if(finest.hypotheses.begin(), finest.hypotheses.end(),
+                              [&](const EnsembleHypothesis& x) { return x.effect == let_through.effect; });
+  const std::string name = effect_name(let_through.effect);
+  const std::string there = h == finest.hypotheses.end()
+                                ? std::string("was not tried there (no level of it was proposed)")
+                                : fmt::format("has delta-BIC {:.1f} against that clump's null{}", h->delta_bic(),
+                                              h->plausible ? "" : " at an implausible level");
+  if (result.ensemble) report_ensemble(*result.ensemble, finest, check.rungs.size() - 1);
+  const std::vector<std::string> far = unexplained_outcomes(result, finest.null_comparisons, recordings, names);
+  supersede(result, Verdict::Unexplained, Basis::UnexplainedOutcomes);
+  for (const auto& tried : finest.hypotheses) mark_undecidable(result, effect_name(tried.effect));
+  mark_undecidable(result, name);
+  result.statement = fmt::format(
+      "Mismatch beyond the release horizon not explained by any known effect: with {} ({} spheres) {} beat the "
+      "null calibrated on the recorded outcomes (delta-BIC {:.1f}), but with {} ({} spheres), whose replayed "
+      "outcomes agree with those of {} spheres at the same coefficients (the particle model has converged), it {} "
+      "(the margin is {:.0f}) and no candidate passes, while that clump's own null still misses the recorded "
+      "outcomes (chi^2 {:.1f} over {}){}. What {} explained with the coarse clump was that clump's share.",
+      check.diagnosed, check.spheres, name, let_through.delta_bic, last.name, last.spheres, before.spheres, there,
+      min_delta_bic, finest.null_chi2, finest.outcomes,
+      far.empty() ? std::string() : fmt::format(", most in: {}", fmt::join(far, "; ")), name);
+  result.experiment =
+      "compare the recorded and replayed outcomes in the report's ensemble section (the finest clump's comparison); "
+      "more trials per set-up, or recorded release orientations, would narrow the cause";
+  return true;
+}
+
 /// The calibrated null leaves the recorded outcomes inconsistent with the replays
 /// (outcomes_consistent), or a candidate (`let_through`) beat a consistent one: before the mismatch is blamed on
 /// missing physics, each finer clump left is tried (its null calibrated afresh on the outcomes, from the same
@@ -614,7 +681,10 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
   }
   if (!finest) return false;
   if (judge_on_converged_clump(result, check, *finest, eo.min_delta_bic)) return true;
-  return let_through && let_through_on_unconverged_finest(result, *finest, *let_through, eo.min_delta_bic);
+  if (!let_through) return false;
+  return let_through_on_unconverged_finest(result, *finest, *let_through, eo.min_delta_bic) ||
+         let_through_unneeded_on_converged_finest(result, *finest, *let_through, eo.min_delta_bic, *c.ev.recordings,
+                                                  c.names);
 }
 
 /// No finer clump explained a mismatch of the outcomes, but the finest one's replayed outcomes
@@ -664,19 +734,7 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
   if (!explained) return std::unexpected(explained.error());
   if (*explained) return {};
   if (particle_model_unconverged(c, result)) return {};
-  // Unexplained: the outcomes beyond the noise, three standard errors or more.
-  std::vector<std::string> far;
-  for (const auto& o : e.null_comparisons) {
-    if (std::abs(o.z) < 3.0) continue;
-    const bool drop = o.outcome == Outcome::ReboundHeight || o.outcome == Outcome::Drift;
-    const Shown as = shown(o.outcome);
-    const std::string where =
-        fmt::format("{} {} of {} (recorded {:.3g}, replayed {:.3g} {}, z = {:.1f})", statistic_name(o.statistic),
-                    outcome_name(o.outcome), recording_label((*c.ev.recordings)[o.recording], c.names[o.recording]),
-                    o.recorded_value * as.scale, o.ensemble_value * as.scale, as.unit, o.z);
-    result.unexplained.push_back({c.names[o.recording], drop ? Phase::Rebound : Phase::Rest, o.z * o.z, where});
-    far.push_back(where);
-  }
+  const std::vector<std::string> far = unexplained_outcomes(result, e.null_comparisons, *c.ev.recordings, c.names);
   supersede(result, Verdict::Unexplained, Basis::UnexplainedOutcomes);
   // No candidate explains the outcomes, so one tried on them and not passing is not shown
   // absent: it may be part of a mismatch no single effect of the library describes (the

@@ -345,6 +345,14 @@ void undecidable_unconverged(DiagnoseResult& result, int spheres);
 /// level; else the verdict is undecidable (returns true).
 bool let_through_on_unconverged_finest(DiagnoseResult& result, const EnsembleResult& finest,
                                        const LetThrough& let_through, double min_delta_bic);
+/// The same candidate when the ladder converged on the finest clump and no candidate passes there
+/// (judge_on_converged_clump): it is not needed on the converged particle model, whose null still
+/// misses the recorded outcomes, and the verdict is unexplained (returns true); false when the
+/// ladder has not converged. `recordings` and `names` label the outcomes in the statement.
+bool let_through_unneeded_on_converged_finest(DiagnoseResult& result, const EnsembleResult& finest,
+                                              const LetThrough& let_through, double min_delta_bic,
+                                              const std::vector<Recording>& recordings,
+                                              const std::vector<std::string>& names);
 /// Once a finer clump explains the outcomes and nothing passes there: the absences the diagnosed
 /// clump's outcomes decided that the explaining clump's comparison (`fine`) does not decide go
 /// back to undecidable (advice ParticleModelDecides); returns their names.

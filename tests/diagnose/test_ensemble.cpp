@@ -861,6 +861,45 @@ TEST(EnsembleUnconvergedLadder, ACandidateLetThroughMustBeNeededOnTheFinestClump
   }
 }
 
+// The same candidate on a converged ladder where no candidate passes on the finest clump
+// (judge_on_converged_clump): not needed on the converged particle model, whose null still
+// misses, so the verdict is unexplained on the finest clump's comparison, never the diagnosed
+// clump's name; an unconverged ladder is not this rule's (let_through_on_unconverged_finest).
+TEST(EnsembleConvergedLadder, ACandidateLetThroughButUnneededOnTheConvergedFinestClumpIsNotNamed) {
+  const auto library = effect_library();
+  const std::size_t parameters = effect_spec(library, Effect::ViscoelasticRestitution).parameters.size();
+  for (const double shift_p : {0.4, 1e-4}) {
+    DiagnoseResult result;
+    result.verdict = Verdict::None;
+    result.ensemble = EnsembleReport{};
+    result.particle_model = ladder(32, 4, 8, shift_p, 1.9);
+    EnsembleResult finest;
+    finest.outcomes = 16;
+    finest.null_chi2 = 61.0;
+    EnsembleHypothesis h;
+    h.effect = Effect::ViscoelasticRestitution;
+    h.values.assign(parameters, 0.5);
+    h.plausible = true;
+    h.first_delta_bic = -1.9;
+    finest.hypotheses.push_back(h);
+    const bool said = diagnosis::let_through_unneeded_on_converged_finest(
+        result, finest, diagnosis::LetThrough{Effect::ViscoelasticRestitution, 15.8}, 10.0, {}, {});
+    const bool converged = shift_p >= OutcomeShift::kReal;
+    EXPECT_EQ(said, converged) << shift_p;
+    if (!converged) {
+      EXPECT_EQ(result.verdict, Verdict::None);
+      continue;
+    }
+    EXPECT_EQ(result.verdict, Verdict::Unexplained);
+    EXPECT_EQ(result.basis, Basis::UnexplainedOutcomes);
+    EXPECT_EQ(result.undecidable, std::vector<std::string>{"viscoelastic_restitution"});
+    EXPECT_EQ(result.ensemble->rung, 3U);  // the finest clump's comparison is the one reported
+    EXPECT_DOUBLE_EQ(result.ensemble->null_chi2, 61.0);
+    EXPECT_NE(result.statement.find("delta-BIC 15.8"), std::string::npos) << result.statement;
+    EXPECT_NE(result.statement.find("delta-BIC -1.9"), std::string::npos) << result.statement;
+  }
+}
+
 // Two candidates that explain the outcomes about equally well are ambiguous even when one draw
 // of release orientations favoured one: the rival's better draw counts. The generated 8-trial
 // realistic elastic-plastic case: delta-BIC 14.6 and 15.3 on the first draw, 10.2 and 2.4 on
