@@ -441,6 +441,19 @@ void undecidable_unconverged(DiagnoseResult& result, int spheres) {
   result.experiment = finer_clumps_experiment(spheres);
 }
 
+namespace {
+/// The candidate let through as the finest clump's comparison tried it (nullptr: not tried), and
+/// how that reads in a statement.
+std::pair<const EnsembleHypothesis*, std::string> let_through_there(const EnsembleResult& finest,
+                                                                    const LetThrough& let_through) {
+  const auto h = std::find_if(finest.hypotheses.begin(), finest.hypotheses.end(),
+                              [&](const EnsembleHypothesis& x) { return x.effect == let_through.effect; });
+  if (h == finest.hypotheses.end()) return {nullptr, "was not tried there (no level of it was proposed)"};
+  return {&*h, fmt::format("has delta-BIC {:.1f} against that clump's null{}", h->delta_bic(),
+                           h->plausible ? "" : " at an implausible level")};
+}
+}  // namespace
+
 /// A candidate beat the diagnosed clump's null (`let_through`), no finer clump explained the
 /// outcomes, and the finest clump's outcomes still moved from the previous clump's at the same
 /// coefficients (particle_model_unconverged): the candidate was tried with the finest clump too
@@ -455,14 +468,9 @@ bool let_through_on_unconverged_finest(DiagnoseResult& result, const EnsembleRes
   const ParticleModelCheck& check = *result.particle_model;
   const ParticleModelRung& last = check.rungs.back();
   if (!last.outcome_shift || !last.outcome_shift->judged || last.outcome_shift->converged()) return false;
-  const auto h = std::find_if(finest.hypotheses.begin(), finest.hypotheses.end(),
-                              [&](const EnsembleHypothesis& x) { return x.effect == let_through.effect; });
+  const auto [h, there] = let_through_there(finest, let_through);
   const std::string name = effect_name(let_through.effect);
-  const std::string there = h == finest.hypotheses.end()
-                                ? std::string("was not tried there (no level of it was proposed)")
-                                : fmt::format("has delta-BIC {:.1f} against that clump's null{}", h->delta_bic(),
-                                              h->plausible ? "" : " at an implausible level");
-  if (h != finest.hypotheses.end() && h->plausible && h->delta_bic() >= min_delta_bic) {
+  if (h && h->plausible && h->delta_bic() >= min_delta_bic) {
     result.notes.push_back(fmt::format("{} with {} ({} spheres), its coefficients refitted, {} (the margin is {:.0f})",
                                        name, last.name, last.spheres, there, min_delta_bic));
     return false;
@@ -522,13 +530,8 @@ bool let_through_unneeded_on_converged_finest(DiagnoseResult& result, const Ense
   const ParticleModelRung& last = check.rungs.back();
   if (!last.outcome_shift || !last.outcome_shift->converged()) return false;
   const ParticleModelRung& before = check.rungs[check.rungs.size() - 2];
-  const auto h = std::find_if(finest.hypotheses.begin(), finest.hypotheses.end(),
-                              [&](const EnsembleHypothesis& x) { return x.effect == let_through.effect; });
+  const std::string there = let_through_there(finest, let_through).second;
   const std::string name = effect_name(let_through.effect);
-  const std::string there = h == finest.hypotheses.end()
-                                ? std::string("was not tried there (no level of it was proposed)")
-                                : fmt::format("has delta-BIC {:.1f} against that clump's null{}", h->delta_bic(),
-                                              h->plausible ? "" : " at an implausible level");
   if (result.ensemble) report_ensemble(*result.ensemble, finest, check.rungs.size() - 1);
   const std::vector<std::string> far = unexplained_outcomes(result, finest.null_comparisons, recordings, names);
   supersede(result, Verdict::Unexplained, Basis::UnexplainedOutcomes);

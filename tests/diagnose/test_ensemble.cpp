@@ -767,6 +767,18 @@ ParticleModelCheck ladder(int spheres, int rungs, int means, double p, double la
   return check;
 }
 
+/// The viscoelastic law tried on a ladder's clump: every parameter at `value`, `delta_bic` on its
+/// first draw.
+EnsembleHypothesis viscoelastic(double value, double delta_bic, bool plausible = true) {
+  EnsembleHypothesis h;
+  h.effect = Effect::ViscoelasticRestitution;
+  const auto library = effect_library();
+  h.values.assign(effect_spec(library, h.effect).parameters.size(), value);
+  h.plausible = plausible;
+  h.first_delta_bic = delta_bic;
+  return h;
+}
+
 }  // namespace
 
 // A ladder of clumps whose finest one leaves the recorded outcomes inconsistent: the candidates
@@ -774,8 +786,6 @@ ParticleModelCheck ladder(int spheres, int rungs, int means, double p, double la
 // that the mismatch may still be the particle model's, and nothing is named. A candidate that
 // does not reach the margin names nothing either.
 TEST(EnsembleConvergedLadder, CandidatesAreJudgedOnTheFinestClumpOnlyOnceItHasConverged) {
-  const auto library = effect_library();
-  const std::size_t parameters = effect_spec(library, Effect::ViscoelasticRestitution).parameters.size();
   struct Case {
     double shift_p, delta_bic;
     bool named;
@@ -783,16 +793,12 @@ TEST(EnsembleConvergedLadder, CandidatesAreJudgedOnTheFinestClumpOnlyOnceItHasCo
   for (const Case& k : {Case{1e-4, 25.0, false}, Case{0.4, 25.0, true}, Case{0.4, 4.0, false}}) {
     DiagnoseResult result;
     result.verdict = Verdict::None;
-    result.ensemble = EnsembleReport{};
+    result.ensemble.emplace();
     const ParticleModelCheck check = ladder(64, 3, 10, k.shift_p, 2.4);
     EnsembleResult finest;
     finest.outcomes = 20;
     finest.null_chi2 = 73.0;
-    EnsembleHypothesis h;
-    h.effect = Effect::ViscoelasticRestitution;
-    h.values.assign(parameters, 0.1);
-    h.plausible = true;
-    h.first_delta_bic = k.delta_bic;
+    EnsembleHypothesis h = viscoelastic(0.1, k.delta_bic);
     for (int o = 0; o < 20; ++o)
       h.comparisons.push_back({.statistic = o < 10 ? Statistic::Mean : Statistic::Spread, .z = 0.5});
     h.chi2 = 5.0;
@@ -818,8 +824,6 @@ TEST(EnsembleConvergedLadder, CandidatesAreJudgedOnTheFinestClumpOnlyOnceItHasCo
 // ladder is not this rule's (judge_on_converged_clump). The generated noisy:15 control-07 at
 // 65de5fc: viscoelastic restitution at delta-BIC 15.8 with 32 spheres, -1.9 with 256.
 TEST(EnsembleUnconvergedLadder, ACandidateLetThroughMustBeNeededOnTheFinestClumpToo) {
-  const auto library = effect_library();
-  const std::size_t parameters = effect_spec(library, Effect::ViscoelasticRestitution).parameters.size();
   struct Case {
     double shift_p;
     std::optional<double> delta_bic;  // none: the candidate was not tried on the finest clump
@@ -835,12 +839,7 @@ TEST(EnsembleUnconvergedLadder, ACandidateLetThroughMustBeNeededOnTheFinestClump
     EnsembleResult finest;
     finest.outcomes = 16;
     if (k.delta_bic) {
-      EnsembleHypothesis h;
-      h.effect = Effect::ViscoelasticRestitution;
-      h.values.assign(parameters, 0.5);
-      h.plausible = k.plausible;
-      h.first_delta_bic = *k.delta_bic;
-      finest.hypotheses.push_back(h);
+      finest.hypotheses.push_back(viscoelastic(0.5, *k.delta_bic, k.plausible));
     }
     const std::size_t notes = result.notes.size();
     const bool said = diagnosis::let_through_on_unconverged_finest(
@@ -866,22 +865,15 @@ TEST(EnsembleUnconvergedLadder, ACandidateLetThroughMustBeNeededOnTheFinestClump
 // misses, so the verdict is unexplained on the finest clump's comparison, never the diagnosed
 // clump's name; an unconverged ladder is not this rule's (let_through_on_unconverged_finest).
 TEST(EnsembleConvergedLadder, ACandidateLetThroughButUnneededOnTheConvergedFinestClumpIsNotNamed) {
-  const auto library = effect_library();
-  const std::size_t parameters = effect_spec(library, Effect::ViscoelasticRestitution).parameters.size();
   for (const double shift_p : {0.4, 1e-4}) {
     DiagnoseResult result;
     result.verdict = Verdict::None;
-    result.ensemble = EnsembleReport{};
+    result.ensemble.emplace();
     result.particle_model = ladder(32, 4, 8, shift_p, 1.9);
     EnsembleResult finest;
     finest.outcomes = 16;
     finest.null_chi2 = 61.0;
-    EnsembleHypothesis h;
-    h.effect = Effect::ViscoelasticRestitution;
-    h.values.assign(parameters, 0.5);
-    h.plausible = true;
-    h.first_delta_bic = -1.9;
-    finest.hypotheses.push_back(h);
+    finest.hypotheses.push_back(viscoelastic(0.5, -1.9));
     const bool said = diagnosis::let_through_unneeded_on_converged_finest(
         result, finest, diagnosis::LetThrough{Effect::ViscoelasticRestitution, 15.8}, 10.0, {}, {});
     const bool converged = shift_p >= OutcomeShift::kReal;
