@@ -65,6 +65,41 @@ def move_in_se(a: dict, b: dict, trials: int = 8) -> float:
     return (b["mean_mm"] - a["mean_mm"]) / se if se > 0 else math.nan
 
 
+def outcomes(a, library: str, name: str, restitution: float, out: pathlib.Path) -> dict:
+    """One clump's outcomes (row -> values in m) at `restitution`; raises RuntimeError on a refusal."""
+    cmd = [a.conceal, library, "--clump", name, "--effect", "none", "--seed", str(a.seed), "--surface", a.surface,
+           "--restitution", str(restitution), "--static-friction", str(a.static_friction), "--rolling-friction",
+           str(a.rolling_friction), "--small", "--trials", str(a.trials), "--wall-mass", a.wall_mass, "-o", str(out)]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(done.stderr.strip())
+    rows = {}
+    for rec in ("drop-0.2m", "drop-1m", "roll-100mm"):
+        rows[f"{rec} rest distance"] = [rest_distance(t) for t in sorted((out / rec).glob("trial-*.csv"))]
+        rows[f"{rec} {SUMMARY[rec][0]}"] = summaries(out / rec, SUMMARY[rec][1])
+    return rows
+
+
+def finite_mean(values: list) -> float:
+    values = [v for v in values if math.isfinite(v)]
+    return statistics.mean(values) if values else math.nan
+
+
+def matched(a, library: str, name: str, target: float, tmp: pathlib.Path) -> tuple:
+    """The restitution (bisected in [0.3, 0.999], 8 halvings) at which this clump's mean `a.match`
+    meets `target` [m] (it rises with e), and the outcomes there."""
+    row = f"{a.match} {SUMMARY[a.match][0]}"
+    low, high, best = 0.3, 0.999, None
+    for step in range(8):
+        e = 0.5 * (low + high)
+        rows = outcomes(a, library, name, e, tmp / f"{name}-{step}")
+        gap = finite_mean(rows[row]) - target
+        if best is None or abs(gap) < abs(best[2]):
+            best = (e, rows, gap)
+        low, high = (e, high) if gap < 0 else (low, e)
+    return best[0], best[1]
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("clumps", nargs="+", help="LIBRARY.h5:NAME, coarsest first")
@@ -77,34 +112,40 @@ def main() -> int:
     p.add_argument("--rolling-friction", type=float, default=0.0252642907)
     p.add_argument("--wall-mass", choices=["whole", "shared"], default="whole",
                    help="the mass in each sphere's wall-contact damping (clumpforge-conceal --wall-mass)")
+    p.add_argument("--match", choices=["drop-0.2m", "drop-1m", "roll-100mm"],
+                   help="each clump after the first at the restitution (bisected) that gives this recording's mean "
+                        "summary the first clump's, as a calibration on it would: how the other outcomes then move")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     a = p.parse_args()
-    results = {}
+    results, restitutions = {}, {}
     with tempfile.TemporaryDirectory() as tmp:
+        target = None
         for spec in a.clumps:
             library, _, name = spec.rpartition(":")
             if not library or not name:
                 print(f"outcomes_by_resolution: '{spec}' is not LIBRARY.h5:NAME", file=sys.stderr)
                 return 2
-            out = pathlib.Path(tmp) / name
-            cmd = [a.conceal, library, "--clump", name, "--effect", "none", "--seed", str(a.seed), "--surface",
-                   a.surface, "--restitution", str(a.restitution), "--static-friction", str(a.static_friction),
-                   "--rolling-friction", str(a.rolling_friction), "--small", "--trials", str(a.trials),
-                   "--wall-mass", a.wall_mass, "-o", str(out)]
-            done = subprocess.run(cmd, capture_output=True, text=True)
-            if done.returncode != 0:
-                print(f"outcomes_by_resolution: {spec}: {done.stderr.strip()}", file=sys.stderr)
+            try:
+                if a.match and target is not None:
+                    restitutions[name], rows = matched(a, library, name, target, pathlib.Path(tmp))
+                else:
+                    restitutions[name] = a.restitution
+                    rows = outcomes(a, library, name, a.restitution, pathlib.Path(tmp) / name)
+                    if a.match:
+                        target = finite_mean(rows[f"{a.match} {SUMMARY[a.match][0]}"])
+            except RuntimeError as e:
+                print(f"outcomes_by_resolution: {spec}: {e}", file=sys.stderr)
                 return 1
-            for rec in ("drop-0.2m", "drop-1m", "roll-100mm"):
-                values = [rest_distance(t) for t in sorted((out / rec).glob("trial-*.csv"))]
-                add(results, f"{rec} rest distance", name, values)
-                add(results, f"{rec} {SUMMARY[rec][0]}", name, summaries(out / rec, SUMMARY[rec][1]))
+            for row, values in rows.items():
+                add(results, row, name, values)
     if a.json:
-        print(json.dumps(results, indent=2))
+        print(json.dumps({"restitution": restitutions, "outcomes": results} if a.match else results, indent=2))
         return 0
     names = [s.rpartition(":")[2] for s in a.clumps]
     print("| recording, outcome (mm) | " + " | ".join(names) + " |")
     print("|---|" + "---:|" * len(names))
+    if a.match:
+        print("| restitution | " + " | ".join(f"{restitutions[n]:.4f}" for n in names) + " |")
     for rec, by in results.items():
         cells = [f"{by[names[0]]['mean_mm']:.1f} +- {by[names[0]]['sd_mm']:.1f}"]
         for before, here in zip(names, names[1:]):
