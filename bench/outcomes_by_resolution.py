@@ -50,8 +50,12 @@ def summaries(folder: pathlib.Path, key: str) -> list:
     return [t.get("summary", {}).get(key, math.nan) for t in recording["trials"]]
 
 
+def finite(values: list) -> list:
+    return [v for v in values if math.isfinite(v)]
+
+
 def add(results: dict, row: str, name: str, values_m: list) -> None:
-    values = [v for v in values_m if math.isfinite(v)]
+    values = finite(values_m)
     results.setdefault(row, {})[name] = {
         "mean_mm": 1e3 * statistics.mean(values),
         "sd_mm": 1e3 * statistics.stdev(values) if len(values) > 1 else math.nan,
@@ -81,7 +85,7 @@ def outcomes(a, library: str, name: str, restitution: float, out: pathlib.Path) 
 
 
 def finite_mean(values: list) -> float:
-    values = [v for v in values if math.isfinite(v)]
+    values = finite(values)
     return statistics.mean(values) if values else math.nan
 
 

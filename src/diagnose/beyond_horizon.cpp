@@ -491,11 +491,18 @@ bool let_through_on_unconverged_finest(DiagnoseResult& result, const EnsembleRes
 }
 
 namespace {
-/// The outcomes a null leaves three standard errors or more from the recorded ones, each added to
-/// the verdict's unexplained phases; returns how each reads in a statement.
-std::vector<std::string> unexplained_outcomes(DiagnoseResult& result, const std::vector<OutcomeComparison>& null,
-                                              const std::vector<Recording>& recordings,
-                                              const std::vector<std::string>& names) {
+/// The verdict unexplained on a comparison beyond the release horizon: its null's outcomes three
+/// standard errors or more from the recorded ones added to the verdict's unexplained phases, the
+/// candidates it tried (`tried`) listed undecidable, the experiment set. Returns how each far
+/// outcome reads in the caller's statement. No candidate explains the outcomes, so one tried on
+/// them and not passing is not shown absent: it may be part of a mismatch no single effect of the
+/// library describes (the generated 8-trial strong viscoelastic case, before 0167403, was
+/// unexplained and called viscoelastic restitution decided absent). Only the frames' claims of
+/// absence stand.
+std::vector<std::string> declare_unexplained(DiagnoseResult& result, const std::vector<OutcomeComparison>& null,
+                                             const std::vector<EnsembleHypothesis>& tried,
+                                             const std::vector<Recording>& recordings,
+                                             const std::vector<std::string>& names) {
   std::vector<std::string> far;
   for (const auto& o : null) {
     if (std::abs(o.z) < 3.0) continue;
@@ -508,6 +515,11 @@ std::vector<std::string> unexplained_outcomes(DiagnoseResult& result, const std:
     result.unexplained.push_back({names[o.recording], drop ? Phase::Rebound : Phase::Rest, o.z * o.z, where});
     far.push_back(where);
   }
+  supersede(result, Verdict::Unexplained, Basis::UnexplainedOutcomes);
+  for (const auto& h : tried) mark_undecidable(result, effect_name(h.effect));
+  result.experiment =
+      "compare the recorded and replayed outcomes in the report's ensemble section; more trials per set-up, or "
+      "recorded release orientations, would narrow the cause";
   return far;
 }
 }  // namespace
@@ -533,9 +545,8 @@ bool let_through_unneeded_on_converged_finest(DiagnoseResult& result, const Ense
   const std::string there = let_through_there(finest, let_through).second;
   const std::string name = effect_name(let_through.effect);
   if (result.ensemble) report_ensemble(*result.ensemble, finest, check.rungs.size() - 1);
-  const std::vector<std::string> far = unexplained_outcomes(result, finest.null_comparisons, recordings, names);
-  supersede(result, Verdict::Unexplained, Basis::UnexplainedOutcomes);
-  for (const auto& tried : finest.hypotheses) mark_undecidable(result, effect_name(tried.effect));
+  const std::vector<std::string> far =
+      declare_unexplained(result, finest.null_comparisons, finest.hypotheses, recordings, names);
   mark_undecidable(result, name);
   result.statement = fmt::format(
       "Mismatch beyond the release horizon not explained by any known effect: with {} ({} spheres) {} beat the "
@@ -546,9 +557,6 @@ bool let_through_unneeded_on_converged_finest(DiagnoseResult& result, const Ense
       check.diagnosed, check.spheres, name, let_through.delta_bic, last.name, last.spheres, before.spheres, there,
       min_delta_bic, finest.null_chi2, finest.outcomes,
       far.empty() ? std::string() : fmt::format(", most in: {}", fmt::join(far, "; ")), name);
-  result.experiment =
-      "compare the recorded and replayed outcomes in the report's ensemble section (the finest clump's comparison); "
-      "more trials per set-up, or recorded release orientations, would narrow the cause";
   return true;
 }
 
@@ -737,15 +745,8 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
   if (!explained) return std::unexpected(explained.error());
   if (*explained) return {};
   if (particle_model_unconverged(c, result)) return {};
-  const std::vector<std::string> far = unexplained_outcomes(result, e.null_comparisons, *c.ev.recordings, c.names);
-  supersede(result, Verdict::Unexplained, Basis::UnexplainedOutcomes);
-  // No candidate explains the outcomes, so one tried on them and not passing is not shown
-  // absent: it may be part of a mismatch no single effect of the library describes (the
-  // generated 8-trial strong viscoelastic case, before 0167403, was unexplained and called
-  // viscoelastic restitution decided absent). Only the frames' claims of absence stand.
-  for (const auto& h : e.hypotheses) {
-    mark_undecidable(result, effect_name(h.effect));
-  }
+  const std::vector<std::string> far =
+      declare_unexplained(result, e.null_comparisons, e.hypotheses, *c.ev.recordings, c.names);
   result.statement = fmt::format(
       "Mismatch beyond the release horizon not explained by any known effect: the recorded outcomes differ from "
       "replays over the unknown release orientation (chi^2 {:.1f} over {} recorded means and spreads, p = {:.2g}){}; "
@@ -754,9 +755,6 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
       e.null_chi2, e.outcomes, chi2_upper_tail(e.null_chi2, dof),
       far.empty() ? std::string() : fmt::format(", most in: {}", fmt::join(far, "; ")),
       c.finer.empty() ? std::string() : ", nor does a finer clump of the same body");
-  result.experiment =
-      "compare the recorded and replayed outcomes in the report's ensemble section; more trials per set-up, or "
-      "recorded release orientations, would narrow the cause";
   return {};
 }
 

@@ -1,6 +1,6 @@
 """bench/rim_faces.py against analytic rims (run by ctest, label fast): a ring of N equal
 spheres on a circle of radius R rolls over N faces of length 2 R sin(pi/N) each; a single
-sphere over none; a library that is not there is refused with its name."""
+sphere over none; a library that is not there, and too few directions, are refused by name."""
 
 import math
 import pathlib
@@ -57,3 +57,8 @@ def test_the_table_names_each_clump_and_a_missing_library_is_refused(tmp_path):
     missing = subprocess.run([sys.executable, str(SCRIPT), f"{tmp_path / 'none.h5'}:ring"], capture_output=True,
                              text=True)
     assert missing.returncode == 1 and "none.h5" in missing.stderr
+
+
+def test_too_few_directions_are_refused():
+    done = subprocess.run([sys.executable, str(SCRIPT), "--samples", "10", "x.h5:a"], capture_output=True, text=True)
+    assert done.returncode == 2 and "--samples 360 or more" in done.stderr and done.stdout == ""
