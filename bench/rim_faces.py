@@ -20,8 +20,9 @@ of the faces' lengths, the sum of their squares and the longest face.
 import argparse
 import sys
 
-import h5py
 import numpy as np
+
+from clump_spec import read_clump
 
 
 def rim_faces(centres: np.ndarray, radii: np.ndarray, axis: int, samples: int) -> np.ndarray:
@@ -49,13 +50,10 @@ def main() -> int:
     print("| clump | spheres | rim spheres | sum of faces (mm) | sum of faces^2 (mm^2) | longest face (mm) |")
     print("|---|---:|---:|---:|---:|---:|")
     for spec in a.clumps:
-        library, _, name = spec.rpartition(":")
         try:
-            with h5py.File(library, "r") as f:
-                spheres = f["clumps"][name]["spheres"][()]
-                moments = f["clumps"][name]["principal_moments_kg_m2"][()]
-        except (OSError, KeyError) as e:
-            print(f"rim_faces: {spec}: {e}", file=sys.stderr)
+            name, spheres, moments = read_clump(spec, "spheres", "principal_moments_kg_m2")
+        except ValueError as e:
+            print(f"rim_faces: {e}", file=sys.stderr)
             return 1
         faces = rim_faces(spheres[:, :3], spheres[:, 3], int(np.argmax(moments)), a.samples)
         print(f"| {name} | {len(spheres)} | {len(faces)} | {1e3 * faces.sum():.1f} | {1e6 * (faces**2).sum():.1f} | "

@@ -15,8 +15,9 @@ DEM is run, and the overlap an impact reaches is shared among the spheres that t
 import argparse
 import sys
 
-import h5py
 import numpy as np
+
+from clump_spec import read_clump
 
 
 def rotation(q: np.ndarray) -> np.ndarray:
@@ -42,12 +43,10 @@ def main() -> int:
     print("| clump | spheres | " + " | ".join(f"within {d * 1e3:g} mm: median (mean)" for d in depths) + " |")
     print("|---|---:|" + "---:|" * len(depths))
     for spec in a.clumps:
-        library, _, name = spec.rpartition(":")
         try:
-            with h5py.File(library, "r") as f:
-                spheres = f["clumps"][name]["spheres"][()]
-        except (OSError, KeyError) as e:
-            print(f"touching_spheres: {spec}: {e}", file=sys.stderr)
+            name, spheres = read_clump(spec, "spheres")
+        except ValueError as e:
+            print(f"touching_spheres: {e}", file=sys.stderr)
             return 1
         centres, radii = spheres[:, :3], spheres[:, 3]
         counts = np.empty((len(depths), len(quaternions)))

@@ -42,7 +42,7 @@ def test_a_ring_normal_to_another_axis_and_a_single_sphere():
     assert len(rim_faces.rim_faces(np.zeros((1, 3)), np.array([1e-3]), 2, 3600)) == 0
 
 
-def test_the_table_names_each_clump_and_a_missing_library_is_refused(tmp_path):
+def test_the_table_names_each_clump_and_a_missing_library_or_clump_is_refused(tmp_path):
     centres, radii = ring(18, 8e-3, 1.5e-3)
     library = tmp_path / "ring.h5"
     with h5py.File(library, "w") as f:
@@ -57,6 +57,10 @@ def test_the_table_names_each_clump_and_a_missing_library_is_refused(tmp_path):
     missing = subprocess.run([sys.executable, str(SCRIPT), f"{tmp_path / 'none.h5'}:ring"], capture_output=True,
                              text=True)
     assert missing.returncode == 1 and "none.h5" in missing.stderr
+    no_clump = subprocess.run([sys.executable, str(SCRIPT), f"{library}:ring-7"], capture_output=True, text=True)
+    assert no_clump.returncode == 1 and "ring-7" in no_clump.stderr
+    no_library = subprocess.run([sys.executable, str(SCRIPT), "ring-18"], capture_output=True, text=True)
+    assert no_library.returncode == 1 and "give LIBRARY.h5:NAME" in no_library.stderr
 
 
 def test_too_few_directions_are_refused():
