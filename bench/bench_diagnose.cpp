@@ -770,7 +770,8 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--controls", o.controls, "Effect-free controls");
   app.add_option("--trials", o.trials, "Trials per recording");
   app.add_option("--seed", o.seed, "Seed of the whole benchmark");
-  app.add_option("--effects", o.only, "Only these effects (default: the library)");
+  app.add_option("--effects", o.only, "Only these effects, by name (space- or comma-separated; default: the library)")
+      ->delimiter(',');
   app.add_flag("--full-set", o.full_set,
                "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
   app.add_flag("--nine-set-ups", o.nine_set_ups,
@@ -874,6 +875,10 @@ Result<std::vector<Case>> generated_cases(const BenchOptions& o, const MaterialT
     }
     return nine_set_up_parts(c);
   };
+  for (const std::string& name : o.only) {
+    if (auto effect = parse_effect(name); !effect)
+      return fail(ErrorCode::InvalidArgument, fmt::format("--effects: {}", effect.error().message));
+  }
   std::vector<Case> cases;
   std::uint64_t k = 0;
   for (const auto& spec : effect_library()) {

@@ -170,7 +170,9 @@ Command add_diagnose_command(CLI::App& app) {
                   "more spheres)");
   add_units_option(*sub, args->units, "With --mesh: its length unit (mm, cm, m)");
   add_density_option(*sub, args->density, "With --mesh: bulk density [kg/m^3]");
-  sub->add_option("--effects", args->effects, "Candidate effects to test (default: the whole library)");
+  sub->add_option("--effects", args->effects,
+                  "Candidate effects to test, space- or comma-separated (default: the whole library)")
+      ->delimiter(',');
   add_materials_option(*sub, args->materials, "Materials file (JSON) overriding the built-in table");
   sub->add_option("--max-evaluations", args->max_evaluations,
                   "Fit budget per candidate (Levenberg-Marquardt iterations: a fifth of it)");
