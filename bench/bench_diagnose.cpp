@@ -742,6 +742,8 @@ struct BenchOptions {
   /// The mass in each clump sphere's wall-contact damping, of the generator and the diagnosis alike
   /// (ContactSettings::wall_mass; the recordings of --recordings-set keep their own).
   std::string wall_mass = "whole";
+  /// Where the diagnosis reads a drop's drift (DiagnoseOptions::drift_at).
+  std::string drop_drift = "track-end";
   ClumpWallMass contact_wall_mass() const { return parse_wall_mass(wall_mass).value_or(ClumpWallMass::Whole); }
   std::string recordings_set, orientation = "none",
                               generator_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default.h5",
@@ -813,6 +815,10 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "The mass in each clump sphere's wall-contact damping, of the generator and the diagnosis: whole "
                  "(the clump's, as LIGGGHTS and EDEM; default) or shared (among the spheres touching that wall)")
       ->check(CLI::IsMember({"whole", "shared"}));
+  app.add_option("--drop-drift", o.drop_drift,
+                 "Where the diagnosis reads a drop's drift, recorded and replayed alike: track-end (default) or "
+                 "after-impact (as diagnose's)")
+      ->check(CLI::IsMember({"track-end", "after-impact"}));
   app.add_option("--ensemble-replays-at-gate", o.replays_at_gate,
                  "Replays per recording of a case's second comparison beyond the release horizon when the first "
                  "decided at a gate (as diagnose's; 0: never)")
@@ -947,6 +953,7 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
                        .finer_clumps = o.finer_clumps.value_or(3)};
   job.options.ensemble_replays_at_gate = o.replays_at_gate;
   job.options.lab.contact.wall_mass = o.contact_wall_mass();
+  job.options.drift_at = parse_drift_at(o.drop_drift).value_or(DriftAt::TrackEnd);  // CLI11 checked it
   // Recordings already made (their answer is written last) are diagnosed as they are: delete a
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
@@ -1071,6 +1078,7 @@ int main(int argc, char** argv) {
     cli::DiagnoseJob job{.spheres = o.spheres, .finer_clumps = o.finer_clumps.value_or(2)};
     job.options.ensemble_replays_at_gate = o.replays_at_gate;
     job.options.lab.contact.wall_mass = o.contact_wall_mass();
+    job.options.drift_at = parse_drift_at(o.drop_drift).value_or(DriftAt::TrackEnd);  // CLI11 checked it
     return compared(run_recordings_set(o.recordings_set, o.out, job, o.existing_only, *team));
   }
   const MaterialTable table = default_material_table();

@@ -73,7 +73,8 @@ def outcomes(a, library: str, name: str, restitution: float, out: pathlib.Path) 
     """One clump's outcomes (row -> values in m) at `restitution`; raises RuntimeError on a refusal."""
     cmd = [a.conceal, library, "--clump", name, "--effect", "none", "--seed", str(a.seed), "--surface", a.surface,
            "--restitution", str(restitution), "--static-friction", str(a.static_friction), "--rolling-friction",
-           str(a.rolling_friction), "--small", "--trials", str(a.trials), "--wall-mass", a.wall_mass, "-o", str(out)]
+           str(a.rolling_friction), "--small", "--trials", str(a.trials), "--wall-mass", a.wall_mass,
+           "--steps-per-contact", str(a.steps_per_contact), "-o", str(out)]
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
         raise RuntimeError(done.stderr.strip())
@@ -116,6 +117,9 @@ def main() -> int:
     p.add_argument("--rolling-friction", type=float, default=0.0252642907)
     p.add_argument("--wall-mass", choices=["whole", "shared"], default="whole",
                    help="the mass in each sphere's wall-contact damping (clumpforge-conceal --wall-mass)")
+    p.add_argument("--steps-per-contact", type=int, default=100,
+                   help="time steps per contact (clumpforge-conceal's; 100, the generator's, by default; the "
+                        "diagnosis replays with 50)")
     p.add_argument("--match", choices=["drop-0.2m", "drop-1m", "roll-100mm"],
                    help="each clump after the first at the restitution (bisected) that gives this recording's mean "
                         "summary the first clump's, as a calibration on it would: how the other outcomes then move")

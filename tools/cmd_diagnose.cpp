@@ -26,7 +26,7 @@ namespace {
 struct DiagnoseArgs {
   std::vector<std::string> recordings, effects;
   std::string mesh, clump, clump_name, out, materials, units = "mm";
-  std::string roll_release = "on-edge", wall_mass = "whole";
+  std::string roll_release = "on-edge", wall_mass = "whole", drop_drift = "track-end";
   double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3, impact_accuracy_pct = 1.0;
   int ensemble_replays = 12, ensemble_replays_at_gate = 48;
   int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
@@ -112,6 +112,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.max_evaluations = args.max_evaluations;
   options.orientation_prior_deg = args.orientation_prior_deg;
   options.roll_release = parse_roll_posture(args.roll_release).value_or(RollPosture::OnEdge);  // CLI11 checked it
+  options.drift_at = parse_drift_at(args.drop_drift).value_or(DriftAt::TrackEnd);              // CLI11 checked it
   const auto wall_mass = parse_wall_mass_option(args.wall_mass);
   if (!wall_mass) return report_error(kCommand, wall_mass.error());
   options.lab.contact.wall_mass = *wall_mass;
@@ -184,6 +185,13 @@ Command add_diagnose_command(CLI::App& app) {
                   "and is turned at random about its flat faces' normal, or, when orientation_wxyz is recorded, at "
                   "the turn nearest it; a sphere or equant body anyhow) or any (uniform over all orientations)")
       ->check(CLI::IsMember({"on-edge", "any"}))
+      ->capture_default_str();
+  sub->add_option("--drop-drift", args->drop_drift,
+                  "Where a drop's drift is read beyond the release horizon, recorded and replayed alike: track-end "
+                  "(each track's last ten frames; default: right when the tracks run until the particle rests) or "
+                  "after-impact (the same time after each first impact, the longest every recorded trial reaches: "
+                  "for tracks that stop while the particle still moves)")
+      ->check(CLI::IsMember({"track-end", "after-impact"}))
       ->capture_default_str();
   sub->add_option("--wall-mass", args->wall_mass,
                   "The mass in each clump sphere's wall-contact damping: whole (the clump's, as LIGGGHTS and EDEM; "

@@ -435,6 +435,7 @@ Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& c
   DiagnoseRun run{.result = std::move(*result), .clump = std::move(clump), .report = {}};
   run.report = diagnosis_report_json(run.result, run.clump.name);
   run.report["wall_mass"] = std::string(wall_mass_name(job.options.lab.contact.wall_mass));
+  run.report["drop_drift"] = std::string(drift_at_name(job.options.drift_at));
   return run;
 }
 

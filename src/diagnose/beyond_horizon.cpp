@@ -893,6 +893,7 @@ EnsembleOptions ensemble_options(const Context& c, const DiagnoseOptions& option
   eo.replays = replays;
   eo.orientation_prior_deg = options.orientation_prior_deg;
   eo.roll_on_edge = on_edge_rolls(*c.ev.clump, options);
+  eo.drift_at = options.drift_at;
   eo.impact_accuracy = options.impact_accuracy;
   eo.min_delta_bic = options.min_delta_bic;
   eo.seed = options.seed;

@@ -44,6 +44,9 @@ struct DiagnoseOptions {
   /// default (the way it rolls; a recorded orientation is set on the rim as near as it goes),
   /// or any orientation.
   RollPosture roll_release = RollPosture::OnEdge;
+  /// Where a drop's drift is read beyond the release horizon, recorded and replayed alike
+  /// (DriftAt in diagnose/ensemble.hpp): each track's end, or a fixed time after the first impact.
+  DriftAt drift_at = DriftAt::TrackEnd;
   /// [m] how closely any clump and contact law can follow a real particle's tracked point,
   /// [0, 0.01]: residuals are weighed against hypot(camera noise, this). 0 trusts the model
   /// as much as the camera (data made by the diagnoser's own model).

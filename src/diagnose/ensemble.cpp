@@ -34,6 +34,17 @@ std::string_view outcome_name(Outcome outcome) {
   return "?";
 }
 
+std::string_view drift_at_name(DriftAt at) {
+  return at == DriftAt::TrackEnd ? "track-end" : "after-impact";
+}
+
+std::optional<DriftAt> parse_drift_at(std::string_view text) {
+  for (DriftAt at : {DriftAt::TrackEnd, DriftAt::AfterImpact}) {
+    if (text == drift_at_name(at)) return at;
+  }
+  return std::nullopt;
+}
+
 std::string_view statistic_name(Statistic statistic) {
   return statistic == Statistic::Mean ? "mean" : "spread";
 }
@@ -126,12 +137,61 @@ bool compared_as_sample(const Recording& recording) {
   return !outcomes_of(recording).empty();
 }
 
-std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved,
-                                                         double tilt_rate_deg_per_s) {
+namespace {
+
+/// The path's frames with a time since release and finite coordinates.
+std::vector<std::size_t> valid_frames(const PathSample& path) {
   std::vector<std::size_t> valid;
   for (std::size_t i = 0; i < path.t.size(); ++i) {
     if (path.t[i] >= 0.0 && std::isfinite(path.x[i]) && std::isfinite(path.z[i])) valid.push_back(i);
   }
+  return valid;
+}
+
+/// The position in `valid` of a drop's first impact (first_impact_time).
+std::optional<std::size_t> first_impact(const PathSample& path, const std::vector<std::size_t>& valid, double moved) {
+  if (valid.empty()) return std::nullopt;
+  double low = path.z[valid.front()];
+  std::size_t low_at = 0;
+  for (std::size_t k = 0; k < valid.size(); ++k) {
+    const double z = path.z[valid[k]];
+    if (z < low) {
+      low = z;
+      low_at = k;
+    } else if (z > low + moved) {
+      return low_at;
+    }
+  }
+  return std::nullopt;
+}
+
+/// The median x of the ten valid frames that end `after` [s] past the first impact (NaN when the
+/// path ends before, or there is no impact).
+double x_after_impact(const PathSample& path, const std::vector<std::size_t>& valid, std::optional<std::size_t> impact,
+                      double after) {
+  if (!impact) return std::nan("");
+  const double until = path.t[valid[*impact]] + after;
+  if (path.t[valid.back()] < until) return std::nan("");
+  std::size_t end = *impact;
+  while (end + 1 < valid.size() && path.t[valid[end + 1]] <= until) ++end;
+  if (end < 9) return std::nan("");
+  std::vector<double> xs;
+  for (std::size_t k = end - 9; k <= end; ++k) xs.push_back(path.x[valid[k]]);
+  return median(xs);
+}
+
+}  // namespace
+
+std::optional<double> first_impact_time(const PathSample& path, double moved) {
+  const std::vector<std::size_t> valid = valid_frames(path);
+  const auto impact = first_impact(path, valid, moved);
+  if (!impact) return std::nullopt;
+  return path.t[valid[*impact]];
+}
+
+std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved,
+                                                         double tilt_rate_deg_per_s, double drift_after_impact) {
+  const std::vector<std::size_t> valid = valid_frames(path);
   if (valid.size() < 10) return {};
   if (test == LabTest::Tilt) return tilt_outcomes(path, valid, moved, tilt_rate_deg_per_s);
   // Where it came to rest: the median of its last ten frames.
@@ -147,21 +207,8 @@ std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const Pat
     if (std::hypot(path.x[i] - x_rest, path.z[i] - z_rest) > moved) rest_time = path.t[i];
   }
   if (test == LabTest::Roll) return {{Outcome::RollDistance, x_rest}, {Outcome::RollTime, rest_time}};
-  // The first impact: the lowest point before the path first rises by `moved` above its
-  // running minimum; the rebound height is the highest point after it, above the rest height.
-  double low = path.z[valid.front()];
-  std::size_t low_at = 0;
-  std::optional<std::size_t> impact;
-  for (std::size_t k = 0; k < valid.size(); ++k) {
-    const double z = path.z[valid[k]];
-    if (z < low) {
-      low = z;
-      low_at = k;
-    } else if (z > low + moved) {
-      impact = low_at;
-      break;
-    }
-  }
+  // The first impact; the rebound height is the highest point after it, above the rest height.
+  const std::optional<std::size_t> impact = first_impact(path, valid, moved);
   double rebound = 0.0;
   if (impact) {
     double apex = -std::numeric_limits<double>::infinity();
@@ -170,7 +217,9 @@ std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const Pat
   }
   // No time to rest for a drop: a lab's track often ends before a tumbling body settles, and
   // the replays' would measure where the replay stops, not the body.
-  return {{Outcome::ReboundHeight, rebound}, {Outcome::Drift, std::abs(x_rest)}};
+  const double drift =
+      std::isfinite(drift_after_impact) ? x_after_impact(path, valid, impact, drift_after_impact) : x_rest;
+  return {{Outcome::ReboundHeight, rebound}, {Outcome::Drift, std::abs(drift)}};
 }
 
 OutcomeComparison compare_outcome(const std::vector<double>& recorded, const std::vector<double>& ensemble,
@@ -354,7 +403,8 @@ struct Plan {
   std::vector<std::vector<double>> recorded;  ///< [outcome][trial]
   std::vector<Eigen::Quaterniond> orientations;
   double duration = 0.0, frame = 1e-3, moved = 1e-3, sigma = 1e-4;
-  double tilt_rate_deg_per_s = 0.0;  ///< a tilt's plate
+  double tilt_rate_deg_per_s = 0.0;          ///< a tilt's plate
+  double drift_after_impact = std::nan("");  ///< [s] where a drop's drifts are read (DriftAt::AfterImpact)
 };
 
 using Sample = std::vector<std::vector<std::vector<double>>>;  ///< [plan][outcome][replay]
@@ -378,6 +428,20 @@ void keep_measured_outcomes(Plan& plan) {
   }
 }
 
+/// [s] DriftAt::AfterImpact's reading time for a drop recording's `paths`: the longest every one
+/// reaches after its first impact, ten frames short of its end (NaN, the tracks' ends, when a path
+/// shows no impact or ends within ten frames of it).
+double drift_reading_time(const std::vector<PathSample>& paths, double moved, double frame) {
+  double shortest = std::numeric_limits<double>::infinity();
+  for (const PathSample& path : paths) {
+    const auto impact = first_impact_time(path, moved);
+    if (!impact || path.t.empty()) return std::nan("");
+    shortest = std::min(shortest, path.t.back() - *impact);
+  }
+  const double reading = shortest - 10.0 * frame;
+  return reading > 10.0 * frame && std::isfinite(reading) ? reading : std::nan("");
+}
+
 /// The plans of every recording compared, their replays' orientations drawn from `stream` on.
 std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>& scores, const EnsembleOptions& options,
                              std::uint64_t stream) {
@@ -394,6 +458,7 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
     plan.tilt_rate_deg_per_s = rec.tilt_rate_deg_per_s.value_or(ev.lab.tilt_rate_deg_per_s);
     plan.recorded.resize(plan.outcomes.size());
     std::vector<Eigen::Quaterniond> recorded_orientations;
+    std::vector<PathSample> paths;  // the recorded trials', in the replay frame
     bool every_recorded = true;
     for (std::size_t i = 0; i < ev.trials.size(); ++i) {
       const TrackedTrial& tt = ev.trials[i];
@@ -401,12 +466,17 @@ std::vector<Plan> make_plans(const Evaluator& ev, const std::vector<TrialScore>&
       const Track& track = *rec.trials[tt.trial].track;
       plan.frame = frame_interval(track);
       plan.duration = std::max(plan.duration, tt.duration);
-      const auto measured =
-          measure_outcomes(rec.test, recorded_path(track, scores[i]), plan.moved, plan.tilt_rate_deg_per_s);
-      for (std::size_t k = 0; k < measured.size(); ++k) plan.recorded[k].push_back(measured[k].second);
+      paths.push_back(recorded_path(track, scores[i]));
       every_recorded = every_recorded && rec.trials[tt.trial].release_orientation.has_value();
       if (rec.trials[tt.trial].release_orientation)
         recorded_orientations.push_back(*rec.trials[tt.trial].release_orientation);
+    }
+    if (rec.test == LabTest::Drop && options.drift_at == DriftAt::AfterImpact)
+      plan.drift_after_impact = drift_reading_time(paths, plan.moved, plan.frame);
+    for (const PathSample& path : paths) {
+      const auto measured =
+          measure_outcomes(rec.test, path, plan.moved, plan.tilt_rate_deg_per_s, plan.drift_after_impact);
+      for (std::size_t k = 0; k < measured.size(); ++k) plan.recorded[k].push_back(measured[k].second);
     }
     keep_measured_outcomes(plan);
     if (plan.outcomes.empty() || plan.recorded.front().size() < 2) continue;
@@ -446,7 +516,7 @@ std::vector<std::pair<Outcome, double>> replay_and_measure(const LabWorld& world
     path.x.push_back(s.x - x0);
     path.z.push_back(s.z);
   }
-  return measure_outcomes(rec.test, path, plan.moved, plan.tilt_rate_deg_per_s);
+  return measure_outcomes(rec.test, path, plan.moved, plan.tilt_rate_deg_per_s, plan.drift_after_impact);
 }
 
 /// One plan's replays to run: its world, lab options and tilt start.

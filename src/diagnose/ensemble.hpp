@@ -51,8 +51,31 @@ struct PathSample {
 /// and a replay. `moved` is the displacement that counts as motion [m] (well above the noise);
 /// a tilt's plate turns at `tilt_rate_deg_per_s` from t = 0 about an axis through x = z = 0.
 /// A tilt's outcome the path does not reach is NaN. Empty for a path with fewer than 10 frames.
+/// A drop's drift is where the tracked point comes to rest, the median of the last ten frames;
+/// with `drift_after_impact` [s] finite, the median of the ten frames that end that long after
+/// the first impact instead (NaN when the path ends before).
 std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const PathSample& path, double moved,
-                                                         double tilt_rate_deg_per_s = 0.0);
+                                                         double tilt_rate_deg_per_s = 0.0,
+                                                         double drift_after_impact = std::nan(""));
+
+/// [s] A drop's first impact on `path`: the lowest point before the path first rises by `moved`
+/// above its running minimum (nullopt when it never does: no rebound, or too few frames).
+std::optional<double> first_impact_time(const PathSample& path, double moved);
+
+/// Where a drop recording's drifts are read, recorded and replayed alike (EnsembleOptions::drift_at).
+enum class DriftAt {
+  /// Each path's last ten frames: a recorded track's end, a replay's (which runs as long as the
+  /// longest recorded track). Right when the tracks run until the particle rests.
+  TrackEnd,
+  /// The same time after each path's first impact, the longest every recorded trial reaches
+  /// (less ten frames): where a lab stops its camera (a fixed clip, the particle out of view, the
+  /// second landing) no longer sets the recorded drifts apart from the replays'. The generated
+  /// tracks end 40 ms after the second landing and lab-like's 1 m drops at 0.99-1.46 s, the
+  /// particle still moving.
+  AfterImpact,
+};
+std::optional<DriftAt> parse_drift_at(std::string_view text);  ///< "track-end", "after-impact"
+std::string_view drift_at_name(DriftAt at);
 
 /// Whether a recording's trials are compared as a sample with replays over the release: every
 /// drop and roll, and a tilt of four particles glued in a square (a single particle's slip
@@ -142,6 +165,7 @@ struct EnsembleOptions {
   int move_replays = 0;  ///< a finer clump's move measured with these (when more than replays)
   double orientation_prior_deg = 15.0;
   bool roll_on_edge = false;  ///< rolls without a recorded orientation start on the rim (OrientationPrior::on_edge)
+  DriftAt drift_at = DriftAt::TrackEnd;  ///< where a drop's drift is read
   double impact_accuracy = 0.01;
   double min_delta_bic = 10.0;
   std::uint64_t seed = 1;

@@ -68,6 +68,35 @@ TEST(EnsembleOutcomes, ReboundHeightAndDriftOfABouncingPath) {
   EXPECT_TRUE(measure_outcomes(LabTest::Drop, short_path, 1e-3).empty());
 }
 
+TEST(EnsembleOutcomes, DriftReadAFixedTimeAfterTheFirstImpact) {
+  // Analytic: dropped from 0.5 m, the first impact at sqrt(2 H / g) = 0.3193 s; the path drifts
+  // linearly through the rebound's flight (2 e g t1 / g = 0.3831 s with e = 0.6) to 20 mm.
+  constexpr double g = 9.81, height = 0.5, e = 0.6, drift = 0.02, fps = 1000.0;
+  const double t1 = std::sqrt(2.0 * height / g), flight = 2.0 * e * t1;
+  const PathSample path = bouncing_path(height, e, drift, fps);
+  const auto impact = first_impact_time(path, 1e-3);
+  ASSERT_TRUE(impact.has_value());
+  EXPECT_NEAR(*impact, t1, 1.5 / fps);  // the frame nearest the contact
+  // Read 0.2 s after the impact: the median of the ten frames ending there, x = drift s / flight
+  // at s = 0.2 - 4.5 frames (to a frame and the impact's frame).
+  const auto at = measure_outcomes(LabTest::Drop, path, 1e-3, 0.0, 0.2);
+  ASSERT_EQ(at.size(), 2u);
+  EXPECT_EQ(at[1].first, Outcome::Drift);
+  EXPECT_NEAR(at[1].second, drift * (0.2 - 4.5 / fps) / flight, drift * 2.0 / fps / flight);
+  // The rebound height is read as before (above the rest height).
+  EXPECT_NEAR(at[0].second, e * e * height, 1e-4);
+  // Past the rebound, the rest drift; past the path's end, NaN; without it, the track's end.
+  EXPECT_NEAR(measure_outcomes(LabTest::Drop, path, 1e-3, 0.0, flight + 0.1)[1].second, drift, 1e-9);
+  EXPECT_TRUE(std::isnan(measure_outcomes(LabTest::Drop, path, 1e-3, 0.0, flight + 0.5)[1].second));
+  EXPECT_NEAR(measure_outcomes(LabTest::Drop, path, 1e-3)[1].second, drift, 1e-9);
+  // A dead landing has no impact to read from.
+  EXPECT_FALSE(first_impact_time(bouncing_path(0.2, 0.0, 0.0, fps), 1e-3).has_value());
+  EXPECT_TRUE(std::isnan(measure_outcomes(LabTest::Drop, bouncing_path(0.2, 0.0, 0.0, fps), 1e-3, 0.0, 0.1)[1].second));
+  // The option's names, both ways.
+  for (DriftAt d : {DriftAt::TrackEnd, DriftAt::AfterImpact}) EXPECT_EQ(parse_drift_at(drift_at_name(d)), d);
+  EXPECT_FALSE(parse_drift_at("rest").has_value());
+}
+
 TEST(EnsembleOutcomes, RollDistanceAndTimeToRest) {
   // Uniform deceleration from 0.3 m/s at 0.5 m/s^2: rest after 0.6 s at 0.09 m.
   PathSample p;
