@@ -744,6 +744,7 @@ struct BenchOptions {
   std::string wall_mass = "whole";
   /// Where the diagnosis reads a drop's drift (DiagnoseOptions::drift_at).
   std::string drop_drift = "track-end";
+  DriftAt drift_at() const { return parse_drift_at(drop_drift).value_or(DriftAt::TrackEnd); }  // CLI11 checked it
   ClumpWallMass contact_wall_mass() const { return parse_wall_mass(wall_mass).value_or(ClumpWallMass::Whole); }
   std::string recordings_set, orientation = "none",
                               generator_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default.h5",
@@ -953,7 +954,7 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
                        .finer_clumps = o.finer_clumps.value_or(3)};
   job.options.ensemble_replays_at_gate = o.replays_at_gate;
   job.options.lab.contact.wall_mass = o.contact_wall_mass();
-  job.options.drift_at = parse_drift_at(o.drop_drift).value_or(DriftAt::TrackEnd);  // CLI11 checked it
+  job.options.drift_at = o.drift_at();
   // Recordings already made (their answer is written last) are diagnosed as they are: delete a
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
@@ -1078,7 +1079,7 @@ int main(int argc, char** argv) {
     cli::DiagnoseJob job{.spheres = o.spheres, .finer_clumps = o.finer_clumps.value_or(2)};
     job.options.ensemble_replays_at_gate = o.replays_at_gate;
     job.options.lab.contact.wall_mass = o.contact_wall_mass();
-    job.options.drift_at = parse_drift_at(o.drop_drift).value_or(DriftAt::TrackEnd);  // CLI11 checked it
+    job.options.drift_at = o.drift_at();
     return compared(run_recordings_set(o.recordings_set, o.out, job, o.existing_only, *team));
   }
   const MaterialTable table = default_material_table();

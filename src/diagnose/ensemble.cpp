@@ -429,14 +429,16 @@ void keep_measured_outcomes(Plan& plan) {
 }
 
 /// [s] DriftAt::AfterImpact's reading time for a drop recording's `paths`: the longest every one
-/// reaches after its first impact, ten frames short of its end (NaN, the tracks' ends, when a path
-/// shows no impact or ends within ten frames of it).
+/// reaches after its first impact, ten frames short of its last valid frame (a lost last frame,
+/// NaN, is not reached; NaN, the tracks' ends, when a path shows no impact or ends within ten
+/// frames of it).
 double drift_reading_time(const std::vector<PathSample>& paths, double moved, double frame) {
   double shortest = std::numeric_limits<double>::infinity();
   for (const PathSample& path : paths) {
-    const auto impact = first_impact_time(path, moved);
-    if (!impact || path.t.empty()) return std::nan("");
-    shortest = std::min(shortest, path.t.back() - *impact);
+    const std::vector<std::size_t> valid = valid_frames(path);
+    const auto impact = first_impact(path, valid, moved);
+    if (!impact) return std::nan("");
+    shortest = std::min(shortest, path.t[valid.back()] - path.t[valid[*impact]]);
   }
   const double reading = shortest - 10.0 * frame;
   return reading > 10.0 * frame && std::isfinite(reading) ? reading : std::nan("");
