@@ -728,7 +728,8 @@ struct Proposal {
 /// Whether a candidate is calibrated with its level whatever the linear surrogate predicts.
 enum class Pursuit {
   No,
-  IfDetectable,  ///< the null leaves the outcomes inconsistent: when its strong magnitude would show
+  IfDetectable,  ///< the null leaves the outcomes inconsistent, or one far out (leaves_far_outcome): when its strong
+                 ///< magnitude would show
   Always,        ///< a coarser clump let this candidate through: whether it passes here is the question
 };
 
@@ -1175,6 +1176,16 @@ bool outcomes_consistent(const std::vector<OutcomeComparison>& comparisons, std:
   return t.means.tail >= 0.5 * kConsistentTail && t.spreads.tail >= 0.5 * kConsistentTail;
 }
 
+bool leaves_far_outcome(const std::vector<OutcomeComparison>& comparisons, double family_tail) {
+  if (comparisons.empty()) return false;
+  double largest = 0.0;
+  for (const auto& o : comparisons) largest = std::max(largest, std::abs(o.z));
+  const double single = std::erfc(largest / std::sqrt(2.0));
+  const double family =
+      -std::expm1(static_cast<double>(comparisons.size()) * std::log1p(-std::min(single, 1.0 - 1e-16)));
+  return family < family_tail;
+}
+
 Result<std::vector<OutcomeComparison>> compare_model(const Evaluator& ev, const Model& model,
                                                      const std::vector<TrialScore>& scores,
                                                      const EnsembleOptions& options, int& replays,
@@ -1223,6 +1234,7 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   const Eigen::VectorXd null_means = means_of(result.null_comparisons);
   const auto library = effect_library();
   const bool unexplained = !outcomes_consistent(result.null_comparisons, free.size());
+  const bool far = unexplained || leaves_far_outcome(result.null_comparisons, kFarOutcomeTail);
   std::vector<Proposal> proposals;
   CandidatesTried tried = CandidatesTried::All;
   if (unexplained && options.candidates_when_inconsistent) {
@@ -1235,7 +1247,7 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
     auto proposal = propose(ev, plans, null_model, null_sample, null_means, recorded, inverse_se, scaling, jacobian,
                             free, effect_spec(library, e), options,
                             options.pursue == e ? Pursuit::Always
-                            : unexplained       ? Pursuit::IfDetectable
+                            : far               ? Pursuit::IfDetectable
                                                 : Pursuit::No,
                             result);
     if (!proposal) return std::unexpected(proposal.error());

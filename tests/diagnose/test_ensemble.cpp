@@ -206,6 +206,38 @@ TEST(EnsembleComparison, FalsePositiveRateOnSamplesOfOneDistribution) {
   EXPECT_LE(static_cast<double>(sets_beyond) / kSets, 0.01);
 }
 
+TEST(EnsembleComparison, AFarOutcomeIsJudgedAmongAllTheComparisons) {
+  // 32 comparisons, one far: Sidak's family tail 1 - (1 - erfc(|z|/sqrt 2))^32.
+  std::vector<OutcomeComparison> c(32);
+  c[5].z = 3.6;  // single 3.18e-4, family 0.0101: far
+  EXPECT_TRUE(leaves_far_outcome(c, kFarOutcomeTail));
+  c[5].z = -3.0;  // single 2.70e-3, family 0.0828: one of 32 as far comes by chance
+  EXPECT_FALSE(leaves_far_outcome(c, kFarOutcomeTail));
+  EXPECT_TRUE(leaves_far_outcome(std::vector<OutcomeComparison>(c.begin(), c.begin() + 6), kFarOutcomeTail));
+  EXPECT_FALSE(leaves_far_outcome({}, kFarOutcomeTail));
+  // On samples of one skewed distribution (6 recorded trials against 12 replays, as
+  // FalsePositiveRateOnSamplesOfOneDistribution), how often a set of 32 outcomes has one far: the
+  // z of so few trials has a t's heavier tails, so more than the nominal 5 %, measured over
+  // 2000 sets (about 14 %). This is how often a consistent null has its candidates tried; a candidate must
+  // still beat it by the margin.
+  Rng rng(23);
+  int far = 0;
+  constexpr int kSets = 2000;
+  for (int s = 0; s < kSets; ++s) {
+    std::vector<OutcomeComparison> set;
+    for (int o = 0; o < 32; ++o) {
+      std::vector<double> recorded, replays;
+      for (int i = 0; i < 6; ++i) recorded.push_back(std::exp(rng.normal(0.0, 0.6)));
+      for (int i = 0; i < 12; ++i) replays.push_back(std::exp(rng.normal(0.0, 0.6)));
+      set.push_back(compare_outcome(recorded, replays, 0.0));
+    }
+    far += leaves_far_outcome(set, kFarOutcomeTail);
+  }
+  const double rate = static_cast<double>(far) / kSets;
+  std::printf("far-outcome rate %.4f\n", rate);
+  EXPECT_NEAR(rate, 0.14, 0.04);  // measured 0.1435; 4 binomial standard errors 0.031
+}
+
 TEST(EnsembleDetectability, ReplayNoiseIsTakenOffACandidatesSignal) {
   // A candidate's response is the difference of two replay samples, so noise alone gives it a
   // squared norm: about one per statistic here (variance = se^2), less what the two
