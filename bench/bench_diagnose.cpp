@@ -31,6 +31,7 @@
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
 #include "diagnose/conceal.hpp"
+#include "diagnose/ensemble.hpp"
 #include "diagnose_job.hpp"
 #include "io/clump_library.hpp"
 #include "io/recording_io.hpp"
@@ -192,6 +193,55 @@ std::string gate_line(const std::vector<GateCase>& cases, nlohmann::json& summar
       "{:.1f} s, of the others {:.1f} s; of every case without what followed its first comparison {:.1f} s\n",
       again.size(), cases.size(), gates.empty() ? std::string() : fmt::format(" ({})", fmt::join(gates, ", ")), held,
       median(again), median(once), median(without));
+}
+
+/// A case's reported null beyond the release horizon: whether it left the outcomes consistent
+/// yet one of them far out, by the library's own tests on the reported z (outcomes_consistent,
+/// leaves_far_outcome): a null whose candidates were tried for that one outcome.
+struct FarCase {
+  bool control = false, consistent_far = false;
+  std::string verdict;
+};
+FarCase far_case(const nlohmann::json& report, bool control) {
+  FarCase c{.control = control, .verdict = report.value("verdict", "?")};
+  if (!report.contains("ensemble") || !report["ensemble"].is_object()) return c;
+  const auto& e = report["ensemble"];
+  std::vector<OutcomeComparison> cmp;
+  if (e.contains("comparisons") && e["comparisons"].is_array()) {
+    for (const auto& j : e["comparisons"]) {
+      OutcomeComparison o;
+      o.statistic =
+          j.value("statistic", "mean") == statistic_name(Statistic::Spread) ? Statistic::Spread : Statistic::Mean;
+      o.z = j.value("z", 0.0);
+      cmp.push_back(o);
+    }
+  }
+  const std::size_t fitted =
+      e.contains("calibrated_here") && e["calibrated_here"].is_array() ? e["calibrated_here"].size() : 0;
+  c.consistent_far = !cmp.empty() && outcomes_consistent(cmp, fitted) && leaves_far_outcome(cmp, kFarOutcomeTail);
+  return c;
+}
+
+/// How many cases' nulls were consistent yet left one outcome far out (far_case), how many of
+/// them controls, and their verdicts: a markdown line, and summary["consistent_nulls_one_far"].
+std::string far_outcome_line(const std::vector<FarCase>& cases, nlohmann::json& summary) {
+  int far = 0, controls = 0;
+  std::map<std::string, int> verdicts;
+  for (const auto& c : cases) {
+    if (!c.consistent_far) continue;
+    ++far;
+    controls += c.control ? 1 : 0;
+    ++verdicts[c.verdict];
+  }
+  summary["consistent_nulls_one_far"] = {
+      {"cases", far}, {"of", cases.size()}, {"controls", controls}, {"verdicts", verdicts}};
+  std::vector<std::string> parts;
+  for (const auto& [verdict, n] : verdicts) parts.push_back(fmt::format("{} {}", verdict, n));
+  return fmt::format(
+      "consistent nulls that left one outcome far out (Sidak family tail < {:.2f}: their candidates tried): {}/{} "
+      "({} controls){}\n",
+      kFarOutcomeTail, far, cases.size(), controls,
+      parts.empty() ? std::string() : fmt::format("; verdicts {}", fmt::join(parts, ", ")));
 }
 
 /// The missed effects' advice counted (advice_for, the trials count left off): a markdown line,
@@ -389,6 +439,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   std::vector<std::pair<std::string, std::string>> misnamed;
   std::vector<std::optional<bool>> contradicts;
   std::vector<GateCase> gates;
+  std::vector<FarCase> fars;
   std::vector<std::pair<std::string, std::optional<bench::TwinShift>>> missed_twins;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
@@ -425,6 +476,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
     }
     seconds.push_back(j.value("seconds", NAN));
     gates.push_back(gate_case(j));
+    fars.push_back(far_case(j, effect == "none"));
     contradicts.push_back(advice_contradicts_verdict(j));
     table +=
         fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} | {} |\n", id,
@@ -461,6 +513,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   table += twin_line(missed_twins, summary);
   table += contradiction_line(contradicts, summary);
   table += gate_line(gates, summary);
+  table += far_outcome_line(fars, summary);
   std::cout << "\n" << table;
   summary.update(nlohmann::json{{"set", set.string()},
                                 {"effects", effects},
@@ -504,6 +557,7 @@ struct CaseScore {
   std::optional<bool> advice_contradicts;  ///< advice_contradicts_verdict
   std::string id;                          ///< the case's folder
   GateCase gate;                           ///< gate_case of its report
+  FarCase far;                             ///< far_case of its report
   std::optional<bench::TwinShift> twin;    ///< from its answer's twins (nullopt: a control, or none stored)
 };
 
@@ -535,6 +589,7 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   if (truth != "none") o.advice = advice_for(j, {truth});
   o.advice_contradicts = advice_contradicts_verdict(j);
   o.gate = gate_case(j);
+  o.far = far_case(j, truth == "none");
   if (j.contains("stage_seconds") && j["stage_seconds"].is_array()) {
     for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", NAN));
   }
@@ -563,8 +618,13 @@ std::string time_summary(const std::vector<CaseScore>& outcomes, nlohmann::json&
   summary["median_seconds_controls"] = median(controls);
   summary["median_seconds_effects"] = median(effects);
   std::vector<GateCase> gates;
-  for (const auto& o : outcomes) gates.push_back(o.gate);
+  std::vector<FarCase> fars;
+  for (const auto& o : outcomes) {
+    gates.push_back(o.gate);
+    fars.push_back(o.far);
+  }
   md += gate_line(gates, summary);
+  md += far_outcome_line(fars, summary);
   if (order.empty()) return md;
   md += "\n| stage | median share of a case |\n|---|---:|\n";
   for (const auto& stage : order) {
