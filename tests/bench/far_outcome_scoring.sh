@@ -8,6 +8,7 @@ set -u
 bench=$1
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+source "$(dirname "$0")/scoring_common.sh"
 report() {  # file verdict far-z other-z
   python3 - "$@" <<'PY'
 import json, sys
@@ -28,16 +29,14 @@ case_dir air_drag-strong air_drag air_drag -3.6 0
 case_dir adhesion-strong adhesion none 3 3
 case_dir control-01 none none 3.6 0
 case_dir control-02 none none 2.5 0
-"$bench" -o "$dir/gen" --full-set --controls 2 --existing-only >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }
-line=$(grep "consistent nulls that left one outcome far out" "$dir/gen/summary.md")
-expected="consistent nulls that left one outcome far out (Sidak family tail < 0.05: their candidates tried): 2/4 (1 controls); verdicts air_drag 1, none 1"
-[ "$line" = "$expected" ] || { echo "generated: $line"; exit 1; }
+score_generated "$dir/gen"
+expect_line "$dir/gen/summary.md" "consistent nulls that left one outcome far out" \
+  "consistent nulls that left one outcome far out (Sidak family tail < 0.05: their candidates tried): 2/4 (1 controls); verdicts air_drag 1, none 1"
 # An independent set scored with --recordings-set.
-for c in a b; do mkdir -p "$dir/set/case-$c" "$dir/out/case-$c"; done
-printf '{"cases":{"case-a":{"effect":"none"},"case-b":{"effect":"air_drag"}}}\n' >"$dir/set/ANSWERS.json"
+two_case_set
 report "$dir/out/case-a/report.json" none 2.5 0
 report "$dir/out/case-b/report.json" none 3.6 0
-"$bench" --recordings-set "$dir/set" -o "$dir/out" --existing-only >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }
+score_set
 python3 - "$dir/out/summary.json" <<'PY' || exit 1
 import json, sys
 s = json.load(open(sys.argv[1]))["consistent_nulls_one_far"]

@@ -8,6 +8,7 @@ set -u
 bench=$1
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+source "$(dirname "$0")/scoring_common.sh"
 report='{"verdict":"none","candidates":[],"undecidable":[],"seconds":%s,%s"fit":{"before":{"heldout_rms_mm":0.1},"after":{"heldout_rms_mm":0.1}}}\n'
 gate='"gate_retry":{"gate":"%s","value":1e-4,"threshold":5e-5,"replays_first":12,"replays_second":48,"replayed_first":100,"seconds_second":%s,"held":%s,"statement":"x"},'
 case_dir() {  # name effect seconds gate seconds_second [held]
@@ -22,19 +23,16 @@ case_dir air_drag-strong air_drag 10 ""
 case_dir adhesion-strong adhesion 100 null_consistency 60
 case_dir control-01 none 20 candidate_margin 5 true  # held: not compared again
 case_dir control-02 none 30 null_consistency 10
-"$bench" -o "$dir/gen" --full-set --controls 2 --existing-only >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }
-line=$(grep "compared again beyond the release horizon" "$dir/gen/summary.md")
-expected="compared again beyond the release horizon with more replays, the first draw at a gate: 3/4 (candidate_margin 1, null_consistency 2); of those, the gates' decisions held with more replays (not compared again): 1; median time of those at a gate 30.0 s, of the others 10.0 s; of every case without what followed its first comparison 17.5 s"
-[ "$line" = "$expected" ] || { echo "generated: $line"; exit 1; }
+score_generated "$dir/gen"
+expect_line "$dir/gen/summary.md" "compared again beyond the release horizon" \
+  "compared again beyond the release horizon with more replays, the first draw at a gate: 3/4 (candidate_margin 1, null_consistency 2); of those, the gates' decisions held with more replays (not compared again): 1; median time of those at a gate 30.0 s, of the others 10.0 s; of every case without what followed its first comparison 17.5 s"
 # An independent set scored with --recordings-set: no case at a gate.
-for c in a b; do mkdir -p "$dir/set/case-$c" "$dir/out/case-$c"; done
-printf '{"cases":{"case-a":{"effect":"none"},"case-b":{"effect":"air_drag"}}}\n' >"$dir/set/ANSWERS.json"
+two_case_set
 printf "$report" 5 "" >"$dir/out/case-a/report.json"
 printf "$report" 7 "$(printf "$gate" convergence 3 false)" >"$dir/out/case-b/report.json"
-"$bench" --recordings-set "$dir/set" -o "$dir/out" --existing-only >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }
-line=$(grep "compared again beyond the release horizon" "$dir/out/summary.md")
-[ "$line" = "compared again beyond the release horizon with more replays, the first draw at a gate: 1/2 (convergence 1); of those, the gates' decisions held with more replays (not compared again): 0; median time of those at a gate 7.0 s, of the others 5.0 s; of every case without what followed its first comparison 4.5 s" ] ||
-  { echo "recordings set: $line"; exit 1; }
+score_set
+expect_line "$dir/out/summary.md" "compared again beyond the release horizon" \
+  "compared again beyond the release horizon with more replays, the first draw at a gate: 1/2 (convergence 1); of those, the gates' decisions held with more replays (not compared again): 0; median time of those at a gate 7.0 s, of the others 5.0 s; of every case without what followed its first comparison 4.5 s"
 python3 - "$dir/out/summary.json" <<'PY' || exit 1
 import json, sys
 s = json.load(open(sys.argv[1]))["second_comparisons"]

@@ -1,0 +1,26 @@
+# Shared by the scorer tests (sourced; needs $bench and $dir): score stored reports with
+# --existing-only and read one summary line back.
+
+# score_generated OUT: the generated-set scorer over OUT (a --full-set run with 2 controls).
+score_generated() {
+  "$bench" -o "$1" --full-set --controls 2 --existing-only >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }
+}
+
+# two_case_set: an independent set (case-a a control, case-b air drag) in $dir/set, its reports'
+# folders in $dir/out.
+two_case_set() {
+  for c in a b; do mkdir -p "$dir/set/case-$c" "$dir/out/case-$c"; done
+  printf '{"cases":{"case-a":{"effect":"none"},"case-b":{"effect":"air_drag"}}}\n' >"$dir/set/ANSWERS.json"
+}
+
+# score_set: the --recordings-set scorer over two_case_set's reports.
+score_set() {
+  "$bench" --recordings-set "$dir/set" -o "$dir/out" --existing-only >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }
+}
+
+# expect_line FILE PREFIX EXPECTED: FILE's line starting with PREFIX is EXPECTED.
+expect_line() {
+  local line
+  line=$(grep "^$2" "$1")
+  [ "$line" = "$3" ] || { echo "$1: $line"; exit 1; }
+}
