@@ -856,6 +856,12 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
                         "near the margin to be tried)",
                         name, ens.trials));
         break;
+      case TrialsAdvice::TriedShortOfMargin:
+        more_trials.push_back(
+            fmt::format("{} more than {:.0f} (to first order these would do, yet tried with them it fell short of "
+                        "the margin)",
+                        name, ens.trials));
+        break;
     }
   }
   if (result.verdict != Verdict::None || (more_trials.empty() && no_more_trials.empty())) return;

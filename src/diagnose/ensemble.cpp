@@ -59,6 +59,8 @@ std::string_view trials_advice_name(TrialsAdvice advice) {
       return "more_trials";
     case TrialsAdvice::FirstOrderWouldDo:
       return "first_order_would_do";
+    case TrialsAdvice::TriedShortOfMargin:
+      return "tried_short_of_margin";
     case TrialsAdvice::ParticleModelDecides:
       return "particle_model_decides";
     case TrialsAdvice::Unexplained:
@@ -307,7 +309,9 @@ TrialsAdvice trials_advice(const Detectability& d, bool tried, bool undecidable,
   if ((tried && d.decides_absence()) || !undecidable) return TrialsAdvice::Decided;
   if (tried && d.strong_signal >= d.needed && d.strong_rejection >= d.needed) return TrialsAdvice::ParticleModelDecides;
   if (std::isfinite(d.trials_needed))
-    return d.trials_needed > trials_now ? TrialsAdvice::MoreTrials : TrialsAdvice::FirstOrderWouldDo;
+    return d.trials_needed > trials_now ? TrialsAdvice::MoreTrials
+           : tried                      ? TrialsAdvice::TriedShortOfMargin
+                                        : TrialsAdvice::FirstOrderWouldDo;
   if (d.misfit_limited) return TrialsAdvice::MisfitLimited;
   if (d.strong_signal > 0.0) return TrialsAdvice::Floor;
   return d.replay_noise > 0.0 ? TrialsAdvice::ReplayNoise : TrialsAdvice::NoResponse;

@@ -283,6 +283,9 @@ enum class TrialsAdvice {
   Decided,               ///< not undecidable: the outcomes (or the frames before them) decided it
   MoreTrials,            ///< trials_needed trials per set-up, more than recorded, would show it
   FirstOrderWouldDo,     ///< the trials recorded would, to first order, yet it was never tried
+  TriedShortOfMargin,    ///< the trials recorded would, to first order, yet tried with them it fell short of
+                         ///< the margin: the first-order count overstates what they show (lab-like case-08 read
+                         ///< after the impact, its candidates tried for one far outcome: 6 would do, delta-BIC -0.8)
   ParticleModelDecides,  ///< rejected by the margin, but within the null's misfit or the finer clump's move,
                          ///< or only by a clump a finer one showed inadequate (absences_on_explaining_clump),
                          ///< or under a verdict the particle model left undecidable (unconverged)
@@ -335,7 +338,8 @@ struct Detectability {
 /// they decide its absence, or when it is not `undecidable` (decided before the outcomes); else
 /// rejected within the particle model's misfit (tried, its strong signal and rejection both
 /// reaching the margin), or, from trials_needed against `trials_now`, more trials, none (the
-/// null's misfit, the floor, the replays' noise, no response) or the count recorded already.
+/// null's misfit, the floor, the replays' noise, no response) or the count recorded already (never
+/// tried, or tried with it and short of the margin).
 TrialsAdvice trials_advice(const Detectability& d, bool tried, bool undecidable, double trials_now);
 
 /// A candidate's response (its replays' statistics less the null's, from the same orientations),

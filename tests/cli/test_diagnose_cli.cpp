@@ -467,7 +467,8 @@ TEST(DiagnoseCli, AStrongOffsetTriedOnTheOutcomesIsNotCalledAbsent) {
   // 9f56c9a it was called absent while present.) Until 6e8e5c6 the rejection was 20.3 against
   // 15.0 needed, within 3.4 times the null's degrees of freedom (advice particle_model_decides);
   // with the four-square tilt's slip angle and slide time compared too it is 10.5 against 15.5
-  // (first_order_would_do). The rule itself: EnsembleDecided.TheAdviceOnMoreTrialsFollowsTheCandidatesDetectability.
+  // (first_order_would_do; tried_short_of_margin since a tried candidate is told apart). The rule itself:
+  // EnsembleDecided.TheAdviceOnMoreTrialsFollowsTheCandidatesDetectability.
   test::ScratchDir dir("diagnose-absence-in-dispersion-units");
   const auto made = test::run_command(fmt::format(
       "'{}' '{}' --clump adaptive-340 --effect com_offset --magnitude strong --surface Q235 --trials 4 --seed 1016 "

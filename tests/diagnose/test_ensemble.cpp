@@ -628,6 +628,9 @@ TEST(EnsembleDecided, TheAdviceOnMoreTrialsFollowsTheCandidatesDetectability) {
   // Not shown at 4 trials: a count beyond them, or the 4 recorded never tried.
   EXPECT_EQ(trials_advice(make(5.0, 0.0, 11.0, false, 0.0), true, true, 4.0), TrialsAdvice::MoreTrials);
   EXPECT_EQ(trials_advice(make(15.0, 0.0, 4.0, false, 0.0), false, true, 4.0), TrialsAdvice::FirstOrderWouldDo);
+  // ... or tried with them and short of the margin: the first-order count overstated.
+  EXPECT_EQ(trials_advice(make(15.0, 0.0, 4.0, false, 0.0), true, true, 4.0), TrialsAdvice::TriedShortOfMargin);
+  EXPECT_EQ(trials_advice_name(TrialsAdvice::TriedShortOfMargin), "tried_short_of_margin");
   // No count: the null's misfit, the floor, the replays' noise, no response.
   EXPECT_EQ(trials_advice(make(5.0, 0.0, kNone, true, 0.0), true, true, 4.0), TrialsAdvice::MisfitLimited);
   EXPECT_EQ(trials_advice(make(5.0, 0.0, kNone, false, 0.0), true, true, 4.0), TrialsAdvice::Floor);
@@ -678,8 +681,9 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
         << result.experiment;
     // The report carries each candidate's advice as the text gives it.
     const auto& reported = result.ensemble->detectability;
+    // (It was tried: where the count says the 8 trials would do, it fell short of the margin.)
     const TrialsAdvice by_count =
-        8.0 * 13.0 / k.strong_signal > 8.0 ? TrialsAdvice::MoreTrials : TrialsAdvice::FirstOrderWouldDo;
+        8.0 * 13.0 / k.strong_signal > 8.0 ? TrialsAdvice::MoreTrials : TrialsAdvice::TriedShortOfMargin;
     EXPECT_EQ(reported[0].advice, k.decided           ? TrialsAdvice::Decided
                                   : by_particle_model ? TrialsAdvice::ParticleModelDecides
                                                       : by_count);
