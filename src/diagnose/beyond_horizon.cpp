@@ -851,16 +851,11 @@ void say_what_outcomes_decide(DiagnoseResult& result, const EnsembleResult& ens)
         more_trials.push_back(fmt::format("{} about {:.0f}", name, d.trials_needed));
         break;
       case TrialsAdvice::FirstOrderWouldDo:
-        more_trials.push_back(
-            fmt::format("{} more than {:.0f} (to first order these would do, yet no candidate came "
-                        "near the margin to be tried)",
-                        name, ens.trials));
-        break;
       case TrialsAdvice::TriedShortOfMargin:
         more_trials.push_back(
-            fmt::format("{} more than {:.0f} (to first order these would do, yet tried with them it fell short of "
-                        "the margin)",
-                        name, ens.trials));
+            fmt::format("{} more than {:.0f} (to first order these would do, yet {})", name, ens.trials,
+                        advice == TrialsAdvice::TriedShortOfMargin ? "tried with them it fell short of the margin"
+                                                                   : "no candidate came near the margin to be tried"));
         break;
     }
   }
