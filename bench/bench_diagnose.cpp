@@ -197,7 +197,9 @@ std::string gate_line(const std::vector<GateCase>& cases, nlohmann::json& summar
 
 /// A case's reported null beyond the release horizon: whether it left the outcomes consistent
 /// yet one of them far out, by the library's own tests on the reported z (outcomes_consistent,
-/// leaves_far_outcome): a null whose candidates were tried for that one outcome.
+/// leaves_far_outcome). The report's ensemble is the comparison its verdict stands on: the
+/// diagnosed clump's, or a finer rung's when one replaced it, so on such a case this reads the
+/// rule on that rung's null, not on every null the diagnosis tried candidates for.
 struct FarCase {
   bool control = false, consistent_far = false;
   std::string verdict;
