@@ -196,10 +196,12 @@ std::string gate_line(const std::vector<GateCase>& cases, nlohmann::json& summar
 }
 
 /// A case's reported null beyond the release horizon: whether it left the outcomes consistent
-/// yet one of them far out, by the library's own tests on the reported z (outcomes_consistent,
-/// leaves_far_outcome). The report's ensemble is the comparison its verdict stands on: the
-/// diagnosed clump's, or a finer rung's when one replaced it, so on such a case this reads the
-/// rule on that rung's null, not on every null the diagnosis tried candidates for.
+/// yet one of them far out, as report.json's ensemble says (`null_fit`, written where the
+/// diagnosis decided which candidates to try). The report's ensemble is the comparison its
+/// verdict stands on: the diagnosed clump's, or a finer rung's when one replaced it, so on such a
+/// case this reads that rung's null, not every null the diagnosis tried candidates for. Reports
+/// older than the field (stored runs scored again with --existing-only) are classified from
+/// their reported z by the library's own null_fit.
 struct FarCase {
   bool control = false, consistent_far = false;
   std::string verdict;
@@ -208,6 +210,10 @@ FarCase far_case(const nlohmann::json& report, bool control) {
   FarCase c{.control = control, .verdict = report.value("verdict", "?")};
   if (!report.contains("ensemble") || !report["ensemble"].is_object()) return c;
   const auto& e = report["ensemble"];
+  if (e.contains("null_fit") && e["null_fit"].is_string()) {
+    c.consistent_far = e["null_fit"].get<std::string>() == null_fit_name(NullFit::OneFarOutcome);
+    return c;
+  }
   std::vector<OutcomeComparison> cmp;
   if (e.contains("comparisons") && e["comparisons"].is_array()) {
     for (const auto& j : e["comparisons"]) {
@@ -220,7 +226,7 @@ FarCase far_case(const nlohmann::json& report, bool control) {
   }
   const std::size_t fitted =
       e.contains("calibrated_here") && e["calibrated_here"].is_array() ? e["calibrated_here"].size() : 0;
-  c.consistent_far = !cmp.empty() && outcomes_consistent(cmp, fitted) && leaves_far_outcome(cmp, kFarOutcomeTail);
+  c.consistent_far = !cmp.empty() && null_fit(cmp, fitted) == NullFit::OneFarOutcome;
   return c;
 }
 

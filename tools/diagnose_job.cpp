@@ -244,6 +244,7 @@ nlohmann::json ensemble_json(const EnsembleReport& e) {
           {"detectability", detect},
           {"outcomes", e.outcomes},
           {"null_chi2", e.null_chi2},
+          {"null_fit", null_fit_name(e.null_fit)},
           {"calibrated", coefficients_json(e.calibrated)},
           {"calibrated_here", e.calibrated_here},
           {"comparisons", outcomes},

@@ -171,6 +171,7 @@ void report_ensemble(EnsembleReport& report, const EnsembleResult& ens, std::siz
   report.replays += ens.replays;
   report.outcomes = ens.outcomes;
   report.null_chi2 = ens.null_chi2;
+  report.null_fit = ens.null_fit;
   report.null_comparisons = ens.null_comparisons;
   report.calibrated = ens.calibrated;
   report.hypotheses = ens.hypotheses;

@@ -220,6 +220,7 @@ struct EnsembleReport {
   int outcomes = 0;                     ///< recorded means compared
   std::vector<std::string> recordings;  ///< names, indexed by OutcomeComparison::recording
   double null_chi2 = 0.0;
+  NullFit null_fit = NullFit::Consistent;           ///< how the null stands (decides the candidates tried)
   std::vector<OutcomeComparison> null_comparisons;  ///< the calibrated null against the recordings
   std::vector<SurfaceParameters> calibrated;        ///< the null's coefficients
   std::vector<std::string> calibrated_here;         ///< "surface:coefficient" calibrated on the outcomes

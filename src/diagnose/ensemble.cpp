@@ -1190,6 +1190,23 @@ bool leaves_far_outcome(const std::vector<OutcomeComparison>& comparisons, doubl
   return family < family_tail;
 }
 
+NullFit null_fit(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted) {
+  if (!outcomes_consistent(comparisons, fitted)) return NullFit::Inconsistent;
+  return leaves_far_outcome(comparisons, kFarOutcomeTail) ? NullFit::OneFarOutcome : NullFit::Consistent;
+}
+
+std::string_view null_fit_name(NullFit fit) {
+  switch (fit) {
+    case NullFit::Consistent:
+      return "consistent";
+    case NullFit::OneFarOutcome:
+      return "one_far_outcome";
+    case NullFit::Inconsistent:
+      return "inconsistent";
+  }
+  return "?";
+}
+
 Result<std::vector<OutcomeComparison>> compare_model(const Evaluator& ev, const Model& model,
                                                      const std::vector<TrialScore>& scores,
                                                      const EnsembleOptions& options, int& replays,
@@ -1237,8 +1254,9 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
   result.null_chi2 = chi2_of(result.null_comparisons);
   const Eigen::VectorXd null_means = means_of(result.null_comparisons);
   const auto library = effect_library();
-  const bool unexplained = !outcomes_consistent(result.null_comparisons, free.size());
-  const bool far = unexplained || leaves_far_outcome(result.null_comparisons, kFarOutcomeTail);
+  result.null_fit = null_fit(result.null_comparisons, free.size());
+  const bool unexplained = result.null_fit == NullFit::Inconsistent;
+  const bool far = result.null_fit != NullFit::Consistent;
   std::vector<Proposal> proposals;
   CandidatesTried tried = CandidatesTried::All;
   if (unexplained && options.candidates_when_inconsistent) {

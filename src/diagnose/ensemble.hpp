@@ -222,6 +222,16 @@ bool leaves_far_outcome(const std::vector<OutcomeComparison>& comparisons, doubl
 /// The family-wise tail leaves_far_outcome is asked with.
 constexpr double kFarOutcomeTail = 0.05;
 
+/// How a calibrated null stands against the recorded outcomes: what decides whether its
+/// candidates are tried (compare_ensembles), and what report.json's ensemble says of it.
+enum class NullFit {
+  Consistent,     ///< outcomes_consistent, no outcome far out: candidates only where pursued
+  OneFarOutcome,  ///< outcomes_consistent, yet leaves_far_outcome at kFarOutcomeTail
+  Inconsistent,   ///< not outcomes_consistent
+};
+NullFit null_fit(const std::vector<OutcomeComparison>& comparisons, std::size_t fitted);
+std::string_view null_fit_name(NullFit fit);
+
 /// The two chi^2 tests outcomes_consistent makes: the means' (over their number less `fitted`, at
 /// least one) and the spreads' (over their number), each with its upper tail (1 and no degrees of
 /// freedom when there are none of that statistic).
@@ -387,6 +397,7 @@ struct EnsembleResult {
   std::vector<SurfaceParameters> calibrated;  ///< the null: free coefficients fitted to the outcomes
   std::vector<OutcomeComparison> null_comparisons;
   double null_chi2 = 0.0;
+  NullFit null_fit = NullFit::Consistent;  ///< null_fit of null_comparisons
   int outcomes = 0;
   std::vector<EnsembleHypothesis> hypotheses;  ///< those the surrogate found worth new replays
   std::vector<Detectability> detectability;    ///< per candidate tried

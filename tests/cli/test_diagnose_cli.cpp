@@ -248,6 +248,9 @@ TEST(DiagnoseCli, AnotherSimulatorsTuberControlIsConsistentWithTheDiagnosedClump
   const std::string calibrated = j["ensemble"]["calibrated_here"].dump();
   EXPECT_NE(calibrated.find("soil:restitution"), std::string::npos) << calibrated;
   EXPECT_NE(calibrated.find("Q235:restitution"), std::string::npos) << calibrated;
+  // A consistent null: its standing is written where the candidates were decided on.
+  const std::string fit = j["ensemble"].value("null_fit", "");
+  EXPECT_TRUE(fit == "consistent" || fit == "one_far_outcome") << fit;
   // Where the time went: the stages that ran, in their order, adding up to the whole (within
   // the report's own bookkeeping, 1 s).
   const std::vector<std::string> order{"load_and_noise", "release_state",  "baseline",     "locate", "candidates",

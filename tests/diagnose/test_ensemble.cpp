@@ -215,6 +215,13 @@ TEST(EnsembleComparison, AFarOutcomeIsJudgedAmongAllTheComparisons) {
   EXPECT_FALSE(leaves_far_outcome(c, kFarOutcomeTail));
   EXPECT_TRUE(leaves_far_outcome(std::vector<OutcomeComparison>(c.begin(), c.begin() + 6), kFarOutcomeTail));
   EXPECT_FALSE(leaves_far_outcome({}, kFarOutcomeTail));
+  // What the null is said to be: consistent yet one far (z 3.6 of 32), consistent, and
+  // inconsistent (every mean at 3: chi^2 288 over 32).
+  c[5].z = 3.6;
+  EXPECT_EQ(null_fit(c, 0), NullFit::OneFarOutcome);
+  c[5].z = -3.0;
+  EXPECT_EQ(null_fit(c, 0), NullFit::Consistent);
+  EXPECT_EQ(null_fit(std::vector<OutcomeComparison>(32, OutcomeComparison{.z = 3.0}), 0), NullFit::Inconsistent);
   // On samples of one skewed distribution (6 recorded trials against 12 replays, as
   // FalsePositiveRateOnSamplesOfOneDistribution), how often a set of 32 outcomes has one far: the
   // z of so few trials has a t's heavier tails, so more than the nominal 5 %, measured over
