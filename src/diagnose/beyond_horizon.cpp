@@ -586,7 +586,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
   // A consistent coarse null is checked too when a candidate beat it (judge_ensembles): then the
   // question is whether that candidate only absorbed the coarse clump's share. (e is the report,
   // replaced when a candidate passes.)
-  const Coarse coarse{e.null_chi2, e.outcomes, outcomes_consistent(e.null_comparisons, free.size())};
+  const Coarse coarse{e.null_chi2, e.outcomes, e.null_fit != NullFit::Inconsistent};
   check.worst_phase_chi2_per_value = largest_z2(e.null_comparisons);
   // The previous rung's calibrated null: its model and its comparisons.
   Model previous_model = baseline;
@@ -658,7 +658,7 @@ Result<bool> finer_clump_explains_outcomes(Context& c, DiagnoseResult& result, c
     c.evaluations += fine->replays;
     rung.chi2_per_value = fine->null_chi2 / std::max(1, fine->outcomes);
     rung.worst_phase_chi2_per_value = largest_z2(fine->null_comparisons);
-    rung.explains = fine->outcomes == coarse.outcomes && outcomes_consistent(fine->null_comparisons, free.size());
+    rung.explains = fine->outcomes == coarse.outcomes && fine->null_fit != NullFit::Inconsistent;
     if (rung.explains && k + 1 == c.finer.size()) {
       // The finest clump at hand: nothing finer to check its agreement against.
       const bool named =
@@ -739,7 +739,7 @@ Result<void> outcomes_beyond_null(Context& c, DiagnoseResult& result, const Mode
                                   const std::vector<Effect>& candidates, const EnsembleOptions& eo,
                                   int max_evaluations) {
   const EnsembleReport& e = *result.ensemble;
-  if (outcomes_consistent(e.null_comparisons, free.size())) return {};
+  if (e.null_fit != NullFit::Inconsistent) return {};
   const double dof = null_dof(e.outcomes, free.size());
   auto explained = finer_clump_explains_outcomes(c, result, baseline, full_scores, free, candidates, eo,
                                                  max_evaluations, std::nullopt);

@@ -160,7 +160,7 @@ GateCheck check_consistency(const EnsembleReport& e, const std::vector<OutcomeCo
                    .first = g.retry.value,
                    .second = g.spreads ? t.spreads.tail : t.means.tail,
                    .threshold = g.retry.threshold,
-                   .held = outcomes_consistent(null, fitted) == outcomes_consistent(e.null_comparisons, fitted)};
+                   .held = outcomes_consistent(null, fitted) == (e.null_fit != NullFit::Inconsistent)};
 }
 
 /// The candidate's margin judged again: its delta-BIC over the null (`null`, its comparisons on the
