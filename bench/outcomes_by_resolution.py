@@ -4,8 +4,10 @@
 Generates the same trials (seed, coefficients, release orientations) with each clump given,
 by `clumpforge-conceal` (no effect, orientation none), and prints per recording the mean and
 sd over the trials of the distance from the first tracked point to the rest point (the
-median of the last ten frames: a drop's drift, a roll's path) and of the summary the
-recording states (a drop's rebound height, a roll's distance on the flat), with each clump's
+median of the last ten frames: a drop's drift, a roll's path), of the summary the
+recording states (a drop's rebound height, a roll's distance on the flat) and of a drop's
+rebound read from its track three ways (rebound_readings: as the diagnosis reads it, above
+the first impact's low point, and from the falling and rising parabolas), with each clump's
 move from the one before in standard errors of a recorded mean of 8 trials. The diagnosis's step 0
 chooses the resolution inside the fitted windows; this shows how far the outcomes beyond them
 are from converged (docs/diagnose.md, Limits).
@@ -25,19 +27,90 @@ import sys
 import tempfile
 
 
-def rest_distance(track: pathlib.Path) -> float:
-    rows = []
+def track_rows(track: pathlib.Path) -> tuple:
+    """A track's frames with finite coordinates: (t, x, z) lists."""
+    t, x, z = [], [], []
     with track.open() as f:
         for r in csv.DictReader(f):
             try:
-                x, z = float(r["x_m"]), float(r["z_m"])
+                row = float(r["t_s"]), float(r["x_m"]), float(r["z_m"])
             except (KeyError, ValueError):
                 continue
-            if math.isfinite(x) and math.isfinite(z):
-                rows.append(x)
-    if len(rows) < 10:
+            if all(math.isfinite(v) for v in row):
+                for column, v in zip((t, x, z), row):
+                    column.append(v)
+    return t, x, z
+
+
+def rest_distance(track: pathlib.Path) -> float:
+    _, x, _ = track_rows(track)
+    if len(x) < 10:
         return math.nan
-    return abs(statistics.median(rows[-10:]) - rows[0])
+    return abs(statistics.median(x[-10:]) - x[0])
+
+
+G = 9.81
+
+
+def first_impact(z: list, moved: float):
+    """The index of the lowest frame before the path first rises `moved` above it (the
+    diagnosis's first_impact); None when it never does."""
+    low, at = z[0], 0
+    for k, v in enumerate(z):
+        if v < low:
+            low, at = v, k
+        elif v > low + moved:
+            return at
+    return None
+
+
+def free_fall_fit(t: list, z: list) -> tuple:
+    """(a, b) of z + g t^2 / 2 = a + b t, least squares: a free flight's parabola with g known."""
+    y = [zi + 0.5 * G * ti * ti for ti, zi in zip(t, z)]
+    n, st, sy = len(t), sum(t), sum(y)
+    stt, sty = sum(ti * ti for ti in t), sum(ti * yi for ti, yi in zip(t, y))
+    b = (n * sty - st * sy) / (n * stt - st * st)
+    return (sy - b * st) / n, b
+
+
+def parabolas_rise(t: list, z: list, impact: int, apex: int) -> float:
+    """The rise from the first impact to the apex of the flight after it, from the falling and
+    rising parabolas (g known) and where they meet: g (t_apex - t_meet)^2 / 2, free of where the
+    frames fall about the contact. NaN when either flight has under five frames clear of the
+    contact, or the parabolas meet more than two frames away from it (a rock or a roll on the
+    plate, not a flight)."""
+    dt = (t[-1] - t[0]) / max(1, len(t) - 1)
+    falling = [k for k in range(impact - 2) if z[k] < z[0] - 2e-3]
+    end = apex
+    while end + 1 < len(z) and z[end + 1] > z[impact + 2]:
+        end += 1
+    rising = list(range(impact + 2, end + 1))
+    if len(falling) < 5 or len(rising) < 5:
+        return math.nan
+    af, bf = free_fall_fit([t[k] for k in falling], [z[k] for k in falling])
+    ar, br = free_fall_fit([t[k] for k in rising], [z[k] for k in rising])
+    if bf == br:
+        return math.nan
+    meet = (ar - af) / (bf - br)
+    if not t[falling[-1]] - 2 * dt <= meet <= t[rising[0]] + 2 * dt:
+        return math.nan
+    return 0.5 * G * (br / G - meet) ** 2
+
+
+def rebound_readings(t: list, z: list, moved: float = 1e-3) -> dict:
+    """A drop's rebound [m] read three ways: the highest point after the first impact above the rest
+    point (the median of the last ten frames), as the diagnosis reads it; above the impact's lowest
+    frame (up to a frame's fall, v_impact / fps, short of the contact); from the parabolas
+    (parabolas_rise). 0 for every reading when the path never rises `moved`."""
+    names = ("above the rest point", "above the impact's low point", "from the parabolas")
+    if len(z) < 10:
+        return dict.fromkeys(names, math.nan)
+    impact = first_impact(z, moved)
+    if impact is None:
+        return dict.fromkeys(names, 0.0)
+    apex = max(range(impact, len(z)), key=lambda k: z[k])
+    rest = statistics.median(z[-10:])
+    return dict(zip(names, (max(0.0, z[apex] - rest), z[apex] - z[impact], parabolas_rise(t, z, impact, apex))))
 
 
 # Each recording's summary as the recording states it (recording-format.md), in mm.
@@ -57,7 +130,7 @@ def finite(values: list) -> list:
 def add(results: dict, row: str, name: str, values_m: list) -> None:
     values = finite(values_m)
     results.setdefault(row, {})[name] = {
-        "mean_mm": 1e3 * statistics.mean(values),
+        "mean_mm": 1e3 * statistics.mean(values) if values else math.nan,
         "sd_mm": 1e3 * statistics.stdev(values) if len(values) > 1 else math.nan,
         "trials": len(values),
     }
@@ -82,6 +155,11 @@ def outcomes(a, library: str, name: str, restitution: float, out: pathlib.Path) 
     for rec in ("drop-0.2m", "drop-1m", "roll-100mm"):
         rows[f"{rec} rest distance"] = [rest_distance(t) for t in sorted((out / rec).glob("trial-*.csv"))]
         rows[f"{rec} {SUMMARY[rec][0]}"] = summaries(out / rec, SUMMARY[rec][1])
+        if rec.startswith("drop"):
+            for track in sorted((out / rec).glob("trial-*.csv")):
+                t, _, z = track_rows(track)
+                for reading, value in rebound_readings(t, z).items():
+                    rows.setdefault(f"{rec} rebound {reading}", []).append(value)
     return rows
 
 
@@ -154,12 +232,17 @@ def main() -> int:
     print("|---|" + "---:|" * len(names))
     if a.match:
         print("| restitution | " + " | ".join(f"{restitutions[n]:.4f}" for n in names) + " |")
+    def cell(v: dict) -> str:
+        fewer = f" [{v['trials']} trials]" if v["trials"] != a.trials else ""
+        return f"{v['mean_mm']:.1f} +- {v['sd_mm']:.1f}{fewer}"
+
     for rec, by in results.items():
-        cells = [f"{by[names[0]]['mean_mm']:.1f} +- {by[names[0]]['sd_mm']:.1f}"]
+        cells = [cell(by[names[0]])]
         for before, here in zip(names, names[1:]):
-            cells.append(f"{by[here]['mean_mm']:.1f} +- {by[here]['sd_mm']:.1f} ({move_in_se(by[before], by[here]):+.1f})")
+            cells.append(f"{cell(by[here])} ({move_in_se(by[before], by[here]):+.1f})")
         print(f"| {rec} | " + " | ".join(cells) + " |")
-    print("(in brackets: the move from the clump before, in standard errors of a recorded mean of 8 trials)")
+    print("(in brackets: the move from the clump before, in standard errors of a recorded mean of 8 trials; in square "
+          "brackets: the trials a reading was had from, where fewer than all)")
     return 0
 
 
