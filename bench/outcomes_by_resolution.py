@@ -79,6 +79,8 @@ def parabolas_rise(t: list, z: list, impact: int, apex: int) -> float:
     frames fall about the contact. NaN when either flight has under five frames clear of the
     contact, or the parabolas meet more than two frames away from it (a rock or a roll on the
     plate, not a flight)."""
+    if impact + 2 >= len(z):
+        return math.nan
     dt = (t[-1] - t[0]) / max(1, len(t) - 1)
     falling = [k for k in range(impact - 2) if z[k] < z[0] - 2e-3]
     end = apex
