@@ -218,6 +218,7 @@ nlohmann::json ensemble_json(const EnsembleReport& e) {
       values[spec.parameters[k].name] = h.values[k];
     tried.push_back({{"name", spec.name},
                      {"values", values},
+                     {"calibrated", coefficients_json(h.base)},
                      {"chi2", h.chi2},
                      {"dispersion", h.dispersion},
                      {"delta_bic", h.delta_bic()},

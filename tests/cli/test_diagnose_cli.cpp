@@ -334,6 +334,12 @@ void expect_speed_dependent_restitution_named(const nlohmann::json& j) {
     found = true;
     EXPECT_GE(h["delta_bic"].get<double>(), 10.0);
     EXPECT_GE(h["fresh_delta_bic"].get<double>(), 10.0);
+    // The coefficients it was calibrated with, beside its own values: each surface's restitution.
+    for (const char* surface : {"Q235", "soil"}) {
+      const double e = h["calibrated"][surface].value("restitution", -1.0);
+      EXPECT_GT(e, 0.0) << surface << " " << h["calibrated"].dump();
+      EXPECT_LT(e, 1.0) << surface << " " << h["calibrated"].dump();
+    }
   }
   EXPECT_TRUE(found) << j["ensemble"]["hypotheses"].dump();
   // The 128-sphere clump was replayed with its coefficients refitted before the name was given.
