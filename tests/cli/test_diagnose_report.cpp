@@ -29,14 +29,14 @@ TEST(DiagnoseReport, TheEnsembleSaysHowItsNullStandsAndWhatEachCandidateWasCalib
   e.outcomes = 16;
   e.null_chi2 = 20.0;
   e.calibrated = {surface("Q235", 0.557)};
+  EnsembleHypothesis h;
+  h.effect = Effect::ViscoelasticRestitution;
+  h.values = {0.32};
+  h.base = {surface("Q235", 0.64)};
+  h.chi2 = 12.0;
+  e.hypotheses = {h};
   for (const NullFit fit : {NullFit::Consistent, NullFit::OneFarOutcome, NullFit::Inconsistent}) {
     e.null_fit = fit;
-    EnsembleHypothesis h;
-    h.effect = Effect::ViscoelasticRestitution;
-    h.values = {0.32};
-    h.base = {surface("Q235", 0.64)};
-    h.chi2 = 12.0;
-    e.hypotheses = {h};
     result.ensemble = e;
     const nlohmann::json j = cli::diagnosis_report_json(result, "adaptive-256");
     const auto& ens = j.at("ensemble");
