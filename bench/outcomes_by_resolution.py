@@ -42,8 +42,8 @@ def track_rows(track: pathlib.Path) -> tuple:
     return t, x, z
 
 
-def rest_distance(track: pathlib.Path) -> float:
-    _, x, _ = track_rows(track)
+def rest_distance(x: list) -> float:
+    """How far a track's x ends (the median of its last ten frames) from where it began."""
     if len(x) < 10:
         return math.nan
     return abs(statistics.median(x[-10:]) - x[0])
@@ -101,9 +101,10 @@ def parabolas_rise(t: list, z: list, impact: int, apex: int) -> float:
 
 def rebound_readings(t: list, z: list, moved: float = 1e-3) -> dict:
     """A drop's rebound [m] read three ways: the highest point after the first impact above the rest
-    point (the median of the last ten frames), as the diagnosis reads it; above the impact's lowest
-    frame (up to a frame's fall, v_impact / fps, short of the contact); from the parabolas
-    (parabolas_rise). 0 for every reading when the path never rises `moved`."""
+    point (the median of the last ten frames), as the diagnosis's measure_outcomes reads it (its
+    `moved` is max(1 mm, 6 noise sds): 1 mm at the cameras compared here); above the impact's lowest
+    frame (at most v_down v_up / (v_down + v_up) / fps above a brief contact, by the frames' phase);
+    from the parabolas (parabolas_rise). 0 for every reading when the path never rises `moved`."""
     names = ("above the rest point", "above the impact's low point", "from the parabolas")
     if len(z) < 10:
         return dict.fromkeys(names, math.nan)
@@ -155,11 +156,11 @@ def outcomes(a, library: str, name: str, restitution: float, out: pathlib.Path) 
         raise RuntimeError(done.stderr.strip())
     rows = {}
     for rec in ("drop-0.2m", "drop-1m", "roll-100mm"):
-        rows[f"{rec} rest distance"] = [rest_distance(t) for t in sorted((out / rec).glob("trial-*.csv"))]
+        tracks = [track_rows(track) for track in sorted((out / rec).glob("trial-*.csv"))]
+        rows[f"{rec} rest distance"] = [rest_distance(x) for _, x, _ in tracks]
         rows[f"{rec} {SUMMARY[rec][0]}"] = summaries(out / rec, SUMMARY[rec][1])
         if rec.startswith("drop"):
-            for track in sorted((out / rec).glob("trial-*.csv")):
-                t, _, z = track_rows(track)
+            for t, _, z in tracks:
                 for reading, value in rebound_readings(t, z).items():
                     rows.setdefault(f"{rec} rebound {reading}", []).append(value)
     return rows
