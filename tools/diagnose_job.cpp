@@ -225,6 +225,7 @@ nlohmann::json ensemble_json(const EnsembleReport& e) {
                      {"fresh_delta_bic", finite_or_null(h.fresh_delta_bic)},
                      {"first_delta_bic", finite_or_null(h.first_delta_bic)},
                      {"plausible", h.plausible},
+                     {"start", calibration_start_name(h.start)},
                      {"comparisons", comparisons_json(h.comparisons)}});
   }
   nlohmann::json detect = nlohmann::json::array();

@@ -254,6 +254,11 @@ int replays_per_recording(int replays, std::size_t trials);
 std::vector<Eigen::Quaterniond> ensemble_orientations(LabTest test, const std::vector<Eigen::Quaterniond>& recorded,
                                                       const EnsembleOptions& options, std::uint64_t stream);
 
+/// Where a candidate's calibration started (confirm): at the surrogate's proposal, or with
+/// its level held at a library magnitude while the free coefficients were calibrated under it.
+enum class CalibrationStart { Proposal, HeldLevel };
+std::string_view calibration_start_name(CalibrationStart start);
+
 /// A candidate effect judged on the outcomes.
 struct EnsembleHypothesis {
   Effect effect = Effect::AirDrag;
@@ -277,7 +282,8 @@ struct EnsembleHypothesis {
     return std::isfinite(fresh_delta_bic) ? std::max(first_delta_bic, fresh_delta_bic) : first_delta_bic;
   }
   bool plausible = false;
-  std::vector<OutcomeComparison> comparisons;  ///< its replays against the recordings
+  CalibrationStart start = CalibrationStart::Proposal;  ///< the start whose calibration was kept
+  std::vector<OutcomeComparison> comparisons;           ///< its replays against the recordings
 };
 
 /// A rejection decides an effect absent only beyond this many times the next finer clump's

@@ -21,7 +21,8 @@ SurfaceParameters surface(const char* name, double restitution) {
 
 // The null's standing (NullFit) becomes its name only here; each candidate tried carries the
 // coefficients it was calibrated with beside its own values (the strong viscoelastic case of 36
-// trials per set-up reached an exponent of 0.32 on coefficients the report did not show).
+// trials per set-up reached an exponent of 0.32 on coefficients the report did not show), and
+// which start of its calibration was kept (CalibrationStart).
 TEST(DiagnoseReport, TheEnsembleSaysHowItsNullStandsAndWhatEachCandidateWasCalibratedWith) {
   DiagnoseResult result;
   result.verdict = Verdict::None;
@@ -34,7 +35,9 @@ TEST(DiagnoseReport, TheEnsembleSaysHowItsNullStandsAndWhatEachCandidateWasCalib
   h.values = {0.32};
   h.base = {surface("Q235", 0.64)};
   h.chi2 = 12.0;
-  e.hypotheses = {h};
+  EnsembleHypothesis held = h;
+  held.start = CalibrationStart::HeldLevel;
+  e.hypotheses = {h, held};
   for (const NullFit fit : {NullFit::Consistent, NullFit::OneFarOutcome, NullFit::Inconsistent}) {
     e.null_fit = fit;
     result.ensemble = e;
@@ -46,6 +49,8 @@ TEST(DiagnoseReport, TheEnsembleSaysHowItsNullStandsAndWhatEachCandidateWasCalib
     EXPECT_EQ(tried.at("name"), "viscoelastic_restitution");
     EXPECT_DOUBLE_EQ(tried.at("values").at("exponent").get<double>(), 0.32);
     EXPECT_DOUBLE_EQ(tried.at("calibrated").at("Q235").at("restitution").get<double>(), 0.64);
+    EXPECT_EQ(tried.at("start"), "proposal");
+    EXPECT_EQ(ens.at("hypotheses").at(1).at("start"), "held_level");
   }
   EXPECT_EQ(null_fit_name(NullFit::OneFarOutcome), "one_far_outcome");
 }
