@@ -52,16 +52,15 @@ def rest_distance(x: list) -> float:
 G = 9.81
 
 
-def first_impact(z: list, moved: float):
-    """The index of the lowest frame before the path first rises `moved` above it (the
-    diagnosis's first_impact); None when it never does."""
-    low, at = z[0], 0
-    for k, v in enumerate(z):
-        if v < low:
-            low, at = v, k
-        elif v > low + moved:
-            return at
-    return None
+def library():
+    """The clumpforge Python module (PYTHONPATH, else the build tree's build/python): the track
+    readings the diagnosis makes are its, not copied here."""
+    try:
+        import clumpforge
+    except ImportError:
+        sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "build" / "python"))
+        import clumpforge
+    return clumpforge
 
 
 def free_fall_fit(t: list, z: list) -> tuple:
@@ -99,21 +98,23 @@ def parabolas_rise(t: list, z: list, impact: int, apex: int) -> float:
     return 0.5 * G * (br / G - meet) ** 2
 
 
-def rebound_readings(t: list, z: list, moved: float = 1e-3) -> dict:
+def rebound_readings(t: list, x: list, z: list, moved: float = 1e-3) -> dict:
     """A drop's rebound [m] read three ways: the highest point after the first impact above the rest
-    point (the median of the last ten frames), as the diagnosis's measure_outcomes reads it (its
+    point (the median of the last ten frames), read by the diagnosis's own measure_outcomes (its
     `moved` is max(1 mm, 6 noise sds): 1 mm at the cameras compared here); above the impact's lowest
     frame (at most v_down v_up / (v_down + v_up) / fps above a brief contact, by the frames' phase);
     from the parabolas (parabolas_rise). 0 for every reading when the path never rises `moved`."""
     names = ("above the rest point", "above the impact's low point", "from the parabolas")
     if len(z) < 10:
         return dict.fromkeys(names, math.nan)
-    impact = first_impact(z, moved)
-    if impact is None:
+    cf = library()
+    impact_time = cf.first_impact_time(t, x, z, moved)
+    if impact_time is None:
         return dict.fromkeys(names, 0.0)
+    impact = t.index(impact_time)
     apex = max(range(impact, len(z)), key=lambda k: z[k])
-    rest = statistics.median(z[-10:])
-    return dict(zip(names, (max(0.0, z[apex] - rest), z[apex] - z[impact], parabolas_rise(t, z, impact, apex))))
+    above_rest = cf.measure_outcomes(cf.LabTest.drop, t, x, z, moved)[cf.Outcome.rebound_height]
+    return dict(zip(names, (above_rest, z[apex] - z[impact], parabolas_rise(t, z, impact, apex))))
 
 
 # Each recording's summary as the recording states it (recording-format.md), in mm.
@@ -160,8 +161,8 @@ def outcomes(a, library: str, name: str, restitution: float, out: pathlib.Path) 
         rows[f"{rec} rest distance"] = [rest_distance(x) for _, x, _ in tracks]
         rows[f"{rec} {SUMMARY[rec][0]}"] = summaries(out / rec, SUMMARY[rec][1])
         if rec.startswith("drop"):
-            for t, _, z in tracks:
-                for reading, value in rebound_readings(t, z).items():
+            for t, x, z in tracks:
+                for reading, value in rebound_readings(t, x, z).items():
                     rows.setdefault(f"{rec} rebound {reading}", []).append(value)
     return rows
 

@@ -1,6 +1,8 @@
 /// The diagnosis: which physics the model leaves out, from recorded tracks.
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "common.hpp"
 #include "diagnose/diagnose.hpp"
 
@@ -257,12 +259,54 @@ DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, con
   return run_released(progress, [&](const RunContext& c) { return diagnose(clump, table, list, names, options, c); });
 }
 
+PathSample path_of(std::vector<double> t, std::vector<double> x, std::vector<double> z) {
+  if (t.size() != x.size() || t.size() != z.size())
+    raise({ErrorCode::InvalidArgument,
+           fmt::format("t, x and z must be as long (they are {}, {} and {})", t.size(), x.size(), z.size())});
+  return {std::move(t), std::move(x), std::move(z)};
+}
+
+/// The outcomes the diagnosis compares beyond the release horizon, read from one path as it reads
+/// a recorded track and a replay (measure_outcomes): a script that reads tracks the same way
+/// calls this, not a copy of it.
+void bind_outcomes(py::module_& m) {
+  m.def(
+      "measure_outcomes",
+      [](LabTest test, std::vector<double> t, std::vector<double> x, std::vector<double> z, double moved,
+         double tilt_rate_deg_per_s, std::optional<double> drift_after_impact) {
+        const PathSample path = path_of(std::move(t), std::move(x), std::move(z));
+        py::dict out;
+        for (const auto& [outcome, value] :
+             measure_outcomes(test, path, moved, tilt_rate_deg_per_s, drift_after_impact.value_or(std::nan(""))))
+          out[py::cast(outcome)] = value;
+        return out;
+      },
+      py::arg("test"), py::arg("t"), py::arg("x"), py::arg("z"), py::arg("moved") = 1e-3,
+      py::arg("tilt_rate_deg_per_s") = 0.0, py::arg("drift_after_impact") = py::none(),
+      "The outcomes `clumpforge diagnose` compares beyond the release horizon, read from one path as it "
+      "reads a recorded track and a replay: {Outcome: value} (a drop's rebound height above the rest point "
+      "and drift [m]; a roll's distance [m] and time to rest [s]; a tilt's slip angle [deg] and slide time "
+      "[s]). t [s] since release (a tilt: since the plate started turning), x from the release point and z "
+      "the tracked point's height [m]; moved [m] the displacement that counts as motion (the diagnosis uses "
+      "max(1 mm, 6 noise sds)); drift_after_impact [s]: a drop's drift read that long after the first impact "
+      "instead of at the track's end. Empty for a path of fewer than ten frames.");
+  m.def(
+      "first_impact_time",
+      [](std::vector<double> t, std::vector<double> x, std::vector<double> z, double moved) {
+        return first_impact_time(path_of(std::move(t), std::move(x), std::move(z)), moved);
+      },
+      py::arg("t"), py::arg("x"), py::arg("z"), py::arg("moved") = 1e-3,
+      "[s] A drop's first impact as the diagnosis finds it: the lowest point before the path first rises "
+      "`moved` [m] above its running minimum; None when it never does.");
+}
+
 }  // namespace
 
 void bind_diagnose(py::module_& m) {
   bind_enums(m);
   bind_parts(m);
   bind_result(m);
+  bind_outcomes(m);
   m.def("diagnose", &run_diagnosis, py::arg("clump"), py::arg("recordings"),
         py::arg("effects") = std::vector<std::string>{}, py::arg("materials") = py::none(),
         py::arg("orientation_prior_deg") = 15.0, py::arg("model_accuracy") = 3e-4, py::arg("ensemble_replays") = 12,

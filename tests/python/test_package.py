@@ -267,3 +267,43 @@ def test_figures_draw_a_diagnosis_folder_with_lost_frames(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "clumpforge.figures", "study", str(tmp_path)], capture_output=True,
                          text=True)
     assert bad.returncode == 1 and "study.json" in bad.stderr
+
+
+def test_the_diagnosis_reads_a_drop_and_a_roll_as_it_reads_their_tracks():
+    """measure_outcomes on analytic paths at 1000 fps: a drop from 0.2 m onto a contact at 5 mm,
+    a rebound at 0.5 m/s (rise v^2 / 2g), rest at 4 mm and 30 mm along; a roll that comes to rest
+    120 mm along at 0.3 s."""
+    g = 9.81
+    t = [k * 1e-3 for k in range(600)]
+    fall = (2 * 0.195 / g) ** 0.5
+    flight = 2 * 0.5 / g
+
+    def z_at(s):
+        if s < fall:
+            return 0.2 - 0.5 * g * s * s
+        if s < fall + flight:
+            u = s - fall
+            return 0.005 + 0.5 * u - 0.5 * g * u * u
+        return 0.004
+
+    z = [z_at(s) for s in t]
+    x = [0.0 if s < fall else min(0.03, 0.1 * (s - fall)) for s in t]
+    out = cf.measure_outcomes(cf.LabTest.drop, t, x, z, moved=1e-3)
+    assert set(out) == {cf.Outcome.rebound_height, cf.Outcome.drift}
+    rise = 0.5**2 / (2 * g)
+    # the rest point 1 mm below the contact; the apex frame at most g dt^2 / 8 below the apex
+    assert out[cf.Outcome.rebound_height] == pytest.approx(rise + 1e-3, abs=2e-6)
+    assert out[cf.Outcome.drift] == pytest.approx(0.03, abs=1e-12)
+    impact = cf.first_impact_time(t, x, z, moved=1e-3)
+    assert impact == pytest.approx(fall, abs=1e-3)
+    # read 50 ms after the first impact, the drift is where the path was then
+    later = cf.measure_outcomes(cf.LabTest.drop, t, x, z, moved=1e-3, drift_after_impact=0.05)
+    assert later[cf.Outcome.drift] == pytest.approx(0.1 * 0.0455, abs=1.5e-3)
+    roll = cf.measure_outcomes(cf.LabTest.roll, t, [min(0.12, 0.4 * s) for s in t], [0.01] * len(t), moved=1e-3)
+    assert roll[cf.Outcome.roll_distance] == pytest.approx(0.12, abs=1e-12)
+    # the last frame farther than 1 mm from the rest point: 0.4 s (t) - 1 mm / 0.4 m/s
+    assert roll[cf.Outcome.roll_time] == pytest.approx(0.3 - 2.5e-3, abs=1.5e-3)
+    assert cf.first_impact_time(t, x, [0.2 - 1e-4 * k for k in range(600)], moved=1e-3) is None
+    assert cf.measure_outcomes(cf.LabTest.drop, t[:9], x[:9], z[:9]) == {}
+    with pytest.raises(cf.InvalidArgumentError, match="must be as long"):
+        cf.measure_outcomes(cf.LabTest.drop, t, x[:-1], z)
