@@ -403,6 +403,28 @@ std::string agreement_unconverged(const ParticleModelRung& agreed, const Particl
       s.p, s.largest);
 }
 
+}  // namespace
+
+namespace {
+/// While the particle model is not converged (its finest clump `spheres`) every candidate asked
+/// about is undecidable, present or absent (the frame-by-frame and first-order claims of absence
+/// included), and the experiment asks for finer clumps.
+void every_candidate_undecidable(DiagnoseResult& result, int spheres) {
+  result.undecidable.clear();
+  for (const auto& h : result.hypotheses) result.undecidable.push_back(h.name);
+  result.experiment = finer_clumps_experiment(spheres);
+}
+}  // namespace
+
+/// The verdict while the particle model is not converged (its finest clump `spheres`): undecidable,
+/// and so is every candidate asked about (one hypothesis each), present or absent (the
+/// frame-by-frame and first-order claims of absence included); the experiment asks for finer
+/// clumps. The statement is the caller's.
+void undecidable_unconverged(DiagnoseResult& result, int spheres) {
+  supersede(result, Verdict::Undecidable, Basis::UnconvergedParticleModel);
+  every_candidate_undecidable(result, spheres);
+}
+
 /// The finest clump agrees with the recorded outcomes and no candidate passes there, but one
 /// passed on a coarser agreeing clump whose agreement the next clump moved away from, and the
 /// finest clump's outcomes moved from those of `before`, the clump before it (its outcome_shift): whether that
@@ -418,6 +440,7 @@ void undecided_by_resolution(DiagnoseResult& result, const ParticleModelRung& be
   result.notes.push_back(fmt::format("before the resolution was weighed: {}", result.statement));
   result.verdict = Verdict::Undecidable;
   result.basis = Basis::UnconvergedParticleModel;
+  every_candidate_undecidable(result, finest.spheres);
   result.statement = fmt::format(
       "Not decidable with these clumps: on a coarser clump whose null agrees with the recorded outcomes, {} beat "
       "that null by the margin, and the next clump's outcomes moved away from it; with {} ({} spheres), the finest, "
@@ -426,20 +449,6 @@ void undecided_by_resolution(DiagnoseResult& result, const ParticleModelRung& be
       "{:.2g}, up to {:.1f} recorded standard errors). Whether {} is missing physics or the coarser clump's share "
       "hangs on a particle model that has not converged.",
       names, finest.name, finest.spheres, before.spheres, finest.spheres, s.chi2, s.means, s.p, s.largest, names);
-  result.experiment = finer_clumps_experiment(finest.spheres);
-}
-
-}  // namespace
-
-/// The verdict while the particle model is not converged (its finest clump `spheres`): undecidable,
-/// and so is every candidate asked about (one hypothesis each), present or absent (the
-/// frame-by-frame and first-order claims of absence included); the experiment asks for finer
-/// clumps. The statement is the caller's.
-void undecidable_unconverged(DiagnoseResult& result, int spheres) {
-  supersede(result, Verdict::Undecidable, Basis::UnconvergedParticleModel);
-  result.undecidable.clear();
-  for (const auto& h : result.hypotheses) result.undecidable.push_back(h.name);
-  result.experiment = finer_clumps_experiment(spheres);
 }
 
 namespace {

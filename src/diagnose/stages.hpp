@@ -339,6 +339,12 @@ bool particle_model_unconverged(const Context& c, DiagnoseResult& result);
 /// The verdict while the particle model is not converged (its finest clump `spheres`): undecidable,
 /// every candidate asked about too; finer clumps asked for. The statement is the caller's.
 void undecidable_unconverged(DiagnoseResult& result, int spheres);
+/// The finest clump agrees with the recorded outcomes and nothing passes there, but `passed`
+/// passed on a coarser agreeing clump and the finest clump's outcomes moved from `before`'s:
+/// undecidable on the unconverged particle model, every candidate asked about with it, finer
+/// clumps asked for; the verdict before it kept as a note.
+void undecided_by_resolution(DiagnoseResult& result, const ParticleModelRung& before, const ParticleModelRung& finest,
+                             const std::vector<Effect>& passed);
 /// A candidate that beat the diagnosed clump's null (`let_through`), tried on the finest clump
 /// (`finest`, its comparison) after that clump's outcomes moved from the previous one's: named
 /// (returns false, a note given) only when it beats that clump's null by the margin at a plausible

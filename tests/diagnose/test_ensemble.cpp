@@ -938,6 +938,30 @@ TEST(EnsembleUnconvergedLadder, ACandidateLetThroughMustBeNeededOnTheFinestClump
   }
 }
 
+// A candidate that passed on a coarser agreeing clump, where the finest clump agrees and nothing
+// passes but its outcomes moved from the clump before (undecided_by_resolution, lab-like case-08
+// at 6ac3aa3): undecidable on the unconverged particle model like every other unconverged ladder,
+// so every candidate asked about is listed undecidable, not only the one that passed, and the
+// verdict before is kept as a note.
+TEST(EnsembleUnconvergedLadder, AnAgreementThatMovesWithTheResolutionLeavesEveryCandidateUndecidable) {
+  DiagnoseResult result;
+  result.verdict = Verdict::None;
+  result.basis = Basis::ParticleModel;
+  result.statement = "the finest clump explains the outcomes";
+  result.undecidable = {"elastic_plastic_restitution"};
+  for (const char* name : {"elastic_plastic_restitution", "adhesion", "air_drag"})
+    result.hypotheses.push_back({.name = name});
+  const ParticleModelCheck check = ladder(64, 3, 16, 1e-5, 3.3);
+  diagnosis::undecided_by_resolution(result, check.rungs[1], check.rungs[2], {Effect::ElasticPlasticRestitution});
+  EXPECT_EQ(result.verdict, Verdict::Undecidable);
+  EXPECT_EQ(result.basis, Basis::UnconvergedParticleModel);
+  EXPECT_EQ(result.undecidable, (std::vector<std::string>{"elastic_plastic_restitution", "adhesion", "air_drag"}));
+  EXPECT_NE(result.experiment.find("more than 256 spheres"), std::string::npos) << result.experiment;
+  ASSERT_FALSE(result.notes.empty());
+  EXPECT_NE(result.notes.back().find("the finest clump explains the outcomes"), std::string::npos);
+  EXPECT_NE(result.statement.find("from 128 to 256 spheres"), std::string::npos) << result.statement;
+}
+
 // The same candidate on a converged ladder where no candidate passes on the finest clump
 // (judge_on_converged_clump): not needed on the converged particle model, whose null still
 // misses, so the verdict is unexplained on the finest clump's comparison, never the diagnosed
