@@ -274,20 +274,13 @@ def test_the_diagnosis_reads_a_drop_and_a_roll_as_it_reads_their_tracks():
     a rebound at 0.5 m/s (rise v^2 / 2g), rest at 4 mm and 30 mm along; a roll that comes to rest
     120 mm along at 0.3 s."""
     g = 9.81
-    t = [k * 1e-3 for k in range(600)]
+    s = np.arange(600) * 1e-3
     fall = (2 * 0.195 / g) ** 0.5
     flight = 2 * 0.5 / g
-
-    def z_at(s):
-        if s < fall:
-            return 0.2 - 0.5 * g * s * s
-        if s < fall + flight:
-            u = s - fall
-            return 0.005 + 0.5 * u - 0.5 * g * u * u
-        return 0.004
-
-    z = [z_at(s) for s in t]
-    x = [0.0 if s < fall else min(0.03, 0.1 * (s - fall)) for s in t]
+    u = s - fall
+    z = np.where(s < fall, 0.2 - 0.5 * g * s**2, np.where(u < flight, 0.005 + 0.5 * u - 0.5 * g * u**2, 0.004))
+    x = np.clip(0.1 * u, 0.0, 0.03)
+    t, x, z = s.tolist(), x.tolist(), z.tolist()
     out = cf.measure_outcomes(cf.LabTest.drop, t, x, z, moved=1e-3)
     assert set(out) == {cf.Outcome.rebound_height, cf.Outcome.drift}
     rise = 0.5**2 / (2 * g)
