@@ -63,10 +63,15 @@ void say_particle_model(DiagnoseResult& result, const ParticleModelCheck& check,
   if (outcomes) {
     blamed = "the recorded outcomes differ from replays over the unknown release orientation beyond the noise";
   } else if (result.verdict == Verdict::Named && result.effect) {
-    blamed = fmt::format("the misfit {} absorbed is three times the noise or more", effect_name(*result.effect));
+    blamed = fmt::format(
+        "the misfit {} absorbed is large (three times the noise or more; in a first flight, the "
+        "camera noise or more)",
+        effect_name(*result.effect));
   } else if (result.verdict == Verdict::Ambiguous) {
-    blamed = fmt::format("the misfit {} absorbed about equally is three times the noise or more",
-                         fmt::join(result.candidates, " and "));
+    blamed = fmt::format(
+        "the misfit {} absorbed about equally is large (three times the noise or more; in a first "
+        "flight, the camera noise or more)",
+        fmt::join(result.candidates, " and "));
   } else {
     blamed = fmt::format(
         "the misfit in {} is three times the noise or more",
@@ -146,8 +151,9 @@ Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result,
       fits.push_back(std::move(unfitted));
     }
     result.notes.push_back(
-        "candidate effects not fitted: no flagged phase misfits by three times hypot(noise, model accuracy) or more, "
-        "and an effect is named only when it clears such a misfit");
+        "candidate effects not fitted: no flagged phase misfits by three times hypot(noise, model accuracy) or more "
+        "(a drop's first flight: by the camera noise or more), and an effect is named only when it clears such a "
+        "misfit");
     return fits;
   }
   for (std::size_t h = 0; h < effects.size(); ++h) {
@@ -236,7 +242,8 @@ namespace {
 
 /// The largest misfit_per_value a signal `kept` (one value per cell of `keys`, in noise units)
 /// would leave in a phase on its own (the noise not counted), over phases with 10 values or
-/// more but the hold.
+/// more but the hold, each as a fraction of what a large misfit there needs beyond the noise's
+/// one (large_misfit_level less 1): 1 is a large misfit.
 double largest_signal_misfit(const Context& c, const std::vector<std::pair<GroupKey, Axis>>& keys,
                              const Eigen::VectorXd& kept) {
   if (static_cast<Eigen::Index>(keys.size()) != kept.size()) return 0.0;
@@ -248,7 +255,7 @@ double largest_signal_misfit(const Context& c, const std::vector<std::pair<Group
   double largest = 0.0;
   for (const auto& [key, g] : groups) {
     if (key.phase == Phase::Hold || g.values < 10) continue;
-    largest = std::max(largest, misfit_per_value(c, key, g));
+    largest = std::max(largest, misfit_per_value(c, key, g) / (large_misfit_level(key.phase) - 1.0));
   }
   return largest;
 }
@@ -724,8 +731,8 @@ Result<DetectionLimits> detection_limits(Context& c, DiagnoseResult& result, con
     const double needed =
         options.min_delta_bic + static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
     // Named frame by frame only over a large misfit too: some phase's chi^2 per value at
-    // kLargeMisfit, of which the noise gives one.
-    const double needed_misfit = kLargeMisfit - 1.0;
+    // large_misfit_level, of which the noise gives one (largest_signal_misfit's 1).
+    const double needed_misfit = 1.0;
     Shown strong{.needed = needed, .needed_misfit = needed_misfit};
     report.strong_delta_chi2 = NAN;
     if (probe_cells.size() == base_cells.size()) {

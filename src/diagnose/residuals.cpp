@@ -366,10 +366,11 @@ std::string experiment_to_show(const std::string& effect) {
 /// accuracy) RMS or more (chi^2 per value >= kLargeMisfit) on either axis of the camera: a
 /// drop's misfit lies in its height, and the horizontal values it fits to the noise would
 /// halve a per-value figure of both. A drop's first flight is judged against the camera noise
-/// alone: before the first contact only the release and the air act on the body, and neither
-/// the clump's shape nor its contact law enters.
+/// alone, and by the camera noise (kLargeFlightMisfit): before the first contact only the
+/// release and the air act on the body, and neither the clump's shape nor its contact law
+/// enters.
 bool large_misfit(const Context& c, const GroupKey& key, const Group& g) {
-  return g.values > 0 && misfit_per_value(c, key, g) >= kLargeMisfit;
+  return g.values > 0 && misfit_per_value(c, key, g) >= large_misfit_level(key.phase);
 }
 
 double misfit_per_value(const Context& c, const GroupKey& key, const Group& g) {

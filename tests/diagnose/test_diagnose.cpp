@@ -307,29 +307,48 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
   }
 }
 
-// A `none` must not claim that an effect it missed would have shown. Realistic drag (C_d
-// 0.45) filmed at 240 fps with 0.5 mm noise, made from the finer 340-sphere body:
-// its flights misfit by a chi^2 per value near 2, under the large misfit a name needs (10), so
-// the verdict is `none`; the smallest detectable drag reported must then lie above 0.45. At
-// b88cdad it said 0.078 (the delta-BIC alone, generated air_drag-realistic at 240 fps).
+// Filmed at 240 fps with 0.5 mm noise (the benchmark's small set, made from the finer
+// 340-sphere body), air drag shows in the drops' first flights by about the camera noise: held
+// to three times hypot(noise, model accuracy) as every other phase (until the commit after
+// be4bed9), realistic drag (C_d 0.45) was `none`, though its fit gained delta-BIC 560 and the
+// held-out trials 541; a first flight from rest is held to the camera noise
+// (kLargeFlightMisfit), since no particle model's inaccuracy enters before the first contact.
+// Realistic drag is named there with its C_d; no drag is named in the control; and a `none`
+// must still not claim that an effect it missed would have shown: drag at C_d 0.1 is `none`,
+// with no smallest detectable drag at or below 0.1 (at b88cdad the delta-BIC alone said 0.078).
 TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) {
-  // The benchmark's small set (drops from 0.2 and 1 m, a 100 mm roll, a tilt; 4 trials), its
-  // air_drag-realistic case's seed.
-  ConcealOptions conceal = one_metre_drops(Effect::AirDrag, {0.45});
-  conceal.drop_heights = {0.2, 1.0};
-  conceal.roll_starts = {0.10};
-  conceal.tilt = true;
-  conceal.seed = 1001;
-  conceal.frame_rate_hz = 240.0;
-  conceal.noise_m = 5e-4;
-  auto result = diagnose_frame_by_frame(conceal, Effect::AirDrag);
-  ASSERT_TRUE(result) << result.error().message;
-  ASSERT_EQ(result->verdict, Verdict::None) << result->statement;
-  const HypothesisReport* drag = hypothesis_named(*result, "air_drag");
-  ASSERT_NE(drag, nullptr);
-  // No replay below the hidden drag showed, and no limit at or below it is claimed (NaN: none).
-  EXPECT_GT(drag->replay_shown, 0.45) << result->statement;
-  EXPECT_FALSE(drag->smallest_detectable <= 0.45) << result->statement;
+  for (const double cd : {0.0, 0.1, 0.45}) {
+    // The benchmark's small set (drops from 0.2 and 1 m, a 100 mm roll, a tilt; 4 trials), its
+    // air_drag-realistic case's seed.
+    ConcealOptions conceal = cd > 0.0 ? one_metre_drops(Effect::AirDrag, {cd}) : one_metre_drops();
+    conceal.drop_heights = {0.2, 1.0};
+    conceal.roll_starts = {0.10};
+    conceal.tilt = true;
+    conceal.seed = 1001;
+    conceal.frame_rate_hz = 240.0;
+    conceal.noise_m = 5e-4;
+    auto result = diagnose_frame_by_frame(conceal, Effect::AirDrag);
+    ASSERT_TRUE(result) << result.error().message;
+    const HypothesisReport* drag = hypothesis_named(*result, "air_drag");
+    ASSERT_NE(drag, nullptr);
+    if (cd >= 0.45) {
+      ASSERT_EQ(result->verdict, Verdict::Named) << result->statement;
+      ASSERT_EQ(result->effect, Effect::AirDrag);
+      ASSERT_EQ(result->effect_parameters.size(), 1u);
+      // Its 95 % interval holds the hidden C_d (0.444 [0.407, 0.481] at the commit after be4bed9).
+      EXPECT_LE(result->effect_parameters[0].low, cd) << result->statement;
+      EXPECT_GE(result->effect_parameters[0].high, cd) << result->statement;
+      EXPECT_GT(drag->heldout_delta_chi2, 0.0);
+      continue;
+    }
+    ASSERT_EQ(result->verdict, Verdict::None) << cd << ": " << result->statement;
+    EXPECT_FALSE(drag->passes) << cd;
+    if (cd > 0.0) {
+      // No replay below the hidden drag showed, and no limit at or below it is claimed (NaN: none).
+      EXPECT_GT(drag->replay_shown, cd) << result->statement;
+      EXPECT_FALSE(drag->smallest_detectable <= cd) << result->statement;
+    }
+  }
 }
 
 // A `none` must not call absent an effect it cannot judge. A strong centre-of-mass offset
