@@ -134,7 +134,7 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
   for (std::size_t k = 0; k < n; ++k) every[k] = k;
   const double excess = median_excess(result.flights, every);
   result.wobble_m = std::sqrt(std::max(0.0, excess));
-  const double threshold = options.allowance_m + result.noise_m;
+  const double threshold = options.allowance_m + options.noise_margin * result.noise_m;
   result.detected = result.wobble_m > threshold;
   // A point at distance d from the centre, turned at random, has a variance d^2 / 3 per
   // coordinate; the silhouette's own wander is taken off first.
