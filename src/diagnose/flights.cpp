@@ -135,7 +135,6 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
   const double excess = median_excess(result.flights, every);
   result.wobble_m = std::sqrt(std::max(0.0, excess));
   const double threshold = options.allowance_m + options.noise_margin * result.noise_m;
-  result.detected = result.wobble_m > threshold;
   // A point at distance d from the centre, turned at random, has a variance d^2 / 3 per
   // coordinate; the silhouette's own wander is taken off first.
   const double allowed = options.allowance_m * options.allowance_m;
@@ -153,6 +152,11 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
     result.offset_low_m = quantile(resampled, 0.025);
     result.offset_high_m = quantile(resampled, 0.975);
   }
+  // Claimed above the threshold, and (when resampled) only when the interval of the offset
+  // excludes none: 8 flights of the noisy:15 strong offset case reach 0.9 noise levels above
+  // the allowance with an interval from 0.00 mm, where lab-like case-25 at 250 fps stands at
+  // 0.60-0.93 mm.
+  result.detected = result.wobble_m > threshold && (resampled.empty() || result.offset_low_m > 0.0);
   return result;
 }
 

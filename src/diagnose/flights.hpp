@@ -76,8 +76,9 @@ struct FlightWobble {
   double wobble_m = 0.0;
   double noise_m = 0.0;      ///< the median of the drop recordings' camera noise
   double allowance_m = 0.0;  ///< as in the options
-  /// The wobble exceeds the allowance and the camera noise together: the tracked point is not
-  /// the body's centre of mass, nor the silhouette centroid of a body with its mass centred.
+  /// The wobble exceeds the allowance by half the camera noise (FlightWobbleOptions::
+  /// noise_margin) and the offset's interval excludes none: the tracked point is not the body's
+  /// centre of mass, nor the silhouette centroid of a body with its mass centred.
   bool detected = false;
   /// [m] the distance of the centre of mass from the tracked point that this wobble needs: a
   /// point at distance d from the centre, turned at random, wanders by d / sqrt(3) per
