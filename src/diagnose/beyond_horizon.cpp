@@ -403,9 +403,6 @@ std::string agreement_unconverged(const ParticleModelRung& agreed, const Particl
       s.p, s.largest);
 }
 
-}  // namespace
-
-namespace {
 /// While the particle model is not converged (its finest clump `spheres`) every candidate asked
 /// about is undecidable, present or absent (the frame-by-frame and first-order claims of absence
 /// included), and the experiment asks for finer clumps.
