@@ -56,6 +56,10 @@ Result<std::optional<std::pair<std::size_t, Fitted>>> particle_model_check(Conte
   return explained;
 }
 
+/// What a large misfit is (large_misfit), as a statement says it.
+constexpr std::string_view kLargeWords =
+    "large (three times the noise or more; in a first flight, the camera noise or more)";
+
 /// The verdict when a finer clump explains the mismatch: none, on the particle model's basis,
 /// with what was about to be blamed on missing physics and the resolution needed.
 void say_particle_model(DiagnoseResult& result, const ParticleModelCheck& check, bool outcomes) {
@@ -63,15 +67,10 @@ void say_particle_model(DiagnoseResult& result, const ParticleModelCheck& check,
   if (outcomes) {
     blamed = "the recorded outcomes differ from replays over the unknown release orientation beyond the noise";
   } else if (result.verdict == Verdict::Named && result.effect) {
-    blamed = fmt::format(
-        "the misfit {} absorbed is large (three times the noise or more; in a first flight, the "
-        "camera noise or more)",
-        effect_name(*result.effect));
+    blamed = fmt::format("the misfit {} absorbed is {}", effect_name(*result.effect), kLargeWords);
   } else if (result.verdict == Verdict::Ambiguous) {
-    blamed = fmt::format(
-        "the misfit {} absorbed about equally is large (three times the noise or more; in a first "
-        "flight, the camera noise or more)",
-        fmt::join(result.candidates, " and "));
+    blamed =
+        fmt::format("the misfit {} absorbed about equally is {}", fmt::join(result.candidates, " and "), kLargeWords);
   } else {
     blamed = fmt::format(
         "the misfit in {} is three times the noise or more",
@@ -530,22 +529,22 @@ double largest_fraction(const EffectSpec& spec) {
 
 /// What a candidate's replays show against the baseline's: the squared norm of their move once
 /// the coefficients absorb what they can (noise units), and the largest misfit it would leave in
-/// a phase. Each is scaled to its margin: `shown()` is the smaller ratio (1 or more: it shows).
+/// a phase, already a fraction of a large misfit (largest_signal_misfit: 1 is large). The
+/// signal is scaled to its margin: `shown()` is the smaller ratio (1 or more: it shows).
 struct Shown {
   double signal = 0.0, misfit = 0.0;
-  double needed = 1.0, needed_misfit = 1.0;
-  double shown() const { return std::min(signal / needed, misfit / needed_misfit); }
+  double needed = 1.0;
+  double shown() const { return std::min(signal / needed, misfit); }
   /// The fraction of `t` at which both would reach their margins were the response linear in
   /// the magnitude (both grow as its square).
-  double linear_scale() const { return std::max(std::sqrt(needed / signal), std::sqrt(needed_misfit / misfit)); }
+  double linear_scale() const { return std::max(std::sqrt(needed / signal), std::sqrt(1.0 / misfit)); }
 };
 
 /// What a probe's cells show against the baseline's once the coefficients absorb what they can.
 Shown measure(const Context& c, const std::vector<std::pair<GroupKey, Axis>>& keys, const ResidualProjection& keep,
-              const Eigen::VectorXd& base_cells, const Eigen::VectorXd& probe_cells, double needed,
-              double needed_misfit) {
+              const Eigen::VectorXd& base_cells, const Eigen::VectorXd& probe_cells, double needed) {
   const Eigen::VectorXd kept = keep(base_cells - probe_cells);
-  return Shown{kept.squaredNorm(), largest_signal_misfit(c, keys, kept), needed, needed_misfit};
+  return Shown{kept.squaredNorm(), largest_signal_misfit(c, keys, kept), needed};
 }
 
 /// How many replays check a candidate's first-order smallest detectable magnitude, and the
@@ -592,7 +591,7 @@ Result<Bracket> smallest_shown_fraction(CellProbe& cells, const Model& baseline,
     auto probed = cells(effect_at(baseline, spec, t));
     if (!probed) return std::unexpected(probed.error());
     if (probed->values.size() != base_cells.size()) break;
-    const Shown at = measure(c, cells.keys, keep, base_cells, probed->values, strong.needed, strong.needed_misfit);
+    const Shown at = measure(c, cells.keys, keep, base_cells, probed->values, strong.needed);
     (at.shown() >= 1.0 ? shown : missed) = t;
     out.tried.emplace_back(t, at.shown() >= 1.0);
     if (std::isfinite(shown) && shown < kBracketRatio * missed) break;
@@ -731,12 +730,11 @@ Result<DetectionLimits> detection_limits(Context& c, DiagnoseResult& result, con
     const double needed =
         options.min_delta_bic + static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
     // Named frame by frame only over a large misfit too: some phase's chi^2 per value at
-    // large_misfit_level, of which the noise gives one (largest_signal_misfit's 1).
-    const double needed_misfit = 1.0;
-    Shown strong{.needed = needed, .needed_misfit = needed_misfit};
+    // large_misfit_level, of which the noise gives one (Shown::misfit reaching 1).
+    Shown strong{.needed = needed};
     report.strong_delta_chi2 = NAN;
     if (probe_cells.size() == base_cells.size()) {
-      strong = measure(c, cells.keys, keep, base_cells, probe_cells, needed, needed_misfit);
+      strong = measure(c, cells.keys, keep, base_cells, probe_cells, needed);
       // The recordings' own answer (cells are residuals): chi^2 at the strong magnitude minus
       // the null's, each after the coefficients absorb what they can.
       report.strong_delta_chi2 = keep(probe_cells).squaredNorm() - keep(base_cells).squaredNorm();
