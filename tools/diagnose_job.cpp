@@ -320,8 +320,15 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["candidates"] = r.candidates;
   j["experiment"] = r.experiment;
   j["effect_parameters"] = nlohmann::json::object();
-  for (const auto& p : r.effect_parameters)
-    j["effect_parameters"][p.name] = {{"value", p.value}, {"low", p.low}, {"high", p.high}};
+  for (const auto& p : r.effect_parameters) {
+    j["effect_parameters"][p.name] = {{"value", p.value},
+                                      {"low", p.low},
+                                      {"high", p.high},
+                                      {"curvature_half_width", finite_or_null(p.curvature_half_width)},
+                                      {"by_recording", nlohmann::json::object()}};
+    for (const auto& [recording, value] : p.by_recording)
+      j["effect_parameters"][p.name]["by_recording"][recording] = value;
+  }
   j["summaries_only"] = r.summaries_only;
   j["decidable"] = r.decidable;
   j["undecidable"] = r.undecidable;

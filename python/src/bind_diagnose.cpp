@@ -46,7 +46,11 @@ void bind_parts(py::module_& m) {
       .def_readonly("name", &ParameterValue::name)
       .def_readonly("value", &ParameterValue::value)
       .def_readonly("low", &ParameterValue::low)
-      .def_readonly("high", &ParameterValue::high);
+      .def_readonly("high", &ParameterValue::high)
+      .def_readonly("curvature_half_width", &ParameterValue::curvature_half_width,
+                    "a named effect's 95 % half-width from the chi^2 curvature alone (NaN: not named frame by frame)")
+      .def_readonly("by_recording", &ParameterValue::by_recording,
+                    "where the trials disagree: each recording's value one step from the fit, (name, value)");
   py::class_<SurfaceParameters>(m, "SurfaceParameters")
       .def_readonly("surface", &SurfaceParameters::surface)
       .def_readonly("interaction", &SurfaceParameters::interaction);
@@ -82,7 +86,7 @@ void bind_parts(py::module_& m) {
       .def_readonly("evaluations", &HypothesisReport::evaluations)
       .def_readonly("smallest_detectable", &HypothesisReport::smallest_detectable,
                     "with verdict none: the smallest magnitude of its first parameter these recordings would have "
-                    "revealed (NaN where they do not decide the effect; 0 under any other verdict)")
+                    "revealed (NaN where they do not decide the effect, and under any other verdict)")
       .def_readonly("replay_shown", &HypothesisReport::replay_shown,
                     "with verdict none: the smallest magnitude a replay of the diagnosed clump showed (NaN: none)")
       .def_readonly("strong_delta_chi2", &HypothesisReport::strong_delta_chi2,

@@ -132,6 +132,13 @@ struct PhaseReport {
 struct ParameterValue {
   std::string name;
   double value = 0.0, low = 0.0, high = 0.0;  ///< 95 % interval [low, high]
+  /// A named effect's parameter: the 95 % half-width from the chi^2 curvature alone. [low, high]
+  /// is wider where the trials pull the value apart beyond their noise (NaN: not named frame by
+  /// frame).
+  double curvature_half_width = NAN;
+  /// Then: each recording's value one Gauss-Newton step from the fit, by recording name (empty
+  /// when the curvature's interval stands).
+  std::vector<std::pair<std::string, double>> by_recording;
 };
 
 /// One surface's recordings of one test, and its share of a chi^2 difference.
@@ -165,8 +172,8 @@ struct HypothesisReport {
   int evaluations = 0;
   /// With verdict "none": the smallest magnitude of its first parameter these recordings would
   /// have revealed. Claimed only for an effect they decide (they reject its strong magnitude, see
-  /// strong_delta_chi2); NaN otherwise, whatever a replay showed.
-  double smallest_detectable = 0.0;
+  /// strong_delta_chi2); NaN otherwise (under any other verdict too), whatever a replay showed.
+  double smallest_detectable = NAN;
   /// With verdict "none": the smallest magnitude of its first parameter at which a replay of the
   /// diagnosed clump showed against the baseline (the coefficients absorbing what they can to
   /// first order): that clump's response, not a claim about the recordings. NaN when none did.

@@ -197,6 +197,14 @@ WelchTest welch_test(const std::vector<double>& a, const std::vector<double>& b,
   return w;
 }
 
+double clustered_standard_error(const std::vector<double>& scores, double curvature) {
+  const double g = static_cast<double>(scores.size());
+  if (scores.size() < 2 || !(curvature > 0.0)) return NAN;
+  double sum = 0.0;
+  for (double s : scores) sum += s * s;
+  return std::sqrt(g / (g - 1.0) * sum) / curvature;
+}
+
 double kolmogorov_upper_tail(double lambda) {
   if (lambda < 0.2) return 1.0;  // the series is 1 to double precision there
   double sum = 0.0;

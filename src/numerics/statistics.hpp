@@ -61,6 +61,14 @@ struct WelchTest {
 };
 WelchTest welch_test(const std::vector<double>& a, const std::vector<double>& b, double confidence = 0.95);
 
+/// A scalar M-estimate's standard error that holds when the model is misspecified (the
+/// clustered sandwich): each independent cluster's derivative of the objective at the estimate
+/// (its score, which sums to zero there) and the objective's total second derivative,
+/// sqrt(G / (G - 1) sum s_g^2) / H. For a chi^2 objective that fits the data's noise it equals
+/// sqrt(2 / H), the curvature's figure; where the clusters pull the estimate apart beyond their
+/// noise it is larger. NaN below two clusters or for H <= 0.
+double clustered_standard_error(const std::vector<double>& scores, double curvature);
+
 /// Two-sample Kolmogorov-Smirnov test of equal distributions: the largest distance between the
 /// empirical distribution functions, and its p-value from Kolmogorov's limit with Stephens'
 /// small-sample correction, lambda = (sqrt(ne) + 0.12 + 0.11 / sqrt(ne)) D, ne = n m / (n + m).

@@ -303,6 +303,10 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
       ASSERT_EQ(result->effect_parameters.size(), 1u);
       EXPECT_NEAR(result->effect_parameters[0].value, 1.5, 0.3);
       EXPECT_LT(result->after.heldout_rms_mm, 0.5 * result->before.heldout_rms_mm);
+      // A named effect's smallest detectable magnitude is not probed: NaN (null in report.json),
+      // not 0, which would read as "any drag at all would have shown".
+      for (const HypothesisReport& h : result->hypotheses)
+        EXPECT_TRUE(std::isnan(h.smallest_detectable)) << h.name << " " << h.smallest_detectable;
     }
   }
 }

@@ -213,6 +213,46 @@ TEST(Statistics, TwoSampleTestsHoldTheirLevelAndDetectAShift) {
   EXPECT_GT(ks_shift / double(kPairs), 0.75);
 }
 
+// The clustered sandwich for the simplest M-estimate, a mean fitted by chi^2 = sum (y - m)^2 /
+// sigma^2: with one value per cluster it is the sample mean's standard error, whatever sigma
+// the chi^2 assumed; with clusters that share an offset (a model that misses what the groups
+// share) it covers the mean at its level where the curvature's sqrt(2 / H) does not.
+TEST(Statistics, ClusteredStandardErrorHoldsWhereTheCurvatureDoesNot) {
+  const std::vector<double> y{1.0, 2.5, 2.0, 4.5, 3.0};
+  const double mean = (1.0 + 2.5 + 2.0 + 4.5 + 3.0) / 5.0, sigma = 0.1;
+  std::vector<double> scores;
+  for (double v : y) scores.push_back(-2.0 * (v - mean) / (sigma * sigma));
+  const double curvature = 2.0 * 5.0 / (sigma * sigma);
+  EXPECT_NEAR(clustered_standard_error(scores, curvature), standard_error(y), 1e-12);
+  EXPECT_TRUE(std::isnan(clustered_standard_error({1.0}, curvature)));
+  EXPECT_TRUE(std::isnan(clustered_standard_error(scores, 0.0)));
+
+  // 8 groups of 20 values, each group offset by N(0, 1), the noise 0.1 within a group.
+  Rng rng(11);
+  constexpr int kGroups = 8, kEach = 20, kRuns = 2000;
+  const double t = student_t_quantile(0.05, kGroups - 1);
+  int sandwich_covers = 0, curvature_covers = 0;
+  for (int run = 0; run < kRuns; ++run) {
+    std::vector<std::vector<double>> groups(kGroups);
+    double sum = 0.0;
+    for (auto& g : groups) {
+      const double offset = rng.normal(0.0, 1.0);
+      for (int i = 0; i < kEach; ++i) sum += g.emplace_back(offset + rng.normal(0.0, sigma));
+    }
+    const double m = sum / (kGroups * kEach), h = 2.0 * kGroups * kEach / (sigma * sigma);
+    std::vector<double> s;
+    for (const auto& g : groups) {
+      double score = 0.0;
+      for (double v : g) score += -2.0 * (v - m) / (sigma * sigma);
+      s.push_back(score);
+    }
+    sandwich_covers += std::abs(m) <= t * clustered_standard_error(s, h);
+    curvature_covers += std::abs(m) <= 1.96 * std::sqrt(2.0 / h);
+  }
+  EXPECT_NEAR(sandwich_covers / double(kRuns), 0.95, 0.015);
+  EXPECT_LT(curvature_covers / double(kRuns), 0.1);
+}
+
 TEST(GoldenSection, FindsAParabolasMinimum) {
   const auto m = golden_section([](double x) { return (x - 0.3) * (x - 0.3); }, -1.0, 2.0, 1e-8, 200);
   EXPECT_NEAR(m.x.at(0), 0.3, 1e-6);
