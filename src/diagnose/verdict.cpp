@@ -59,6 +59,9 @@ double clustered_half_width(const std::vector<double>& scores, double curvature)
 /// Recordings that must show a parameter before they count as clusters of their own (below,
 /// Student's t on so few degrees of freedom says little).
 constexpr std::size_t kRecordingClusters = 4;
+/// The least share of the curvature a recording must carry for its own value to be given
+/// (lab-like case-09's tilt, whose step from the fit "said" C_d 820).
+constexpr double kRecordingShare = 0.01;
 
 /// The chi^2 curvature's interval (others held, scaled by the fit's reduced chi^2 when it is
 /// above 1) holds when the replays miss the recordings by noise alone. Where a test's replays
@@ -103,8 +106,8 @@ Result<ParameterSpread> parameter_spread(Context& c, const Model& improved, std:
     spread.clustered_half = std::max(spread.clustered_half, clustered_half_width(recording_scores, curvature));
   spread.half = std::max(spread.curvature_half, spread.clustered_half);
   if (!(spread.clustered_half > spread.curvature_half)) return spread;
-  for (const auto& [recording, sh] : sums)
-    if (sh.second > 0.0) spread.by_recording.emplace_back(recording, v - sh.first / sh.second);
+  for (const auto& [recording, sh] : sums)  // a recording that hardly shows it says little alone
+    if (sh.second > kRecordingShare * curvature) spread.by_recording.emplace_back(recording, v - sh.first / sh.second);
   return spread;
 }
 
