@@ -74,11 +74,12 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   const Decision decision = decide(result.hypotheses, options.min_delta_bic);
   Improvement improved{.model = baseline, .clump = c.ev.clump, .scores = located->base_scores, .changed = false};
   if (decision.named()) {
-    if (auto ok = say_named(c, result, fits[*decision.best], decision); !ok) return std::unexpected(ok.error());
     improved.model = fits[*decision.best].model;
     auto s = score(c, improved.model, c.all, true);
     if (!s) return std::unexpected(s.error());
     improved.scores = std::move(*s);
+    if (auto ok = say_named(c, result, fits[*decision.best], decision, improved.scores); !ok)
+      return std::unexpected(ok.error());
     improved.changed = true;
   } else if (decision.best) {
     say_ambiguous(result, decision);

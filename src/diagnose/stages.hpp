@@ -448,7 +448,9 @@ void say_flights(DiagnoseResult& result, const FlightWobble& f);
 // ---- verdict.cpp -----------------------------------------------------------------------------
 
 void say_ambiguous(DiagnoseResult& result, const Decision& decision);
-Result<void> say_named(Context& c, DiagnoseResult& result, const Fitted& fit, const Decision& decision);
+/// `at_fit`: the fit's scores of every trial (c.all), whose training chi^2 the intervals start from.
+Result<void> say_named(Context& c, DiagnoseResult& result, const Fitted& fit, const Decision& decision,
+                       const std::vector<TrialScore>& at_fit);
 void say_unexplained_phases(DiagnoseResult& result, const DiagnoseOptions& options);
 Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline, const std::vector<Fitted>& fits,
                       const Groups& final_groups, const DiagnoseOptions& options);

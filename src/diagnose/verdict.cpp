@@ -70,9 +70,10 @@ constexpr double kRecordingShare = 0.01;
 /// sandwich (numerics) measures that, each trial a cluster and each recording one (when at
 /// least kRecordingClusters show the parameter), with Student's t on clusters - 1 degrees of
 /// freedom, and the widest of the three is reported (lab-like case-09, a sphere with C_d 0.47:
-/// its steel drops alone say 0.47, its rolls 0.51-0.56).
-Result<ParameterSpread> parameter_spread(Context& c, const Model& improved, std::size_t k, double step,
-                                         double inflation) {
+/// its steel drops alone say 0.47, its rolls 0.51-0.56). `mid`: the fit's chi^2 of each training
+/// trial (c.training's order).
+Result<ParameterSpread> parameter_spread(Context& c, const Model& improved, const std::vector<double>& mid,
+                                         std::size_t k, double step, double inflation) {
   auto per_trial = [&](double value) -> Result<std::vector<double>> {
     Model m = improved;
     m.values[k] = value;
@@ -83,13 +84,13 @@ Result<ParameterSpread> parameter_spread(Context& c, const Model& improved, std:
     return chi2;
   };
   const double v = improved.values[k];
-  auto lo = per_trial(v - step), mid = per_trial(v), hi = per_trial(v + step);
-  if (!lo || !mid || !hi) return std::unexpected(!lo ? lo.error() : !mid ? mid.error() : hi.error());
+  auto lo = per_trial(v - step), hi = per_trial(v + step);
+  if (!lo || !hi) return std::unexpected(!lo ? lo.error() : hi.error());
   std::vector<double> scores;
   std::map<std::size_t, std::pair<double, double>> sums;  // recording: (score, curvature)
   double curvature = 0.0;
-  for (std::size_t i = 0; i < mid->size(); ++i) {
-    const double s = ((*hi)[i] - (*lo)[i]) / (2.0 * step), h = ((*lo)[i] + (*hi)[i] - 2.0 * (*mid)[i]) / (step * step);
+  for (std::size_t i = 0; i < mid.size(); ++i) {
+    const double s = ((*hi)[i] - (*lo)[i]) / (2.0 * step), h = ((*lo)[i] + (*hi)[i] - 2.0 * mid[i]) / (step * step);
     scores.push_back(s);
     curvature += h;
     auto& sum = sums[c.ev.trials[c.training[i]].recording];
@@ -114,7 +115,8 @@ Result<ParameterSpread> parameter_spread(Context& c, const Model& improved, std:
 /// Named frame by frame: the effect's parameters with 95 % intervals (parameter_spread), and the
 /// statement with the runner-up (the next candidate on every trial when another passed, else the
 /// next by training delta-BIC).
-Result<void> say_named(Context& c, DiagnoseResult& result, const Fitted& fit, const Decision& decision) {
+Result<void> say_named(Context& c, DiagnoseResult& result, const Fitted& fit, const Decision& decision,
+                       const std::vector<TrialScore>& at_fit) {
   HypothesisReport& report = result.hypotheses[*decision.best];
   const Model& improved = fit.model;
   result.verdict = Verdict::Named;
@@ -123,11 +125,14 @@ Result<void> say_named(Context& c, DiagnoseResult& result, const Fitted& fit, co
   const auto library = effect_library();
   const EffectSpec& spec = effect_spec(library, *improved.effect);
   const double inflation = std::sqrt(std::max(1.0, fit.chi2 / std::max(1, report.values_used)));
+  std::vector<double> by_trial(c.ev.trials.size()), mid;  // the fit's chi^2, the training trials'
+  for (std::size_t k = 0; k < c.all.size(); ++k) by_trial[c.all[k]] = at_fit[k].alignment.chi_squared;
+  for (std::size_t t : c.training) mid.push_back(by_trial[t]);
   for (std::size_t k = 0; k < spec.parameters.size(); ++k) {
     const auto& p = spec.parameters[k];
     const double v = improved.values[k];
     const double step = p.log_scale ? v * 0.1 : std::max(0.05 * std::abs(v), 0.01 * (p.upper - p.lower));
-    auto spread = parameter_spread(c, improved, k, step, inflation);
+    auto spread = parameter_spread(c, improved, mid, k, step, inflation);
     if (!spread) return std::unexpected(spread.error());
     report.values[k].low = std::max(p.lower, v - spread->half);
     report.values[k].high = std::min(p.upper, v + spread->half);
