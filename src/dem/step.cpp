@@ -28,44 +28,78 @@ std::uint64_t pair_key(std::size_t bi, std::size_t si, std::size_t bj, std::size
 // is listed again every few centimetres, not every few hundredths of a millimetre. A sphere
 // left out cannot touch before the next listing, so the forces are those of every sphere
 // checked every step, to the bit.
-void refresh_candidates(World& world, std::size_t b, double skin) {
+//
+// The skin is a tenth of the smallest sphere's radius. The list is conservative at any skin, so
+// the skin changes only the work: a wider one lists many spheres of a flat underside that never
+// touch, a narrower one lists anew too often. One diagnosis (control-01 of `bench_diagnose
+// --nine-set-ups --trials 8`): 113 s at half the radius, 103 s at a tenth, 112 s at 0.03, the
+// report the same to the bit. A rolling or resting body is listed anew every few steps at a
+// tenth, so the lists are picked from near lists, the spheres within a whole radius, themselves
+// made anew only once the body may have moved half the gap of the nearest sphere they leave out:
+// a listing walks the few near spheres, not all of a 256-sphere clump's (or a four-square's
+// 1024). `bench_time_step --trials 4` (the 256-sphere clump's replays of the nine set-ups) ran
+// 14 % fewer instructions under callgrind; LabTests.NoSphereTouchingAWallIsLeftOutOfItsContactList
+// checks that no touching sphere is ever left out.
+
+// The gap to wall `w` of each of `spheres` (all the body's when null): listed in `list` when
+// below `skin`, else counted in `clearance`.
+void list_within(const RigidBody& body, const Wall& wall, double skin, const std::vector<int>* spheres,
+                 std::vector<int>& list, double& clearance) {
+  list.clear();
+  const double centre_height = (body.position - wall.point).dot(wall.normal);
+  if (centre_height - body.bounding_radius > skin) {
+    clearance = std::min(clearance, centre_height - body.bounding_radius);
+    return;
+  }
+  // The wall's normal turned into the body frame once ((q c) . n = c . (q^-1 n)) instead of
+  // every sphere into the world: a list differs from that of a sphere-by-sphere test only by
+  // rounding at the skin's edge, and either is conservative (the forces are the same bits).
+  const Eigen::Vector3d normal_in_body = body.orientation.conjugate() * wall.normal;
+  auto check = [&](std::size_t k) {
+    const double gap = centre_height + body.spheres[k].centre.dot(normal_in_body) - body.spheres[k].radius;
+    if (gap < skin)
+      list.push_back(static_cast<int>(k));
+    else
+      clearance = std::min(clearance, gap);
+  };
+  if (spheres == nullptr) {
+    for (std::size_t k = 0; k < body.spheres.size(); ++k) check(k);
+  } else {
+    for (int k : *spheres) check(static_cast<std::size_t>(k));
+  }
+}
+
+// The near lists (every sphere within the smallest radius of a wall) made anew; the candidate
+// lists follow at once.
+void refresh_near(World& world, std::size_t b) {
+  const RigidBody& body = world.bodies[b];
+  double smallest = body.spheres.front().radius;
+  for (const auto& s : body.spheres) smallest = std::min(smallest, s.radius);
+  world.candidate_skin[b] = 0.1 * smallest;
+  auto& near = world.wall_near[b];
+  near.resize(world.walls.size());
+  double clearance = std::numeric_limits<double>::infinity();
+  for (std::size_t w = 0; w < world.walls.size(); ++w)
+    list_within(body, world.walls[w], smallest, nullptr, near[w], clearance);
+  world.near_travel[b] = 0.0;
+  world.near_clearance[b] = clearance;
+  world.candidate_travel[b] = std::numeric_limits<double>::infinity();
+}
+
+// The candidate lists picked from the near lists. A sphere in neither has moved by at most the
+// near lists' travel since its gap was at least their clearance.
+void refresh_candidates(World& world, std::size_t b) {
   const RigidBody& body = world.bodies[b];
   auto& lists = world.wall_candidates[b];
   lists.resize(world.walls.size());
-  double clearance = std::numeric_limits<double>::infinity();
+  double clearance = world.near_clearance[b] - world.near_travel[b];
   for (std::size_t w = 0; w < world.walls.size(); ++w) {
-    const Wall& wall = world.walls[w];
     lists[w].clear();
-    const double centre_height = (body.position - wall.point).dot(wall.normal);
-    if (centre_height - body.bounding_radius > skin) {
-      clearance = std::min(clearance, centre_height - body.bounding_radius);
-      continue;
-    }
-    // The wall's normal turned into the body frame once ((q c) . n = c . (q^-1 n)) instead of
-    // every sphere into the world: a list differs from that of a sphere-by-sphere test only by
-    // rounding at the skin's edge, and either is conservative (the forces are the same bits).
-    const Eigen::Vector3d normal_in_body = body.orientation.conjugate() * wall.normal;
-    for (std::size_t k = 0; k < body.spheres.size(); ++k) {
-      const double gap = centre_height + body.spheres[k].centre.dot(normal_in_body) - body.spheres[k].radius;
-      if (gap < skin)
-        lists[w].push_back(static_cast<int>(k));
-      else
-        clearance = std::min(clearance, gap);
-    }
+    if (!world.wall_near[b][w].empty())
+      list_within(body, world.walls[w], world.candidate_skin[b], &world.wall_near[b][w], lists[w], clearance);
   }
   world.candidate_travel[b] = 0.0;
   world.candidate_clearance[b] = clearance;
-}
-
-// A tenth of the smallest sphere's radius. The list is conservative at any skin (a sphere left
-// out stays clear until the body has moved half of it), so the skin changes only the work: a
-// wider one lists many spheres of a flat underside that never touch, a narrower one lists anew
-// too often. One diagnosis (control-01 of `bench_diagnose --nine-set-ups --trials 8`): 113 s at
-// half the radius, 103 s at a tenth, 112 s at 0.03, the report the same to the bit.
-double candidate_skin(const RigidBody& body) {
-  double smallest = body.spheres.front().radius;
-  for (const auto& s : body.spheres) smallest = std::min(smallest, s.radius);
-  return 0.1 * smallest;
 }
 
 // Records the contact's impact speed on its first step, then lets every contact-level
@@ -174,6 +208,7 @@ void wall_contact(World& world, std::size_t b, std::size_t k, std::size_t w, dou
     state.max_overlap = dent;
   }
   state.last_step = world.steps;
+  ++world.contacts_touched;
   adjust_by_terms(world, in, state);
   const ContactOutput out = hertz_mindlin(in, world.contact, state);
   world.force[b] += out.force;
@@ -216,6 +251,7 @@ void sphere_contacts(World& world, std::size_t bi, std::size_t bj, double dt) {
       in.dt = dt;
       ContactState& state = world.history[pair_key(bi, si, bj, sj)];
       state.last_step = world.steps;
+      ++world.contacts_touched;
       adjust_by_terms(world, in, state);
       const ContactOutput out = hertz_mindlin(in, world.contact, state);
       world.force[bi] += out.force;
@@ -234,8 +270,10 @@ Eigen::Quaterniond turn_by(const Eigen::Vector3d& v) {
   const double h2 = 0.25 * v.squaredNorm();  // (|v| / 2)^2
   double c = 0.0, s = 0.0;                   // cos(|v|/2) and sin(|v|/2) / |v|
   if (h2 < 4e-4) {
-    c = 1.0 - h2 / 2.0 * (1.0 - h2 / 12.0 * (1.0 - h2 / 30.0 * (1.0 - h2 / 56.0)));
-    s = 0.5 * (1.0 - h2 / 6.0 * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0)));
+    // Multiplied by the reciprocals: divisions by the constants were a chain of six divisions
+    // per call, each waited on.
+    c = 1.0 - 0.5 * h2 * (1.0 - (1.0 / 12.0) * h2 * (1.0 - (1.0 / 30.0) * h2 * (1.0 - (1.0 / 56.0) * h2)));
+    s = 0.5 * (1.0 - (1.0 / 6.0) * h2 * (1.0 - (1.0 / 20.0) * h2 * (1.0 - (1.0 / 42.0) * h2)));
   } else {
     const double h = std::sqrt(h2);
     c = std::cos(h);
@@ -247,14 +285,17 @@ Eigen::Quaterniond turn_by(const Eigen::Vector3d& v) {
 // Implicit midpoint for dq/dt = 1/2 q (0, omega_body(q)) with the world angular momentum
 // fixed: symplectic and time-reversible; fixed-point iterations converge by a factor of about
 // the step's turn (|omega| dt, a few thousandths) each. They stop once an iteration moves the
-// orientation by less than 1e-10, which leaves it about 1e-13 from the fixed point: three
-// iterations for a rolling or tumbling tuber where four were taken to reach the fixed point to
-// the bit (under perf the rotation was about half of a replay's time).
+// orientation by less than 1e-10, which leaves it about 1e-13 from the fixed point. The first
+// guess is the last step's turn, which differs from this one's by the change of the body-frame
+// spin over a step (|omega|^2 dt^2 between contacts): a tumbling tuber's flight at a 37 us step
+// took four iterations from no turn and takes two or three from the last (under perf the
+// rotation was a third of a replay's time).
 void rotate(RigidBody& body, double dt) {
   const Eigen::Quaterniond start = body.orientation;
   const Eigen::Vector3d inverse_inertia = body.inertia.cwiseInverse();
   const Eigen::Vector3d& momentum = body.angular_momentum;
-  Eigen::Quaterniond end = start;
+  Eigen::Quaterniond end = start * body.last_turn;
+  Eigen::Quaterniond turn = body.last_turn;
   for (int iteration = 0; iteration < 4; ++iteration) {
     // The momentum turned into the body frame by the midpoint's unnormalised quaternion
     // m = (w, u): R(m)^T L = ((w^2 - |u|^2) L + 2 (u.L) u - 2 w u x L) / |m|^2 (one division).
@@ -264,12 +305,14 @@ void rotate(RigidBody& body, double dt) {
     const Eigen::Vector3d in_body =
         ((w * w - u.squaredNorm()) * momentum + 2.0 * u.dot(momentum) * u - 2.0 * w * u.cross(momentum)) /
         m.squaredNorm();
-    const Eigen::Quaterniond next = start * turn_by(dt * in_body.cwiseProduct(inverse_inertia));
+    turn = turn_by(dt * in_body.cwiseProduct(inverse_inertia));
+    const Eigen::Quaterniond next = start * turn;
     const double moved = (next.coeffs() - end.coeffs()).cwiseAbs().maxCoeff();
     end = next;
     if (moved < 1e-10) break;
   }
   body.orientation = end.normalized();
+  body.last_turn = turn;
 }
 
 void rotate_wall(Wall& wall, double dt) {
@@ -283,10 +326,15 @@ void compute_forces(World& world, double dt) {
   const std::size_t n = world.bodies.size();
   world.force.assign(n, Eigen::Vector3d::Zero());
   world.torque.assign(n, Eigen::Vector3d::Zero());
-  if (world.wall_candidates.size() != n || world.candidate_clearance.size() != n) {
+  world.contacts_touched = 0;
+  if (world.wall_near.size() != n || world.near_clearance.size() != n) {
     world.wall_candidates.assign(n, {});
     world.candidate_travel.assign(n, std::numeric_limits<double>::infinity());
     world.candidate_clearance.assign(n, 0.0);
+    world.candidate_skin.assign(n, 0.0);
+    world.wall_near.assign(n, {});
+    world.near_travel.assign(n, std::numeric_limits<double>::infinity());
+    world.near_clearance.assign(n, 0.0);
   }
   for (std::size_t b = 0; b < n; ++b) {
     RigidBody& body = world.bodies[b];
@@ -303,8 +351,8 @@ void compute_forces(World& world, double dt) {
           term);
     }
     // Listed again once the body may have moved by half the gap of the nearest sphere left out.
-    if (world.candidate_travel[b] > 0.5 * world.candidate_clearance[b])
-      refresh_candidates(world, b, candidate_skin(body));
+    if (world.near_travel[b] > 0.5 * world.near_clearance[b]) refresh_near(world, b);
+    if (world.candidate_travel[b] > 0.5 * world.candidate_clearance[b]) refresh_candidates(world, b);
     const auto& lists = world.wall_candidates[b];
     if (std::all_of(lists.begin(), lists.end(), [](const auto& list) { return list.empty(); }))
       continue;  // in flight: no rotation matrix needed
@@ -323,13 +371,16 @@ void compute_forces(World& world, double dt) {
   }
   // Contacts that ended this step lose their history, except, on a plastic substrate, the
   // dent a sphere left in the plate (its largest overlap), which later contacts unload into.
+  // When every contact in the history was touched here, none ended: no sweep (most steps; the
+  // sweep walked every contact's node every step).
+  world.forces_current = true;
+  if (world.contacts_touched == world.history.size()) return;
   const bool plastic = std::any_of(world.terms.begin(), world.terms.end(),
                                    [](const PhysicsTerm& t) { return std::holds_alternative<PlasticSubstrate>(t); });
   std::erase_if(world.history, [&](const auto& entry) {
     return entry.second.last_step != world.steps &&
            !(plastic && (entry.first >> 63) == 0 && entry.second.max_overlap > 0.0);
   });
-  world.forces_current = true;
 }
 
 void step(World& world, double dt) {
@@ -345,6 +396,7 @@ void step(World& world, double dt) {
     for (const auto& wall : world.walls)
       travel += wall.spin.norm() * ((body.position - wall.pivot).norm() + body.bounding_radius) * dt;
     world.candidate_travel[b] += travel;
+    world.near_travel[b] += travel;
   }
   for (auto& wall : world.walls) rotate_wall(wall, dt);
   world.time += dt;

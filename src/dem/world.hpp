@@ -28,6 +28,9 @@ struct RigidBody {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< body -> world
   Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();       ///< world frame [kg m^2/s]
   double bounding_radius = 0.0;                                     ///< max |centre| + radius [m]
+  /// The last step's turn in the body frame (orientation before^-1 * after): the next step's
+  /// first guess of its own turn (dem/step.cpp, rotate). Only a guess: stale, it costs iterations.
+  Eigen::Quaterniond last_turn = Eigen::Quaterniond::Identity();
 
   Eigen::Vector3d angular_velocity() const;  ///< world frame [rad/s]
   /// The same from the body's rotation matrix, when the caller has built it already.
@@ -141,11 +144,22 @@ struct World {
   double time = 0.0;               ///< [s]
   std::uint64_t steps = 0;
   std::unordered_map<std::uint64_t, ContactState> history;  ///< key: contact id
-  /// Per (body, wall): spheres that may touch the wall before the next refresh.
+  /// Contacts whose state the last force evaluation touched (last_step set to `steps`): when it is
+  /// the size of `history`, no contact ended and the history needs no sweep (dem/step.cpp).
+  std::size_t contacts_touched = 0;
+  /// Per (body, wall): spheres that may touch the wall before the next refresh, picked from the
+  /// spheres near it (`wall_near`).
   std::vector<std::vector<std::vector<int>>> wall_candidates;
   std::vector<double> candidate_travel;  ///< per body: motion since its candidates were refreshed [m]
-  /// Per body: the smallest gap to a wall of a sphere left out of its lists (at least the skin) [m].
+  /// Per body: a lower bound on the gap to a wall of every sphere left out of its lists (at
+  /// least the skin, or half the near lists' skin) [m].
   std::vector<double> candidate_clearance;
+  std::vector<double> candidate_skin;  ///< per body: a tenth of its smallest sphere's radius [m]
+  /// Per (body, wall): the spheres within the smallest sphere's radius of the wall, listed again
+  /// only when the body may have moved half the gap of the nearest sphere left out.
+  std::vector<std::vector<std::vector<int>>> wall_near;
+  std::vector<double> near_travel;             ///< per body: motion since its near lists were made [m]
+  std::vector<double> near_clearance;          ///< per body: the smallest gap of a sphere left out of them [m]
   std::vector<Eigen::Vector3d> force, torque;  ///< per body, at the current state (world frame)
   /// Per material pair (row-major): E*, G* and beta, and the E, nu (both) and e they came from.
   std::vector<PairConstants> pair_constants;

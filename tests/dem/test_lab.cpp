@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -242,6 +243,65 @@ TEST(LabTests, AReplaysLowestPointIsTheMinimumOverEverySphereToTheBit) {
     if (setup.test == LabTest::Drop) {
       EXPECT_GT(lowest_changes, 5U);  // it tumbles after the impact
     }
+  }
+}
+TEST(LabTests, NoSphereTouchingAWallIsLeftOutOfItsContactList) {
+  // compute_forces checks only the spheres its wall lists name (dem/step.cpp: candidate lists
+  // picked from near lists, each made anew once the body may have moved half the gap of the
+  // nearest sphere left out). The forces are every sphere's only if no sphere overlapping a
+  // wall's plane is ever missing from that wall's list: checked after every step of a 256-sphere
+  // clump falling onto an incline and rolling down onto the flat (two finite walls), and of the
+  // 128-sphere four-square (512 spheres) on a plate tilting at 20 deg/s until it slides.
+  auto ladder = read_clump_library(test::source_dir() / "clumps" / "tuber-default-ladder.h5");
+  ASSERT_TRUE(ladder);
+  Recording roll = setup_for(LabTest::Roll, "Q235");
+  roll.start_distance = 0.07;
+  roll.incline_deg = 30.0;
+  Recording tilt = setup_for(LabTest::Tilt, "Q235");
+  tilt.tilt_rate_deg_per_s = 20.0;
+  const std::vector<std::pair<std::string, Recording>> cases{{"adaptive-256", roll}, {"adaptive-128", tilt}};
+  for (const auto& [name, setup] : cases) {
+    const Clump clump = *select_clump(*ladder, name, "tuber-default-ladder.h5");
+    auto lab = make_lab_world(clump, default_material_table(), setup, LabOptions{});
+    ASSERT_TRUE(lab) << lab.error().message;
+    World& world = lab->world;
+    RigidBody& body = world.bodies[0];
+    const Wall& first = world.walls[0];
+    double lowest = std::numeric_limits<double>::infinity();  // below the centre, lying flat
+    for (const auto& s : body.spheres) lowest = std::min(lowest, s.centre.z() - s.radius);
+    if (setup.test == LabTest::Roll) {
+      // Tumbled, 2 mm above the incline 70 mm from its foot (its u axis points down to the foot
+      // at the plate's far edge), spinning.
+      body.orientation = Eigen::Quaterniond(0.3, -0.5, 0.7, 0.4).normalized();
+      body.position = first.point + (first.half_u - 0.07) * first.u_axis + (body.bounding_radius + 2e-3) * first.normal;
+      body.angular_momentum = body.orientation * Eigen::Vector3d(0.0, 5.0, 2.0).cwiseProduct(body.inertia);
+    } else {
+      body.position = first.point + (1e-5 - lowest) * first.normal;  // lying flat on the level plate
+      world.walls[0].spin = {0.0, 20.0 * std::numbers::pi / 180.0, 0.0};
+    }
+    const double duration = setup.test == LabTest::Roll ? 1.5 : 2.2;
+    std::size_t touching = 0, missing = 0, steps = 0;
+    while (world.time < duration) {
+      step(world, lab->time_step);
+      ++steps;
+      for (std::size_t w = 0; w < world.walls.size(); ++w) {
+        const Wall& wall = world.walls[w];
+        const auto& listed = world.wall_candidates[0][w];
+        for (std::size_t k = 0; k < body.spheres.size(); ++k) {
+          const double gap = (body.sphere_position(k) - wall.point).dot(wall.normal) - body.spheres[k].radius;
+          if (gap >= 0.0) continue;
+          ++touching;
+          if (std::find(listed.begin(), listed.end(), static_cast<int>(k)) == listed.end()) ++missing;
+        }
+      }
+    }
+    const double travelled = (body.position - first.point).norm();
+    SCOPED_TRACE(testing::Message() << name << " " << body.spheres.size() << " spheres: " << steps << " steps, "
+                                    << touching << " sphere-steps touching, body " << travelled
+                                    << " m from where it started");
+    EXPECT_EQ(missing, 0U);
+    EXPECT_GT(touching, steps / 2);  // it rests or rolls on the walls most of the time
+    EXPECT_GT(travelled, 0.05);      // it rolled, or slid down the tilting plate
   }
 }
 }  // namespace clumpforge
