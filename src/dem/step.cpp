@@ -33,13 +33,14 @@ std::uint64_t pair_key(std::size_t bi, std::size_t si, std::size_t bj, std::size
 // the skin changes only the work: a wider one lists many spheres of a flat underside that never
 // touch, a narrower one lists anew too often. One diagnosis (control-01 of `bench_diagnose
 // --nine-set-ups --trials 8`): 113 s at half the radius, 103 s at a tenth, 112 s at 0.03, the
-// report the same to the bit. A rolling or resting body is listed anew every few steps at a
-// tenth, so the lists are picked from near lists, the spheres within a whole radius, themselves
+// report the same to the bit. At a tenth a rolling body's lists are made anew often, and each
+// time over every sphere, so the lists are picked from near lists, the spheres within a whole radius, themselves
 // made anew only once the body may have moved half the gap of the nearest sphere they leave out:
 // a listing walks the few near spheres, not all of a 256-sphere clump's (or a four-square's
-// 1024). `bench_time_step --trials 4` (the 256-sphere clump's replays of the nine set-ups) ran
-// 14 % fewer instructions under callgrind; LabTests.NoSphereTouchingAWallIsLeftOutOfItsContactList
-// checks that no touching sphere is ever left out.
+// 1024). Three diagnoses of the generated nine-set-up set took 0.95-0.99 of their time, their
+// reports the same (docs/diagnose.md, "Where the nine-set-up time goes");
+// LabTests.NoSphereTouchingAWallIsLeftOutOfItsContactList checks that no touching sphere is
+// ever left out.
 
 // The gap to wall `w` of each of `spheres` (all the body's when null): listed in `list` when
 // below `skin`, else counted in `clearance`.
@@ -270,10 +271,8 @@ Eigen::Quaterniond turn_by(const Eigen::Vector3d& v) {
   const double h2 = 0.25 * v.squaredNorm();  // (|v| / 2)^2
   double c = 0.0, s = 0.0;                   // cos(|v|/2) and sin(|v|/2) / |v|
   if (h2 < 4e-4) {
-    // Multiplied by the reciprocals: divisions by the constants were a chain of six divisions
-    // per call, each waited on.
-    c = 1.0 - 0.5 * h2 * (1.0 - (1.0 / 12.0) * h2 * (1.0 - (1.0 / 30.0) * h2 * (1.0 - (1.0 / 56.0) * h2)));
-    s = 0.5 * (1.0 - (1.0 / 6.0) * h2 * (1.0 - (1.0 / 20.0) * h2 * (1.0 - (1.0 / 42.0) * h2)));
+    c = 1.0 - h2 / 2.0 * (1.0 - h2 / 12.0 * (1.0 - h2 / 30.0 * (1.0 - h2 / 56.0)));
+    s = 0.5 * (1.0 - h2 / 6.0 * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0)));
   } else {
     const double h = std::sqrt(h2);
     c = std::cos(h);
@@ -285,17 +284,14 @@ Eigen::Quaterniond turn_by(const Eigen::Vector3d& v) {
 // Implicit midpoint for dq/dt = 1/2 q (0, omega_body(q)) with the world angular momentum
 // fixed: symplectic and time-reversible; fixed-point iterations converge by a factor of about
 // the step's turn (|omega| dt, a few thousandths) each. They stop once an iteration moves the
-// orientation by less than 1e-10, which leaves it about 1e-13 from the fixed point. The first
-// guess is the last step's turn, which differs from this one's by the change of the body-frame
-// spin over a step (|omega|^2 dt^2 between contacts): a tumbling tuber's flight at a 37 us step
-// took four iterations from no turn and takes two or three from the last (under perf the
-// rotation was a third of a replay's time).
+// orientation by less than 1e-10, which leaves it about 1e-13 from the fixed point: three
+// iterations for a rolling or tumbling tuber where four were taken to reach the fixed point to
+// the bit (under perf the rotation was about half of a replay's time).
 void rotate(RigidBody& body, double dt) {
   const Eigen::Quaterniond start = body.orientation;
   const Eigen::Vector3d inverse_inertia = body.inertia.cwiseInverse();
   const Eigen::Vector3d& momentum = body.angular_momentum;
-  Eigen::Quaterniond end = start * body.last_turn;
-  Eigen::Quaterniond turn = body.last_turn;
+  Eigen::Quaterniond end = start;
   for (int iteration = 0; iteration < 4; ++iteration) {
     // The momentum turned into the body frame by the midpoint's unnormalised quaternion
     // m = (w, u): R(m)^T L = ((w^2 - |u|^2) L + 2 (u.L) u - 2 w u x L) / |m|^2 (one division).
@@ -305,14 +301,12 @@ void rotate(RigidBody& body, double dt) {
     const Eigen::Vector3d in_body =
         ((w * w - u.squaredNorm()) * momentum + 2.0 * u.dot(momentum) * u - 2.0 * w * u.cross(momentum)) /
         m.squaredNorm();
-    turn = turn_by(dt * in_body.cwiseProduct(inverse_inertia));
-    const Eigen::Quaterniond next = start * turn;
+    const Eigen::Quaterniond next = start * turn_by(dt * in_body.cwiseProduct(inverse_inertia));
     const double moved = (next.coeffs() - end.coeffs()).cwiseAbs().maxCoeff();
     end = next;
     if (moved < 1e-10) break;
   }
   body.orientation = end.normalized();
-  body.last_turn = turn;
 }
 
 void rotate_wall(Wall& wall, double dt) {

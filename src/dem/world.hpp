@@ -28,9 +28,6 @@ struct RigidBody {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< body -> world
   Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();       ///< world frame [kg m^2/s]
   double bounding_radius = 0.0;                                     ///< max |centre| + radius [m]
-  /// The last step's turn in the body frame (orientation before^-1 * after): the next step's
-  /// first guess of its own turn (dem/step.cpp, rotate). Only a guess: stale, it costs iterations.
-  Eigen::Quaterniond last_turn = Eigen::Quaterniond::Identity();
 
   Eigen::Vector3d angular_velocity() const;  ///< world frame [rad/s]
   /// The same from the body's rotation matrix, when the caller has built it already.
