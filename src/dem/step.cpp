@@ -37,7 +37,7 @@ std::uint64_t pair_key(std::size_t bi, std::size_t si, std::size_t bj, std::size
 // time over every sphere, so the lists are picked from near lists, the spheres within a whole radius, themselves
 // made anew only once the body may have moved half the gap of the nearest sphere they leave out:
 // a listing walks the few near spheres, not all of a 256-sphere clump's (or a four-square's
-// 1024). Three diagnoses of the generated nine-set-up set took 0.95-0.99 of their time, their
+// 1024). Five diagnoses of the generated nine-set-up set took 0.93-0.99 of their time, their
 // reports the same (docs/diagnose.md, "Where the nine-set-up time goes");
 // LabTests.NoSphereTouchingAWallIsLeftOutOfItsContactList checks that no touching sphere is
 // ever left out.
