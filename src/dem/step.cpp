@@ -34,10 +34,10 @@ std::uint64_t pair_key(std::size_t bi, std::size_t si, std::size_t bj, std::size
 // touch, a narrower one lists anew too often. One diagnosis (control-01 of `bench_diagnose
 // --nine-set-ups --trials 8`): 113 s at half the radius, 103 s at a tenth, 112 s at 0.03, the
 // report the same to the bit. At a tenth a rolling body's lists are made anew often, and each
-// time over every sphere, so the lists are picked from near lists, the spheres within a whole radius, themselves
-// made anew only once the body may have moved half the gap of the nearest sphere they leave out:
-// a listing walks the few near spheres, not all of a 256-sphere clump's (or a four-square's
-// 1024). Five diagnoses of the generated nine-set-up set took 0.93-0.99 of their time, their
+// time over every sphere, so the lists are picked from near lists (the spheres within a whole
+// radius), themselves made anew only once the body may have moved half the gap of the nearest
+// sphere they leave out: a listing walks the few near spheres, not all of a 256-sphere clump's
+// (or a four-square's 1024). Five diagnoses of the generated nine-set-up set took 0.93-0.99 of their time, their
 // reports the same (docs/diagnose.md, "Where the nine-set-up time goes");
 // LabTests.NoSphereTouchingAWallIsLeftOutOfItsContactList checks that no touching sphere is
 // ever left out.

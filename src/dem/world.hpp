@@ -149,7 +149,7 @@ struct World {
   std::vector<std::vector<std::vector<int>>> wall_candidates;
   std::vector<double> candidate_travel;  ///< per body: motion since its candidates were refreshed [m]
   /// Per body: a lower bound on the gap to a wall of every sphere left out of its lists (at
-  /// least the skin, or half the near lists' skin) [m].
+  /// least the skin) [m].
   std::vector<double> candidate_clearance;
   std::vector<double> candidate_skin;  ///< per body: a tenth of its smallest sphere's radius [m]
   /// Per (body, wall): the spheres within the smallest sphere's radius of the wall, listed again
