@@ -31,7 +31,7 @@ struct DiagnoseArgs {
   int ensemble_replays = 12, ensemble_replays_at_gate = 48;
   int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
   std::uint64_t seed = 1;
-  bool json = false;
+  bool json = false, no_replay_reuse = false;
 };
 
 void print_text(const DiagnoseResult& r) {
@@ -121,6 +121,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.ensemble_replays = args.ensemble_replays;
   options.ensemble_replays_at_gate = args.ensemble_replays_at_gate;
   options.release_orientations = args.release_orientations;
+  options.reuse_replays = !args.no_replay_reuse;
   for (const auto& name : args.effects) {
     auto e = parse_effect(name);
     if (!e) return report_error(kCommand, e.error());
@@ -211,6 +212,9 @@ Command add_diagnose_command(CLI::App& app) {
                   "candidate's margin within the draw's reach, a candidate past the margin that leaves the outcomes "
                   "inconsistent): each decision is judged again, or the comparison made again, with these; each "
                   "finer clump's move is measured with them too (0, or no more than --ensemble-replays: never)");
+  sub->add_flag("--no-replay-reuse", args->no_replay_reuse,
+                "Run every replay beyond the release horizon, even one already run with the same clump, model and "
+                "release orientation (by default read back, the same bits: report.json's replays_reused counts them)");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   add_output_option(*sub, args->out, "Directory for report.json, tracks.json and the figures (PNG, SVG)");

@@ -378,6 +378,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["tracked_trials"] = r.tracked_trials;
   j["training_trials"] = r.training_trials;
   j["trial_replays"] = r.evaluations;
+  j["replays_reused"] = r.replays_reused;
   j["seconds"] = r.seconds;
   j["stage_seconds"] = nlohmann::json::array();
   for (const auto& st : r.stage_seconds)

@@ -27,6 +27,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   if (!any_track) return diagnose_summaries(clump, table, recordings, names, options, run);
 
   Context c;
+  if (options.reuse_replays) c.ev.memo = &c.memo;
   c.names = names;
   c.run = &run;
   c.ev.clump = &clump;
@@ -157,6 +158,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   track_plots(c, result, *full_base, *full_improved);
   took(Stage::Ensemble);
   result.evaluations = c.evaluations;
+  result.replays_reused = c.memo.reused();
   result.seconds = seconds_since(started);
   run.report("done", 1.0);
   return result;

@@ -73,6 +73,11 @@ struct DiagnoseOptions {
   /// missing physics the coefficients are refitted with the finer clumps left. Empty: the
   /// clump is taken as it is.
   std::vector<Clump> finer_clumps;
+  /// A replay beyond the release horizon asked for again (the same clump, model, recording and
+  /// release orientation) is read back from the first time it ran, the same bits (ReplayMemo in
+  /// diagnose/ensemble.hpp). False: every one is run (slower; a check that reading back
+  /// changes nothing).
+  bool reuse_replays = true;
   std::uint64_t seed = 1;
 };
 
@@ -367,6 +372,9 @@ struct DiagnoseResult {
   std::optional<ParticleModelCheck> particle_model;  ///< when finer clumps were given
   std::optional<FlightWobble> flights;               ///< when drops were tracked
   int tracked_trials = 0, training_trials = 0, evaluations = 0;
+  /// Of `evaluations`, the replays beyond the release horizon read back from an earlier
+  /// comparison's (ReplayMemo): the same model, clump and release orientation, not run again.
+  int replays_reused = 0;
   double seconds = 0.0;
   std::vector<StageTime> stage_seconds;  ///< the stages that ran, in order
 };

@@ -8,6 +8,8 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <string>
+#include <type_traits>
 
 #include "diagnose/release.hpp"
 #include "diagnose/tracks.hpp"
@@ -554,15 +556,64 @@ std::vector<std::pair<Outcome, double>> replay_for(const PlanJob& job, const Pla
   return measured;
 }
 
+/// Appends `v`'s bytes to `key`.
+template <typename T>
+void append_bytes(std::string& key, const T& v) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  key.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+/// ReplayMemo's key of replay `k` of `plan` under `model`: replay_for's inputs, the evaluator's
+/// clump and materials table by address (its lab options are those of every evaluator sharing
+/// the memo).
+std::string replay_key(const Evaluator& ev, const Model& model, const Plan& plan, std::size_t k) {
+  std::string key;
+  append_bytes(key, ev.clump);
+  append_bytes(key, ev.table);
+  append_bytes(key, ev.drop_steps_per_contact);
+  append_bytes(key, plan.recording);
+  for (double v : {plan.duration, plan.frame, plan.moved, plan.tilt_rate_deg_per_s, plan.drift_after_impact})
+    append_bytes(key, v);
+  const Eigen::Quaterniond& q = plan.orientations[k];
+  for (double v : {q.w(), q.x(), q.y(), q.z()}) append_bytes(key, v);
+  for (const SurfaceParameters& b : model.base) {
+    append_bytes(key, b.surface.size());
+    key += b.surface;
+    for (double v : {b.interaction.restitution, b.interaction.static_friction, b.interaction.rolling_friction})
+      append_bytes(key, v);
+  }
+  append_bytes(key, model.effect.has_value());
+  append_bytes(key, model.effect.value_or(Effect::AirDrag));
+  for (double v : model.values) append_bytes(key, v);
+  return key;
+}
+
+}  // namespace
+
+const ReplayMemo::Measured* ReplayMemo::find(const std::string& key) const {
+  const auto it = kept_.find(key);
+  return it == kept_.end() ? nullptr : &it->second;
+}
+
+void ReplayMemo::keep(std::string key, Measured measured) {
+  kept_.insert_or_assign(std::move(key), std::move(measured));
+}
+
+namespace {
+
 /// The outcomes of every plan's replays under `model`; plans not in `run` keep `reuse`'s values.
 /// Every plan's replays run in one parallel loop: a loop per plan waited at each plan's end for
-/// its slowest replay (a roll's replays differ by up to a second of rolling).
+/// its slowest replay (a roll's replays differ by up to a second of rolling). A replay the
+/// evaluator's memo holds is read back, not run; `replays` counts both.
 Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const std::vector<Plan>& plans,
                                const std::vector<bool>& run, const Sample* reuse, int& replays) {
   const auto& recs = *ev.recordings;
   Sample out(plans.size());
   std::vector<PlanJob> jobs;
-  std::vector<std::pair<std::size_t, std::size_t>> tasks;  // (job, orientation)
+  std::vector<std::pair<std::size_t, std::size_t>> slots;  // (plan, orientation), in order
+  std::vector<ReplayMemo::Measured> measured;              // per slot
+  std::vector<std::pair<std::size_t, std::size_t>> tasks;  // (job, slot) to run
+  std::vector<std::string> keys;                           // per task, when there is a memo
   if (auto ok = check_cancelled(ev); !ok) return std::unexpected(ok.error());
   for (std::size_t p = 0; p < plans.size(); ++p) {
     if (!run[p] && reuse != nullptr) {
@@ -570,35 +621,53 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
       continue;
     }
     const Recording& rec = recs[plans[p].recording];
-    PlanJob job{p, lab_options_for(ev, model, rec), {}, 0.0};
-    auto world = make_lab_world(*ev.clump, *ev.table, rec, job.lab);
-    if (!world) return std::unexpected(world.error());
-    job.world = std::move(*world);
-    if (rec.test == LabTest::Tilt) job.tilt_start = tilt_start_deg(job.world.interaction, job.lab.terms);
-    for (std::size_t k = 0; k < plans[p].orientations.size(); ++k) tasks.emplace_back(jobs.size(), k);
-    jobs.push_back(std::move(job));
+    std::optional<std::size_t> job;
+    for (std::size_t k = 0; k < plans[p].orientations.size(); ++k) {
+      slots.emplace_back(p, k);
+      measured.emplace_back();
+      std::string key = ev.memo ? replay_key(ev, model, plans[p], k) : std::string();
+      if (const ReplayMemo::Measured* kept = ev.memo ? ev.memo->find(key) : nullptr) {
+        measured.back() = *kept;
+        ev.memo->count_reused(1);
+        continue;
+      }
+      if (!job) {
+        PlanJob made{p, lab_options_for(ev, model, rec), {}, 0.0};
+        auto world = make_lab_world(*ev.clump, *ev.table, rec, made.lab);
+        if (!world) return std::unexpected(world.error());
+        made.world = std::move(*world);
+        if (rec.test == LabTest::Tilt) made.tilt_start = tilt_start_deg(made.world.interaction, made.lab.terms);
+        job = jobs.size();
+        jobs.push_back(std::move(made));
+      }
+      tasks.emplace_back(*job, slots.size() - 1);
+      keys.push_back(std::move(key));
+    }
   }
-  std::vector<std::vector<std::pair<Outcome, double>>> measured(tasks.size());
   tbb::parallel_for(std::size_t{0}, tasks.size(), [&](std::size_t i) {
     const PlanJob& job = jobs[tasks[i].first];
-    measured[i] = replay_for(job, plans[job.plan], recs[plans[job.plan].recording], tasks[i].second);
+    const std::size_t slot = tasks[i].second;
+    measured[slot] = replay_for(job, plans[job.plan], recs[plans[job.plan].recording], slots[slot].second);
   });
-  for (const auto& job : jobs) out[job.plan].assign(plans[job.plan].outcomes.size(), {});
-  for (std::size_t i = 0; i < tasks.size(); ++i) {
-    const std::size_t p = jobs[tasks[i].first].plan;
-    const Plan& plan = plans[p];
+  if (ev.memo)
+    for (std::size_t i = 0; i < tasks.size(); ++i) ev.memo->keep(std::move(keys[i]), measured[tasks[i].second]);
+  for (std::size_t p = 0; p < plans.size(); ++p)
+    if (run[p] || reuse == nullptr) out[p].assign(plans[p].outcomes.size(), {});
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    const Plan& plan = plans[slots[i].first];
+    auto& values = out[slots[i].first];
     // Looked up by outcome: a plan keeps only those measured on every recorded trial.
     for (std::size_t o = 0; o < plan.outcomes.size(); ++o) {
       const auto& m = measured[i];
       const auto it = std::find_if(m.begin(), m.end(), [&](const auto& v) { return v.first == plan.outcomes[o]; });
       if (it == m.end()) continue;
       if (std::isfinite(it->second))
-        out[p][o].push_back(it->second);
+        values[o].push_back(it->second);
       else if (it->first == Outcome::SlipAngle)
-        out[p][o].push_back(89.0);  // a replay runs to 89 degrees: one that never slid counts as sliding there
+        values[o].push_back(89.0);  // a replay runs to 89 degrees: one that never slid counts as sliding there
     }
   }
-  replays += static_cast<int>(tasks.size());
+  replays += static_cast<int>(slots.size());
   return out;
 }
 

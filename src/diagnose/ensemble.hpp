@@ -20,7 +20,9 @@
 #include <functional>
 #include <limits>
 #include <optional>
+#include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -425,6 +427,30 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
                                          const std::vector<TrialScore>& scores,
                                          const std::vector<FreeCoefficient>& free,
                                          const std::vector<Effect>& candidates, const EnsembleOptions& options);
+
+/// The outcomes of every replay a diagnosis compared, each under a key of all that can change
+/// within the diagnosis and sets the replay (the clump, the recording, the whole model, the
+/// release orientation, and the plan's duration, frame, tilt rate and reading thresholds). The
+/// evaluators that share one (Evaluator::memo: the diagnosis's and its copies) share their lab
+/// options, which are not in the key.
+/// A replay asked for again (the same orientations are drawn again by every comparison of a
+/// model: a rung's calibrated null is replayed again when the next clump's move is measured,
+/// and a second comparison with more replays starts with the first's) is read back, the same
+/// bits, not run again. Used from the serial part of a comparison only: not thread-safe.
+class ReplayMemo {
+ public:
+  using Measured = std::vector<std::pair<Outcome, double>>;
+  /// The kept outcomes under `key`, none when that replay was not run.
+  const Measured* find(const std::string& key) const;
+  void keep(std::string key, Measured measured);
+  /// Replays read back rather than run.
+  [[nodiscard]] int reused() const { return reused_; }
+  void count_reused(int n) { reused_ += n; }
+
+ private:
+  std::unordered_map<std::string, Measured> kept_;
+  int reused_ = 0;
+};
 
 /// The orientations compare_ensembles draws for its null (and compare_model by default).
 constexpr std::uint64_t kNullStream = 90000;

@@ -68,6 +68,8 @@ struct TrialScore {
   std::vector<std::pair<Phase, Axis>> cells;
 };
 
+class ReplayMemo;
+
 /// The set-up shared by every evaluation of a diagnosis.
 struct Evaluator {
   const Clump* clump = nullptr;
@@ -87,6 +89,9 @@ struct Evaluator {
   bool full_duration = false;       ///< replay whole tracks, not only up to each trial's horizon (plots, summaries)
   /// True when the caller asked to stop (RunContext::cancelled): evaluations end with Cancelled.
   std::function<bool()> cancelled;
+  /// The replays beyond the release horizon compared so far (diagnose/ensemble.hpp), read back
+  /// when asked for again; none: every replay run.
+  ReplayMemo* memo = nullptr;
 };
 
 /// Cancelled when the evaluator's caller asked to stop.

@@ -184,6 +184,9 @@ struct Context {
   /// a gate, which asks the same of it: the refit is frame by frame, before the release horizon,
   /// and does not depend on the replays beyond it. Emptied when the ensemble stage ends.
   std::map<std::pair<const Clump*, const Model*>, Refitted> refits;
+  /// The replays beyond the release horizon compared so far; ev.memo points here (so a Context is
+  /// never copied or moved once made).
+  ReplayMemo memo;
 };
 
 /// Replays run with `clump` while it lives; the clump before it is restored after.

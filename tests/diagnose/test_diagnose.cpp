@@ -707,6 +707,61 @@ TEST(DiagnoseParticleModel, AClumpThatAgreesExplainsOnlyOnceTheNextReplaysTheSam
   }
 }
 
+namespace {
+
+// Whether two diagnoses said the same, to the bit: the verdict and all it rests on (the notes
+// carry every calibrated coefficient and chi^2 as printed), the replays compared, each chi^2
+// beyond the release horizon and each rung's.
+void expect_same_diagnosis(const DiagnoseResult& a, const DiagnoseResult& b) {
+  EXPECT_EQ(a.verdict, b.verdict);
+  EXPECT_EQ(a.basis, b.basis);
+  EXPECT_EQ(a.statement, b.statement);
+  EXPECT_EQ(a.notes, b.notes);
+  EXPECT_EQ(a.evaluations, b.evaluations);
+  ASSERT_EQ(a.ensemble.has_value(), b.ensemble.has_value());
+  if (a.ensemble) {
+    EXPECT_EQ(a.ensemble->null_chi2, b.ensemble->null_chi2);
+    ASSERT_EQ(a.ensemble->hypotheses.size(), b.ensemble->hypotheses.size());
+    for (std::size_t k = 0; k < a.ensemble->hypotheses.size(); ++k)
+      EXPECT_EQ(a.ensemble->hypotheses[k].chi2, b.ensemble->hypotheses[k].chi2) << k;
+  }
+  ASSERT_EQ(a.particle_model.has_value(), b.particle_model.has_value());
+  if (!a.particle_model) return;
+  ASSERT_EQ(a.particle_model->rungs.size(), b.particle_model->rungs.size());
+  for (std::size_t k = 0; k < a.particle_model->rungs.size(); ++k) {
+    const ParticleModelRung &x = a.particle_model->rungs[k], &y = b.particle_model->rungs[k];
+    EXPECT_TRUE(x.chi2_per_value == y.chi2_per_value || (std::isnan(x.chi2_per_value) && std::isnan(y.chi2_per_value)))
+        << k;
+    ASSERT_EQ(x.outcome_shift.has_value(), y.outcome_shift.has_value()) << k;
+    if (x.outcome_shift) {
+      EXPECT_EQ(x.outcome_shift->chi2, y.outcome_shift->chi2) << k;
+    }
+  }
+}
+
+}  // namespace
+
+TEST(DiagnoseParticleModel, AReplayReadBackChangesNothing) {
+  // A replay asked for again (the same clump, model, recording and release orientation) is read
+  // back, not run again (ReplayMemo): the last rung's move is measured on 48 replays from the
+  // previous clump's calibrated coefficients, whose first 12 are that clump's calibrated null.
+  // Control-09 with the 64- and 128-sphere fills, with and without reading back: the same
+  // diagnosis to the bit, and replays read back only with it. About five minutes: labelled
+  // `slow` (EnsembleReplayMemo checks the memo itself in the default suite).
+  auto set = control_09({"adaptive-64", "adaptive-128"});
+  ASSERT_TRUE(set);
+  DiagnoseOptions options;
+  options.roll_release = RollPosture::Any;
+  options.finer_clumps = set->ladder;
+  auto read_back = diagnose(set->coarse, set->table, set->made.recordings, set->made.names, options);
+  options.reuse_replays = false;
+  auto run_all = diagnose(set->coarse, set->table, set->made.recordings, set->made.names, options);
+  ASSERT_TRUE(read_back && run_all);
+  EXPECT_GT(read_back->replays_reused, 0);
+  EXPECT_EQ(run_all->replays_reused, 0);
+  expect_same_diagnosis(*read_back, *run_all);
+}
+
 // Tuber drops on soil from `heights`, `trials` each, made from the finer adaptive-340 of the
 // default scan with `base` (the table's soil coefficients when unset), no release orientation.
 Result<ConcealResult> soil_drops_from_the_finer_body(int trials, const std::vector<double>& heights, std::uint64_t seed,

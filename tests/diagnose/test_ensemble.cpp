@@ -13,10 +13,13 @@
 #include <vector>
 
 #include "core/rng.hpp"
+#include "diagnose/conceal.hpp"
 #include "diagnose/ensemble.hpp"
 #include "diagnose/release.hpp"
 #include "diagnose/stages.hpp"
 #include "diagnose/tracks.hpp"
+#include "io/clump_library.hpp"
+#include "support/test_support.hpp"
 
 using namespace clumpforge;
 
@@ -1200,4 +1203,79 @@ TEST(EnsembleTilt, ARestitutionLawsTiltReplayStartsLevel) {
   EXPECT_NEAR(tilt_start_deg(steel, {PhysicsTerm{QuadraticAirDrag{}}}), tilt_start_deg(steel, {}), 1e-12);
   EXPECT_EQ(tilt_start_deg(steel, {PhysicsTerm{ViscoelasticRestitution{.exponent = 0.5}}}), 0.0);
   EXPECT_EQ(tilt_start_deg(steel, {PhysicsTerm{ElasticPlasticRestitution{.yield_speed = 0.05}}}), 0.0);
+}
+
+TEST(EnsembleReplayMemo, AReplayAskedForAgainIsReadBackTheSameAndNoOtherIs) {
+  // Four 1 m drops of the 340-sphere body, compared with replays of the diagnosis's 32-sphere
+  // clump. The same model compared twice: the second time every replay is read back and every
+  // comparison is the bits of one made with no memo at all; a model one coefficient away is run.
+  auto generators = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
+  auto clumps = read_clump_library(test::source_dir() / "clumps" / "tuber-default-diagnosis.h5");
+  ASSERT_TRUE(generators && clumps);
+  auto generator = select_clump(std::move(*generators), "adaptive-340", "tuber-default.h5");
+  ASSERT_TRUE(generator);
+  const MaterialTable table = default_material_table();
+  ConcealOptions conceal;
+  conceal.trials = 4;
+  conceal.drop_heights = {1.0};
+  conceal.roll_starts = {};
+  conceal.tilt = false;
+  conceal.seed = 11;
+  auto made = make_concealed_recordings(*generator, table, conceal);
+  ASSERT_TRUE(made) << made.error().message;
+  ReplayMemo memo;
+  Evaluator ev;
+  ev.clump = &clumps->front();
+  ev.table = &table;
+  ev.recordings = &made->recordings;
+  ev.lab = diagnosis_lab_options();
+  ev.memo = &memo;
+  for (std::size_t r = 0; r < made->recordings.size(); ++r) {
+    ev.sigma.push_back(1e-4);
+    for (std::size_t t = 0; t < made->recordings[r].trials.size(); ++t) {
+      const Track& track = *made->recordings[r].trials[t].track;
+      ev.trials.push_back({.recording = r, .trial = t, .duration = track.t.back() - track.t.front()});
+    }
+  }
+  const std::vector<TrialScore> scores(ev.trials.size());  // the tracks as filmed
+  Model model{.base = {{"Q235", *table.interaction("tuber", "Q235")}}, .effect = std::nullopt, .values = {}};
+  EnsembleOptions eo;
+  eo.replays = 4;
+  int replays = 0;
+  auto first = compare_model(ev, model, scores, eo, replays);
+  ASSERT_TRUE(first) << first.error().message;
+  ASSERT_FALSE(first->empty());
+  EXPECT_EQ(memo.reused(), 0);
+  const int run_first = replays;
+  auto again = compare_model(ev, model, scores, eo, replays);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(memo.reused(), run_first);  // every one read back
+  Evaluator without = ev;
+  without.memo = nullptr;
+  int unused = 0;
+  auto fresh = compare_model(without, model, scores, eo, unused);
+  ASSERT_TRUE(fresh);
+  ASSERT_EQ(again->size(), fresh->size());
+  for (std::size_t j = 0; j < fresh->size(); ++j) {
+    EXPECT_EQ((*again)[j].ensemble_value, (*fresh)[j].ensemble_value) << j;
+    EXPECT_EQ((*again)[j].z, (*fresh)[j].z) << j;
+    EXPECT_EQ((*first)[j].z, (*fresh)[j].z) << j;
+  }
+  // More replays from the same stream: its first four are the ones run, the rest are new.
+  eo.replays = 6;
+  auto more = compare_model(ev, model, scores, eo, replays);
+  ASSERT_TRUE(more);
+  EXPECT_EQ(memo.reused(), 2 * run_first);
+  // Another restitution, or the clump of another rung: nothing read back.
+  model.base[0].interaction.restitution += 1e-6;
+  auto other = compare_model(ev, model, scores, eo, replays);
+  ASSERT_TRUE(other);
+  EXPECT_EQ(memo.reused(), 2 * run_first);
+  model.base[0].interaction.restitution -= 1e-6;
+  ev.clump = &*generator;
+  eo.replays = 4;
+  auto finer = compare_model(ev, model, scores, eo, replays);
+  ASSERT_TRUE(finer);
+  EXPECT_EQ(memo.reused(), 2 * run_first);
+  EXPECT_NE((*finer)[0].ensemble_value, (*first)[0].ensemble_value);
 }
