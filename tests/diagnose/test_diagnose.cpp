@@ -46,19 +46,6 @@ Track falling_track(double t0, double sigma, std::uint64_t seed) {
   return track;
 }
 
-// Four trials of 1 m drops only (the fast blind subset), seed 11, `effect` hidden at `values`.
-ConcealOptions one_metre_drops(std::optional<Effect> effect = std::nullopt, std::vector<double> values = {}) {
-  ConcealOptions conceal;
-  conceal.trials = 4;
-  conceal.drop_heights = {1.0};
-  conceal.roll_starts = {};
-  conceal.tilt = false;
-  conceal.seed = 11;
-  conceal.effect = effect;
-  conceal.values = std::move(values);
-  return conceal;
-}
-
 // Recordings of the finer 340-sphere body made with `conceal`, diagnosed against the 32-sphere
 // clump with `effect` the only candidate and no replay ensembles (the frame-by-frame figures are
 // the ones asserted), and `finer` for the particle-model check.
@@ -275,7 +262,7 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
   options.max_evaluations = 30;
   for (bool with_drag : {false, true}) {
     SCOPED_TRACE(with_drag);
-    const ConcealOptions conceal = with_drag ? one_metre_drops(Effect::AirDrag, {1.5}) : one_metre_drops();
+    const ConcealOptions conceal = with_drag ? test::one_metre_drops(Effect::AirDrag, {1.5}) : test::one_metre_drops();
     ASSERT_EQ(conceal.orientation, OrientationRecord::None);
     auto made = make_concealed_recordings(finer, table, conceal);
     ASSERT_TRUE(made) << made.error().message;
@@ -324,7 +311,7 @@ TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) 
   for (const double cd : {0.0, 0.1, 0.45}) {
     // The benchmark's small set (drops from 0.2 and 1 m, a 100 mm roll, a tilt; 4 trials), its
     // air_drag-realistic case's seed.
-    ConcealOptions conceal = cd > 0.0 ? one_metre_drops(Effect::AirDrag, {cd}) : one_metre_drops();
+    ConcealOptions conceal = cd > 0.0 ? test::one_metre_drops(Effect::AirDrag, {cd}) : test::one_metre_drops();
     conceal.drop_heights = {0.2, 1.0};
     conceal.roll_starts = {0.10};
     conceal.tilt = true;
@@ -363,7 +350,7 @@ TEST(DiagnoseBlind, TheSmallestDetectableEffectHoldsToTheLargeMisfitANameNeeds) 
 // misfits these recordings by delta-chi^2 about 3600 (the tilt's): the release is a nuisance,
 // and at other releases the trials allow, the strong offset is not rejected.
 TEST(DiagnoseBlind, AStrongEffectWhosePathHangsOnTheReleaseIsNotCalledAbsent) {
-  ConcealOptions conceal = one_metre_drops(Effect::ComOffset, {2.5e-3, 1.2e-3});
+  ConcealOptions conceal = test::one_metre_drops(Effect::ComOffset, {2.5e-3, 1.2e-3});
   conceal.drop_heights = {};
   conceal.roll_starts = {0.10};
   conceal.tilt = true;
@@ -407,7 +394,7 @@ TEST(DiagnoseBlind, AStrongEffectWhosePathHangsOnTheReleaseIsNotCalledAbsent) {
 // 0.1 hidden: the 32-sphere clump responds more than the 340-sphere body. Refitting the
 // coefficients to the replays at 0.078 (tried, not kept) still shows it.
 TEST(DiagnoseBlind, TheSmallestDetectableEffectIsOneAReplayShowed) {
-  ConcealOptions conceal = one_metre_drops(Effect::StaticKineticFriction, {0.1});
+  ConcealOptions conceal = test::one_metre_drops(Effect::StaticKineticFriction, {0.1});
   conceal.drop_heights = {};
   conceal.tilt = true;
   auto result = diagnose_frame_by_frame(conceal, Effect::StaticKineticFriction);
@@ -435,7 +422,7 @@ TEST(DiagnoseBlind, TheSmallestDetectableEffectIsOneAReplayShowed) {
 // rejected the strong adhesion by 8887 and 0.135 J/m^2 was claimed as the smallest detectable.
 // With the friction calibrated again over its whole range, they fit it better than the null.
 TEST(DiagnoseBlind, AnEffectTheCoefficientsAbsorbFarFromTheNullIsNotCalledAbsent) {
-  ConcealOptions conceal = one_metre_drops(Effect::Adhesion, {0.4});
+  ConcealOptions conceal = test::one_metre_drops(Effect::Adhesion, {0.4});
   // clumpforge-conceal's six recordings: on the tilt alone (4 or 8 trials) the first-order signal
   // does not show, and the check is not reached.
   conceal.drop_heights = {0.2, 0.5, 1.0};
@@ -476,7 +463,7 @@ TEST(DiagnoseBlind, AnEffectOutsideTheCandidatesIsUnexplainedNotNamed) {
   DiagnoseOptions options;
   options.effects = {Effect::ViscousRolling};
   options.max_evaluations = 30;
-  auto made = make_concealed_recordings(clump, table, one_metre_drops(Effect::AirDrag, {1.5}));
+  auto made = make_concealed_recordings(clump, table, test::one_metre_drops(Effect::AirDrag, {1.5}));
   ASSERT_TRUE(made) << made.error().message;
   auto result = diagnose(clump, table, made->recordings, made->names, options);
   ASSERT_TRUE(result) << result.error().message;
@@ -496,7 +483,7 @@ TEST(DiagnoseBlind, OneTrialsMisfitIsAnOutlierNotAMismatch) {
   // That is an outlier, not a mismatch the trials share: `none`, with the outlier said.
   const Clump clump = diagnosis_clump();
   const MaterialTable table = default_material_table();
-  ConcealOptions conceal = one_metre_drops();
+  ConcealOptions conceal = test::one_metre_drops();
   auto made = make_concealed_recordings(clump, table, conceal);
   ASSERT_TRUE(made) << made.error().message;
   Track& track = *made->recordings[0].trials[0].track;

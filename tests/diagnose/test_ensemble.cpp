@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/rng.hpp"
+#include "diagnose/bodies.hpp"
 #include "diagnose/conceal.hpp"
 #include "diagnose/ensemble.hpp"
 #include "diagnose/release.hpp"
@@ -1209,19 +1210,11 @@ TEST(EnsembleReplayMemo, AReplayAskedForAgainIsReadBackTheSameAndNoOtherIs) {
   // Four 1 m drops of the 340-sphere body, compared with replays of the diagnosis's 32-sphere
   // clump. The same model compared twice: the second time every replay is read back and every
   // comparison is the bits of one made with no memo at all; a model one coefficient away is run.
-  auto generators = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
   auto clumps = read_clump_library(test::source_dir() / "clumps" / "tuber-default-diagnosis.h5");
-  ASSERT_TRUE(generators && clumps);
-  auto generator = select_clump(std::move(*generators), "adaptive-340", "tuber-default.h5");
-  ASSERT_TRUE(generator);
+  ASSERT_TRUE(clumps);
+  const Clump generator = test::generator_tuber();
   const MaterialTable table = default_material_table();
-  ConcealOptions conceal;
-  conceal.trials = 4;
-  conceal.drop_heights = {1.0};
-  conceal.roll_starts = {};
-  conceal.tilt = false;
-  conceal.seed = 11;
-  auto made = make_concealed_recordings(*generator, table, conceal);
+  auto made = make_concealed_recordings(generator, table, test::one_metre_drops());
   ASSERT_TRUE(made) << made.error().message;
   ReplayMemo memo;
   Evaluator ev;
@@ -1272,7 +1265,7 @@ TEST(EnsembleReplayMemo, AReplayAskedForAgainIsReadBackTheSameAndNoOtherIs) {
   ASSERT_TRUE(other);
   EXPECT_EQ(memo.reused(), 2 * run_first);
   model.base[0].interaction.restitution -= 1e-6;
-  ev.clump = &*generator;
+  ev.clump = &generator;
   eo.replays = 4;
   auto finer = compare_model(ev, model, scores, eo, replays);
   ASSERT_TRUE(finer);
