@@ -563,19 +563,14 @@ void append_bytes(std::string& key, const T& v) {
   key.append(reinterpret_cast<const char*>(&v), sizeof(T));
 }
 
-/// ReplayMemo's key of replay `k` of `plan` under `model`: replay_for's inputs, the evaluator's
-/// clump and materials table by address (its lab options are those of every evaluator sharing
-/// the memo).
-std::string replay_key(const Evaluator& ev, const Model& model, const Plan& plan, std::size_t k) {
+/// The part of ReplayMemo's key that one call of replay_outcomes shares: the evaluator's clump
+/// and materials table by address (its lab options are those of every evaluator sharing the
+/// memo) and the whole model.
+std::string model_key(const Evaluator& ev, const Model& model) {
   std::string key;
   append_bytes(key, ev.clump);
   append_bytes(key, ev.table);
   append_bytes(key, ev.drop_steps_per_contact);
-  append_bytes(key, plan.recording);
-  for (double v : {plan.duration, plan.frame, plan.moved, plan.tilt_rate_deg_per_s, plan.drift_after_impact})
-    append_bytes(key, v);
-  const Eigen::Quaterniond& q = plan.orientations[k];
-  for (double v : {q.w(), q.x(), q.y(), q.z()}) append_bytes(key, v);
   for (const SurfaceParameters& b : model.base) {
     append_bytes(key, b.surface.size());
     key += b.surface;
@@ -584,15 +579,29 @@ std::string replay_key(const Evaluator& ev, const Model& model, const Plan& plan
   }
   append_bytes(key, model.effect.has_value());
   append_bytes(key, model.effect.value_or(Effect::AirDrag));
+  append_bytes(key, model.values.size());
   for (double v : model.values) append_bytes(key, v);
+  return key;
+}
+
+/// ReplayMemo's key of replay `k` of `plan`: `model`'s key (model_key) and replay_for's other inputs.
+std::string replay_key(const std::string& model, const Plan& plan, std::size_t k) {
+  std::string key = model;
+  append_bytes(key, plan.recording);
+  for (double v : {plan.duration, plan.frame, plan.moved, plan.tilt_rate_deg_per_s, plan.drift_after_impact})
+    append_bytes(key, v);
+  const Eigen::Quaterniond& q = plan.orientations[k];
+  for (double v : {q.w(), q.x(), q.y(), q.z()}) append_bytes(key, v);
   return key;
 }
 
 }  // namespace
 
-const ReplayMemo::Measured* ReplayMemo::find(const std::string& key) const {
+const ReplayMemo::Measured* ReplayMemo::read_back(const std::string& key) {
   const auto it = kept_.find(key);
-  return it == kept_.end() ? nullptr : &it->second;
+  if (it == kept_.end()) return nullptr;
+  ++reused_;
+  return &it->second;
 }
 
 void ReplayMemo::keep(std::string key, Measured measured) {
@@ -615,6 +624,7 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
   std::vector<std::pair<std::size_t, std::size_t>> tasks;  // (job, slot) to run
   std::vector<std::string> keys;                           // per task, when there is a memo
   if (auto ok = check_cancelled(ev); !ok) return std::unexpected(ok.error());
+  const std::string shared = ev.memo ? model_key(ev, model) : std::string();
   for (std::size_t p = 0; p < plans.size(); ++p) {
     if (!run[p] && reuse != nullptr) {
       out[p] = (*reuse)[p];
@@ -625,10 +635,9 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
     for (std::size_t k = 0; k < plans[p].orientations.size(); ++k) {
       slots.emplace_back(p, k);
       measured.emplace_back();
-      std::string key = ev.memo ? replay_key(ev, model, plans[p], k) : std::string();
-      if (const ReplayMemo::Measured* kept = ev.memo ? ev.memo->find(key) : nullptr) {
+      std::string key = ev.memo ? replay_key(shared, plans[p], k) : std::string();
+      if (const ReplayMemo::Measured* kept = ev.memo ? ev.memo->read_back(key) : nullptr) {
         measured.back() = *kept;
-        ev.memo->count_reused(1);
         continue;
       }
       if (!job) {
@@ -641,7 +650,7 @@ Result<Sample> replay_outcomes(const Evaluator& ev, const Model& model, const st
         jobs.push_back(std::move(made));
       }
       tasks.emplace_back(*job, slots.size() - 1);
-      keys.push_back(std::move(key));
+      if (ev.memo) keys.push_back(std::move(key));
     }
   }
   tbb::parallel_for(std::size_t{0}, tasks.size(), [&](std::size_t i) {

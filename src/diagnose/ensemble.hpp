@@ -440,12 +440,11 @@ Result<EnsembleResult> compare_ensembles(const Evaluator& ev, const Model& basel
 class ReplayMemo {
  public:
   using Measured = std::vector<std::pair<Outcome, double>>;
-  /// The kept outcomes under `key`, none when that replay was not run.
-  const Measured* find(const std::string& key) const;
+  /// The kept outcomes under `key`, counted as read back; none when that replay was not run.
+  const Measured* read_back(const std::string& key);
   void keep(std::string key, Measured measured);
   /// Replays read back rather than run.
   [[nodiscard]] int reused() const { return reused_; }
-  void count_reused(int n) { reused_ += n; }
 
  private:
   std::unordered_map<std::string, Measured> kept_;

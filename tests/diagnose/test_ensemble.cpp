@@ -1231,7 +1231,7 @@ TEST(EnsembleReplayMemo, AReplayAskedForAgainIsReadBackTheSameAndNoOtherIs) {
     }
   }
   const std::vector<TrialScore> scores(ev.trials.size());  // the tracks as filmed
-  Model model{.base = {{"Q235", *table.interaction("tuber", "Q235")}}, .effect = std::nullopt, .values = {}};
+  const Model model{.base = {{"Q235", *table.interaction("tuber", "Q235")}}, .effect = std::nullopt, .values = {}};
   EnsembleOptions eo;
   eo.replays = 4;
   int replays = 0;
@@ -1260,11 +1260,11 @@ TEST(EnsembleReplayMemo, AReplayAskedForAgainIsReadBackTheSameAndNoOtherIs) {
   ASSERT_TRUE(more);
   EXPECT_EQ(memo.reused(), 2 * run_first);
   // Another restitution, or the clump of another rung: nothing read back.
-  model.base[0].interaction.restitution += 1e-6;
-  auto other = compare_model(ev, model, scores, eo, replays);
+  Model bouncier = model;
+  bouncier.base[0].interaction.restitution += 1e-6;
+  auto other = compare_model(ev, bouncier, scores, eo, replays);
   ASSERT_TRUE(other);
   EXPECT_EQ(memo.reused(), 2 * run_first);
-  model.base[0].interaction.restitution -= 1e-6;
   ev.clump = &generator;
   eo.replays = 4;
   auto finer = compare_model(ev, model, scores, eo, replays);
