@@ -32,7 +32,9 @@
 #include "core/rng.hpp"
 #include "diagnose/conceal.hpp"
 #include "diagnose/ensemble.hpp"
+#include "diagnose/flights.hpp"
 #include "diagnose_job.hpp"
+#include "flight_levels.hpp"
 #include "io/clump_library.hpp"
 #include "io/recording_io.hpp"
 #include "parallel/team.hpp"
@@ -448,6 +450,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   std::vector<std::optional<bool>> contradicts;
   std::vector<GateCase> gates;
   std::vector<FarCase> fars;
+  std::vector<bench::FlightLevels> flights;
   std::vector<std::pair<std::string, std::optional<bench::TwinShift>>> missed_twins;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
@@ -485,6 +488,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
     seconds.push_back(j.value("seconds", NAN));
     gates.push_back(gate_case(j));
     fars.push_back(far_case(j, effect == "none"));
+    flights.push_back(bench::flight_levels(j, id, effect == "none"));
     contradicts.push_back(advice_contradicts_verdict(j));
     table +=
         fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} | {} |\n", id,
@@ -522,6 +526,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   table += contradiction_line(contradicts, summary);
   table += gate_line(gates, summary);
   table += far_outcome_line(fars, summary);
+  table += bench::flight_level_lines(flights, FlightWobbleOptions{}.noise_margin, summary);
   std::cout << "\n" << table;
   summary.update(nlohmann::json{{"set", set.string()},
                                 {"effects", effects},
@@ -566,6 +571,7 @@ struct CaseScore {
   std::string id;                          ///< the case's folder
   GateCase gate;                           ///< gate_case of its report
   FarCase far;                             ///< far_case of its report
+  bench::FlightLevels flights;             ///< flight_levels of its report
   std::optional<bench::TwinShift> twin;    ///< from its answer's twins (nullopt: a control, or none stored)
 };
 
@@ -598,6 +604,7 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   o.advice_contradicts = advice_contradicts_verdict(j);
   o.gate = gate_case(j);
   o.far = far_case(j, truth == "none");
+  o.flights = bench::flight_levels(j, "", truth == "none");
   if (j.contains("stage_seconds") && j["stage_seconds"].is_array()) {
     for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", NAN));
   }
@@ -627,12 +634,15 @@ std::string time_summary(const std::vector<CaseScore>& outcomes, nlohmann::json&
   summary["median_seconds_effects"] = median(effects);
   std::vector<GateCase> gates;
   std::vector<FarCase> fars;
+  std::vector<bench::FlightLevels> flights;
   for (const auto& o : outcomes) {
     gates.push_back(o.gate);
     fars.push_back(o.far);
+    flights.push_back(o.flights);
   }
   md += gate_line(gates, summary);
   md += far_outcome_line(fars, summary);
+  md += bench::flight_level_lines(flights, FlightWobbleOptions{}.noise_margin, summary);
   if (order.empty()) return md;
   md += "\n| stage | median share of a case |\n|---|---:|\n";
   for (const auto& stage : order) {
@@ -1092,6 +1102,7 @@ int score_generated(const std::vector<Case>& cases, const std::string& out) {
       return 1;
     }
     o->id = c.id;
+    o->flights.id = c.id;
     if (c.effect) {
       o->concealed = effect_part(c).values.at(0);
       o->null_value = effect_off(effect_spec(library, *c.effect))[0];

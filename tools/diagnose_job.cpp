@@ -269,6 +269,8 @@ nlohmann::json phases_json(const std::vector<PhaseReport>& phases) {
                    {"growth_power", p.growth_power},
                    {"end_residual_mm", p.end_residual_mm},
                    {"improved_chi2_per_value", p.improved_chi2_per_value},
+                   {"misfit_per_value", finite_or_null(p.misfit_per_value)},
+                   {"large_misfit_level", p.large_misfit_level},
                    {"statement", p.statement}});
   }
   return out;

@@ -132,6 +132,12 @@ struct PhaseReport {
   Axis axis = Axis::Z;
   std::string statement;
   double improved_chi2_per_value = 0.0;  ///< under the improved model (= baseline when none)
+  /// The training trials' chi^2 per value on the phase's worse axis, a drop's first flight
+  /// against the camera noise alone: what decides whether the phase's misfit is large (the
+  /// candidates are fitted frame by frame only when a flagged phase's reaches
+  /// `large_misfit_level`). NaN when no training trial has the phase.
+  double misfit_per_value = NAN;
+  double large_misfit_level = 0.0;  ///< 2 for a first flight, 10 for any other phase
 };
 
 struct ParameterValue {

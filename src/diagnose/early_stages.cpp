@@ -357,6 +357,14 @@ Result<Located> locate_stage(Context& c, DiagnoseResult& result, const Model& ba
     if (c.ev.trials[c.all[k]].training) train_scores.push_back((*base_scores)[k]);
   }
   out.base_train_groups = phase_groups(c, c.training, train_scores);
+  for (PhaseReport& p : result.phases) {
+    const auto key = std::find_if(out.base_train_groups.begin(), out.base_train_groups.end(), [&](const auto& kg) {
+      return kg.first.phase == p.phase && c.names[kg.first.recording] == p.recording;
+    });
+    p.large_misfit_level = large_misfit_level(p.phase);
+    if (key != out.base_train_groups.end() && key->second.values > 0)
+      p.misfit_per_value = misfit_per_value(c, key->first, key->second);
+  }
   for (const auto& [key, g] : all_groups) {
     if (key.phase == Phase::Hold || g.values < 10) continue;
     if (beyond_noise(g.chi2, g.values, all_groups.size())) out.flagged.push_back(key);

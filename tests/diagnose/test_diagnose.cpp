@@ -268,6 +268,20 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
     ASSERT_TRUE(made) << made.error().message;
     auto result = diagnose(clump, table, made->recordings, made->names, options);
     ASSERT_TRUE(result) << result.error().message;
+    // The first flights' misfit against the camera noise, as the report gives it (what decides
+    // whether candidates are fitted): the control's at the noise (about 1), the drag's above its
+    // level of 2.
+    double flight_misfit = 0.0;
+    for (const PhaseReport& p : result->phases) {
+      if (p.phase != Phase::Flight) continue;
+      EXPECT_EQ(p.large_misfit_level, 2.0);
+      ASSERT_TRUE(std::isfinite(p.misfit_per_value)) << p.recording;
+      flight_misfit = std::max(flight_misfit, p.misfit_per_value);
+    }
+    if (with_drag)
+      EXPECT_GE(flight_misfit, 2.0);
+    else
+      EXPECT_NEAR(flight_misfit, 1.0, 0.5);
     if (!with_drag) {
       EXPECT_EQ(result->verdict, Verdict::None) << result->statement;
       EXPECT_NEAR(result->before.train_rms_mm, 0.1, 0.02);  // the camera's noise, nothing else

@@ -700,11 +700,12 @@ TEST(EnsembleDecided, ATriedCandidateDecidesOnlyWhereItsStrongMagnitudeWouldShow
                                                       : by_count);
     EXPECT_EQ(reported[1].advice, TrialsAdvice::NoResponse);
     // The experiment says it was tried, not that no candidate came near the margin.
-    if (reported[0].advice == TrialsAdvice::TriedShortOfMargin)
+    if (reported[0].advice == TrialsAdvice::TriedShortOfMargin) {
       EXPECT_NE(result.experiment.find("plastic_substrate more than 8 (to first order these would do, yet tried with "
                                        "them it fell short of the margin)"),
                 std::string::npos)
           << result.experiment;
+    }
   }
 }
 
