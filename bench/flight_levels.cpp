@@ -8,24 +8,33 @@
 
 namespace clumpforge::bench {
 
+namespace {
+
+/// `j[key]` when it is a number, NaN otherwise (absent, or null as report.json writes a value
+/// it does not have).
+double number_or_nan(const nlohmann::json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
+}
+
+}  // namespace
+
 FlightLevels flight_levels(const nlohmann::json& report, const std::string& id, bool control) {
   FlightLevels out{.id = id, .control = control};
   if (report.contains("phases") && report["phases"].is_array()) {
     for (const auto& p : report["phases"]) {
-      if (p.value("phase", "") != "flight" || !p.contains("misfit_per_value") || !p["misfit_per_value"].is_number())
-        continue;
-      const double m = p["misfit_per_value"].get<double>();
+      const double m = number_or_nan(p, "misfit_per_value");
+      if (!p.contains("phase") || p["phase"] != "flight" || !std::isfinite(m)) continue;
       if (!(m <= out.flight_misfit)) {
         out.flight_misfit = m;
-        out.flight_level = p.value("large_misfit_level", 0.0);
+        out.flight_level = number_or_nan(p, "large_misfit_level");
       }
     }
   }
   if (report.contains("flights") && report["flights"].is_object()) {
     const auto& f = report["flights"];
-    const double noise = f.value("noise_mm", NAN);
-    if (f.value("judged", false) && noise > 0.0)
-      out.wobble_levels = (f.value("wobble_mm", NAN) - f.value("allowance_mm", NAN)) / noise;
+    const double noise = number_or_nan(f, "noise_mm");
+    if (f.contains("judged") && f["judged"] == true && noise > 0.0)
+      out.wobble_levels = (number_or_nan(f, "wobble_mm") - number_or_nan(f, "allowance_mm")) / noise;
   }
   return out;
 }

@@ -14,9 +14,9 @@ namespace clumpforge::bench {
 struct FlightLevels {
   std::string id;
   bool control = false;
-  /// The largest first-flight misfit per value of the report's drops, and its level (NaN, 0:
-  /// no first flight in the report, or a report older than the field).
-  double flight_misfit = NAN, flight_level = 0.0;
+  /// The largest first-flight misfit per value of the report's drops, and its level (NaN: no
+  /// first flight in the report, or a report older than the field).
+  double flight_misfit = NAN, flight_level = NAN;
   /// (wobble - allowance) / camera noise of the report's flights (NaN: not judged).
   double wobble_levels = NAN;
 };

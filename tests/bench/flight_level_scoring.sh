@@ -22,9 +22,11 @@ if misfits != "-":
                        "large_misfit_level": 2.0})
         phases.append({"recording": f"drop-{k}", "phase": "rebound", "misfit_per_value": 40.0,
                        "large_misfit_level": 10.0})
+# "null" as report.json writes a value it does not have (unjudged flights).
+num = lambda v: None if v == "null" else float(v)
 json.dump({"verdict": verdict, "candidates": [], "undecidable": [], "seconds": 1, "phases": phases,
-           "flights": {"judged": judged == "yes", "wobble_mm": float(wobble), "allowance_mm": float(allowance),
-                       "noise_mm": float(noise)},
+           "flights": {"judged": judged == "yes", "wobble_mm": num(wobble), "allowance_mm": num(allowance),
+                       "noise_mm": num(noise)},
            "fit": {"before": {"heldout_rms_mm": 0.1}, "after": {"heldout_rms_mm": 0.1}}}, open(path, "w"))
 PY
 }
@@ -49,10 +51,11 @@ expect_line "$dir/gen/summary.md" "first-flight misfit per value" \
 expect_line "$dir/gen/summary.md" "free-flight wobble above its allowance" \
   "free-flight wobble above its allowance, in camera-noise levels (an offset claimed from 0.5): read in 4 of 5 reports; controls' largest 0.13 (control-01); effect cases at or above it: com_offset-strong 4.10"
 # An independent set scored with --recordings-set: a control's flight at 2.5 is its largest, not
-# an effect case; the drag's flights all below the level.
+# an effect case; the drag's flights all below the level, and not judged (their wobble and
+# noise null).
 two_case_set
 report "$dir/out/case-a/report.json" none 2.5 0.1 0.1 0.1 yes
-report "$dir/out/case-b/report.json" air_drag 1.5 0.1 0.1 0.1 no
+report "$dir/out/case-b/report.json" air_drag 1.5 null 0.1 null no
 score_set
 python3 - "$dir/out/summary.json" <<'PY' || exit 1
 import json, sys
