@@ -65,6 +65,8 @@ void bind_parts(py::module_& m) {
       .def_readonly("bias_x_mm", &PhaseReport::bias_x_mm)
       .def_readonly("bias_z_mm", &PhaseReport::bias_z_mm)
       .def_readonly("axis", &PhaseReport::axis)
+      .def_readonly("misfit_per_value", &PhaseReport::misfit_per_value)
+      .def_readonly("large_misfit_level", &PhaseReport::large_misfit_level)
       .def_readonly("statement", &PhaseReport::statement);
   py::class_<SetUpShare>(m, "SetUpShare", "One surface's recordings of one test, and its share of a chi^2 difference.")
       .def_readonly("surface", &SetUpShare::surface)

@@ -207,6 +207,11 @@ def test_diagnose_from_python_names_the_bundled_air_drag_and_reports_each_candid
         assert math.isnan(h.strong_delta_chi2) and math.isnan(h.strong_resolution_chi2)
         assert h.strong_preferred_in == [] and h.preferred_alone() is None
     assert {"surface", "test", "delta_chi2"} <= set(dir(cf.SetUpShare))
+    # The drag shows in the drops' first flights: their misfit against the camera noise reaches
+    # the level (2) at which candidates are fitted frame by frame.
+    flights = [p for p in result.phases if p.phase == cf.Phase.flight]
+    assert flights and all(p.large_misfit_level == 2.0 for p in flights)
+    assert max(p.misfit_per_value for p in flights) >= 2.0
 
 
 def test_materials_export_names_its_conventions():
