@@ -41,13 +41,14 @@ FlightLevels flight_levels(const nlohmann::json& report, const std::string& id, 
 
 namespace {
 
-/// The controls' largest value (with its case) and the effect cases at or above `level` (each
-/// case's own level when `level` is NaN), for one reading: a markdown line and a JSON object.
+/// One reading of a case (`value`, NaN when the report lacks it) and the level it is held to
+/// (`level`, per case): reading_line gives the controls' largest and the effect cases at or above.
 struct Reading {
   std::string what;
   std::function<double(const FlightLevels&)> value, level;
 };
 
+/// A markdown line and a JSON object for one reading over every case.
 std::string reading_line(const std::vector<FlightLevels>& cases, const Reading& r, nlohmann::json& json) {
   double largest = NAN;
   std::string largest_id;
