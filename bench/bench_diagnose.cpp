@@ -807,16 +807,17 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
 
 /// The benchmark's command line.
 struct BenchOptions {
-  // The diagnosed clump (adaptive-32) with finer fills of the same scan (64, 128, 256), against
-  // which the diagnosis checks its particle model before it blames missing physics.
+  // The diagnosed clump (adaptive-64: the fill diagnose --mesh takes on this scan, the first within
+  // 0.1 mm RMS of it) with finer fills of the same scan (128, 256: diagnose's two), against which
+  // the diagnosis checks its particle model before it blames missing physics.
   std::string clump_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default-ladder.h5",
-              clump_name = "adaptive-32", out = "bench-out/diagnose";
+              clump_name = "adaptive-64", out = "bench-out/diagnose";
   int controls = 50, trials = 4;
   std::uint64_t seed = 1;
   std::vector<std::string> only;
   bool full_set = false, nine_set_ups = false, existing_only = false, generate_only = false;
   // The recordings come from a finer clump of the same scan than the one diagnosed (340 spheres
-  // against the diagnosis's 32), as real data never comes from the diagnoser's own model.
+  // against the diagnosis's 64), as real data never comes from the diagnoser's own model.
   /// The mass in each clump sphere's wall-contact damping, of the generator and the diagnosis alike
   /// (ContactSettings::wall_mass; the recordings of --recordings-set keep their own).
   std::string wall_mass = "whole";
@@ -830,10 +831,10 @@ struct BenchOptions {
   int spheres = 0, threads = 0;
   /// Replays per recording of the second comparison at a gate (DiagnoseOptions::ensemble_replays_at_gate).
   int replays_at_gate = DiagnoseOptions{}.ensemble_replays_at_gate;
-  /// Finer clumps of the particle-model check (DiagnoseJob::finer_clumps); unset: 3 for the
-  /// generated set (its ladder's 64, 128 and 256 spheres: from 64 to 128 the tuber's outcomes
-  /// still move), 2 with --recordings-set (as diagnose: fills with 2 and 4 times the spheres).
-  std::optional<int> finer_clumps;
+  /// Finer clumps of the particle-model check (DiagnoseJob::finer_clumps), as diagnose's: the
+  /// library's next two (128 and 256 spheres), or with --recordings-set fills of the mesh with 2
+  /// and 4 times the spheres.
+  int finer_clumps = cli::DiagnoseJob{}.finer_clumps;
   double fps = 1000.0, noise = 1e-4;
   bool no_pre_roll = false;
   std::string camera_target = "silhouette";
@@ -846,7 +847,9 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--library", o.clump_file,
                  "Clump library diagnosed against (default clumps/tuber-default-ladder.h5: its clumps with more "
                  "spheres than --clump are the finer clumps of the particle-model check)");
-  app.add_option("--clump", o.clump_name, "Which clump of the library is diagnosed (default adaptive-32)");
+  app.add_option(
+      "--clump", o.clump_name,
+      "Which clump of the library is diagnosed (default adaptive-64, the one diagnose --mesh fills on this scan)");
   app.add_option("-o,--output,--out", o.out, "Working directory (recordings, answers, reports, summary)");
   app.add_option("--controls", o.controls, "Effect-free controls");
   app.add_option("--trials", o.trials, "Trials per recording");
@@ -886,9 +889,9 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "convergence to the scan, as diagnose does)");
   app.add_option("--threads", o.threads, "Threads per process (0: the cores shared among the MPI ranks on a node)");
   app.add_option("--finer-clumps", o.finer_clumps,
-                 "Finer clumps of the particle-model check: the library's next ones with more spheres than --clump "
-                 "(default 3: 64, 128, 256); with --recordings-set, fills of the mesh with 2, 4, ... times the "
-                 "spheres (default 2, as diagnose)")
+                 "Finer clumps of the particle-model check (default 2, as diagnose): the library's next ones with "
+                 "more spheres than --clump (128, 256); with --recordings-set, fills of the mesh with 2, 4, ... "
+                 "times the spheres")
       ->check(CLI::Range(0, 4));
   app.add_option("--wall-mass", o.wall_mass,
                  "The mass in each clump sphere's wall-contact damping, of the generator and the diagnosis: whole "
@@ -1029,7 +1032,7 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
   cli::DiagnoseJob job{.recordings = {(dir / "recordings").string()},
                        .library = o.clump_file,
                        .clump_name = o.clump_name,
-                       .finer_clumps = o.finer_clumps.value_or(3)};
+                       .finer_clumps = o.finer_clumps};
   job.options.ensemble_replays_at_gate = o.replays_at_gate;
   job.options.lab.contact.wall_mass = o.contact_wall_mass();
   job.options.drift_at = o.drift_at();
@@ -1155,7 +1158,7 @@ int main(int argc, char** argv) {
     return scored != 0 || !team->leader() || o.compare.empty() ? scored : write_comparison(o.out, o.compare);
   };
   if (!o.recordings_set.empty()) {
-    cli::DiagnoseJob job{.spheres = o.spheres, .finer_clumps = o.finer_clumps.value_or(2)};
+    cli::DiagnoseJob job{.spheres = o.spheres, .finer_clumps = o.finer_clumps};
     job.options.ensemble_replays_at_gate = o.replays_at_gate;
     job.options.lab.contact.wall_mass = o.contact_wall_mass();
     job.options.drift_at = o.drift_at();

@@ -1,5 +1,7 @@
 # Sourced by the slow gate tests: generates the nine-set-up, 8-trial set's cases of one effect
-# (the bench's default seed) and diagnoses one of them with the bench's own diagnosis.
+# (the bench's default seed) and diagnoses one of them against the ladder's 32-sphere clump and its
+# three finer ones (the bench's diagnosis until it took diagnose's own 64-sphere fill and two finer
+# clumps): the gates these tests read are reached there.
 # Usage: diagnose_generated_case BENCH CLUMPFORGE LIBRARY EFFECT MAGNITUDE; sets `dir` (removed
 # on exit) and writes the report to "$dir/out/report.json".
 diagnose_generated_case() {
