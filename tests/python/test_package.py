@@ -305,3 +305,13 @@ def test_the_diagnosis_reads_a_drop_and_a_roll_as_it_reads_their_tracks():
     assert cf.measure_outcomes(cf.LabTest.drop, t[:9], x[:9], z[:9]) == {}
     with pytest.raises(cf.InvalidArgumentError, match="must be as long"):
         cf.measure_outcomes(cf.LabTest.drop, t, x[:-1], z)
+
+
+def test_the_bench_diagnoses_the_fill_diagnose_takes_on_the_default_scan():
+    # bench_diagnose's default clump (adaptive-64 of the ladder library) is the one diagnose --mesh
+    # takes on this scan: the first adaptive fill whose surface lies within a third of
+    # --model-accuracy (0.3 mm, diagnose's default) of the mesh. The 32-sphere fill lies just outside.
+    clumps = {c.name: c for c in cf.read_library(str(ROOT / "clumps/tuber-default-ladder.h5"))}
+    limit = 0.3e-3 / 3
+    assert clumps["adaptive-32"].error.surface_rms > limit
+    assert clumps["adaptive-64"].error.surface_rms <= limit
