@@ -82,6 +82,20 @@ void print_text(const DiagnoseResult& r) {
     std::cout << fmt::format("  summary error {}: {:+.3g} -> {:+.3g}\n", r.before.summary_error[k].first,
                              r.before.summary_error[k].second, r.after.summary_error[k].second);
   }
+  if (const auto& h = r.heldout_outcomes) {
+    std::cout << fmt::format(
+        "held-out outcomes (calibrated on {} training trials, compared on {} held-out): RMS z {:.2f} -> {:.2f} over "
+        "{} means and spreads ({:.1f} % better)\n",
+        h->training_trials, h->heldout_trials, h->rms_z_null(), h->rms_z_named(), h->statistics,
+        100.0 * h->improvement());
+  }
+  if (const auto& h = r.heldout_flights) {
+    std::cout << fmt::format(
+        "held-out flights ({} from the training trials give an offset of {:.2f} mm; {} held out): their wobble "
+        "{:.3f} mm, predicted {:.3f} mm with the mass centred, {:.3f} mm with the offset ({:.1f} % better)\n",
+        h->training_flights, h->offset_m * 1e3, h->heldout_flights, h->wobble_m * 1e3, h->without_m * 1e3,
+        h->with_m * 1e3, 100.0 * h->improvement());
+  }
   for (const auto& note : r.notes) std::cout << "note: " << note << "\n";
   std::cout << fmt::format("{} tracked trials ({} for fitting), {} trial replays, {:.1f} s\n", r.tracked_trials,
                            r.training_trials, r.evaluations, r.seconds);

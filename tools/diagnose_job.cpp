@@ -360,6 +360,28 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                                            {"held", k.held}});
   }
   j["fit"] = {{"before", quality_json(r.before)}, {"after", quality_json(r.after)}};
+  if (const auto& h = r.heldout_outcomes) {
+    j["fit"]["heldout_outcomes"] = {{"training_trials", h->training_trials},
+                                    {"heldout_trials", h->heldout_trials},
+                                    {"statistics", h->statistics},
+                                    {"chi2_null", h->chi2_null},
+                                    {"chi2_named", h->chi2_named},
+                                    {"rms_z_null", h->rms_z_null()},
+                                    {"rms_z_named", h->rms_z_named()},
+                                    {"improvement", h->improvement()},
+                                    {"values", h->values},
+                                    {"replays", h->replays},
+                                    {"seconds", h->seconds}};
+  }
+  if (const auto& h = r.heldout_flights) {
+    j["fit"]["heldout_flights"] = {{"training_flights", h->training_flights},
+                                   {"heldout_flights", h->heldout_flights},
+                                   {"offset_m", h->offset_m},
+                                   {"wobble_m", h->wobble_m},
+                                   {"without_m", h->without_m},
+                                   {"with_m", h->with_m},
+                                   {"improvement", h->improvement()}};
+  }
   j["phases"] = phases_json(r.phases);
   j["hypotheses"] = hypotheses_json(r.hypotheses);
   auto phases_of = [](const std::vector<PhaseOf>& list) {

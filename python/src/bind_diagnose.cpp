@@ -109,6 +109,28 @@ void bind_parts(py::module_& m) {
       .def_readonly("heldout_rms_mm", &FitQuality::heldout_rms_mm)
       .def_readonly("train_chi2_per_value", &FitQuality::train_chi2_per_value)
       .def_readonly("heldout_chi2_per_value", &FitQuality::heldout_chi2_per_value);
+  py::class_<OutcomeHoldout>(m, "OutcomeHoldout",
+                             "A name made on the outcomes, checked on the held-out trials' outcomes.")
+      .def_readonly("training_trials", &OutcomeHoldout::training_trials)
+      .def_readonly("heldout_trials", &OutcomeHoldout::heldout_trials)
+      .def_readonly("statistics", &OutcomeHoldout::statistics, "held-out means and spreads compared")
+      .def_readonly("chi2_null", &OutcomeHoldout::chi2_null)
+      .def_readonly("chi2_named", &OutcomeHoldout::chi2_named)
+      .def_readonly("values", &OutcomeHoldout::values, "the effect's parameters from the training trials")
+      .def_readonly("seconds", &OutcomeHoldout::seconds, "[s] its wall clock")
+      .def_property_readonly("rms_z_null", &OutcomeHoldout::rms_z_null)
+      .def_property_readonly("rms_z_named", &OutcomeHoldout::rms_z_named)
+      .def_property_readonly("improvement", &OutcomeHoldout::improvement,
+                             "the share of the null's held-out RMS z the effect removes");
+  py::class_<FlightHoldout>(m, "FlightHoldout",
+                            "A name from the free flights, checked on the held-out trials' flights.")
+      .def_readonly("training_flights", &FlightHoldout::training_flights)
+      .def_readonly("heldout_flights", &FlightHoldout::heldout_flights)
+      .def_readonly("offset_m", &FlightHoldout::offset_m, "[m] from the training trials' flights")
+      .def_readonly("wobble_m", &FlightHoldout::wobble_m, "[m] the held-out flights' wobble")
+      .def_readonly("without_m", &FlightHoldout::without_m, "[m] predicted with the mass centred")
+      .def_readonly("with_m", &FlightHoldout::with_m, "[m] predicted with the offset")
+      .def_property_readonly("improvement", &FlightHoldout::improvement);
   py::class_<TrackComparison>(m, "TrackComparison", "A recording's first trial against both models (replay time).")
       .def_readonly("recording", &TrackComparison::recording)
       .def_readonly("t", &TrackComparison::t)
@@ -230,6 +252,8 @@ void bind_result(py::module_& m) {
                     "why the tracks fitted frame by frame left candidates undecided")
       .def_readonly("particle_model", &DiagnoseResult::particle_model)
       .def_readonly("flights", &DiagnoseResult::flights)
+      .def_readonly("heldout_outcomes", &DiagnoseResult::heldout_outcomes)
+      .def_readonly("heldout_flights", &DiagnoseResult::heldout_flights)
       .def_readonly("evaluations", &DiagnoseResult::evaluations)
       .def_readonly("seconds", &DiagnoseResult::seconds);
 }

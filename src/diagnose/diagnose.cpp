@@ -147,7 +147,10 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   // the outcomes over the release are not needed to say so.
   result.flights = flights_of(c, recordings, options);
   const bool by_flights = open && result.flights && result.flights->detected;
-  if (by_flights) say_flights(result, *result.flights);
+  if (by_flights) {
+    say_flights(result, *result.flights);
+    result.heldout_flights = heldout_flights(c, *result.flights);
+  }
   if (open && !by_flights && options.ensemble_replays > 0) {
     run.report("ensembles", 0.9);
     if (auto ok = ensemble_stage(c, result, baseline, *full_base, effects, options); !ok)

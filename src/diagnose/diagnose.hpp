@@ -15,6 +15,7 @@
 ///    "unexplained" (a smooth per-phase discrepancy the library cannot account for), "none"
 ///    (with the smallest effect the data would have shown) or "undecidable" (too little or
 ///    too noisy data).
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <string>
@@ -217,6 +218,27 @@ struct FitQuality {
   std::vector<std::pair<std::string, double>> summary_error;  ///< per recording: model mean - recorded mean (mm or deg)
 };
 
+/// A name made on the outcomes beyond the release horizon (basis Ensemble), checked on trials it
+/// was not calibrated on, as a name made frame by frame is on its held-out tracks: the null and the
+/// named effect each calibrated again on the training trials' outcomes alone (every other trial of
+/// each recording), then both replayed from the same fresh release orientations and compared with
+/// the held-out trials' outcomes (diagnosis::heldout_outcomes). The verdict itself used every trial;
+/// this measures how much better the model with the effect predicts trials it did not see.
+struct OutcomeHoldout {
+  int training_trials = 0, heldout_trials = 0;
+  int statistics = 0;          ///< held-out means and spreads compared
+  double chi2_null = 0.0;      ///< the training trials' null against the held-out outcomes
+  double chi2_named = 0.0;     ///< the training trials' named effect against them
+  std::vector<double> values;  ///< the effect's parameters as the training trials calibrate them
+  int replays = 0;             ///< DEM replays this check ran
+  double seconds = 0.0;        ///< [s] its wall clock
+  /// RMS of the held-out statistics' z (standard errors of the recorded outcomes).
+  double rms_z_null() const { return statistics > 0 ? std::sqrt(chi2_null / statistics) : 0.0; }
+  double rms_z_named() const { return statistics > 0 ? std::sqrt(chi2_named / statistics) : 0.0; }
+  /// The share of the null's held-out RMS z the effect removes (negative: it predicts worse).
+  double improvement() const { return rms_z_null() > 0.0 ? 1.0 - rms_z_named() / rms_z_null() : 0.0; }
+};
+
 /// What the plots need: per recording, its first trial's track against both models.
 struct TrackComparison {
   std::string recording;
@@ -377,6 +399,8 @@ struct DiagnoseResult {
   std::optional<GateRetry> gate_retry;               ///< when the ensemble was compared again at a gate
   std::optional<ParticleModelCheck> particle_model;  ///< when finer clumps were given
   std::optional<FlightWobble> flights;               ///< when drops were tracked
+  std::optional<OutcomeHoldout> heldout_outcomes;    ///< a name on the outcomes, checked on held-out trials
+  std::optional<FlightHoldout> heldout_flights;      ///< a name from the free flights, checked on held-out trials
   int tracked_trials = 0, training_trials = 0, evaluations = 0;
   /// Of `evaluations`, the replays beyond the release horizon read back from an earlier
   /// comparison's (ReplayMemo): the same model, clump and release orientation, not run again.

@@ -54,6 +54,13 @@ double median_excess(const std::vector<FreeFlight>& flights, const std::vector<s
   return weighted_median(v, w);
 }
 
+/// [m] The offset a median excess needs: a point at distance d from the centre, turned at random,
+/// has a variance d^2 / 3 per coordinate; the silhouette's own wander (`allowance` [m]) is taken
+/// off first.
+double offset_for(double excess, double allowance) {
+  return std::sqrt(3.0 * std::max(0.0, excess - allowance * allowance));
+}
+
 }  // namespace
 
 std::vector<FreeFlight> free_flights(const Track& track, double clearance, double noise, int min_frames) {
@@ -135,10 +142,7 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
   const double excess = median_excess(result.flights, every);
   result.wobble_m = std::sqrt(std::max(0.0, excess));
   const double threshold = options.allowance_m + options.noise_margin * result.noise_m;
-  // A point at distance d from the centre, turned at random, has a variance d^2 / 3 per
-  // coordinate; the silhouette's own wander is taken off first.
-  const double allowed = options.allowance_m * options.allowance_m;
-  auto offset_of = [&](double e) { return std::sqrt(3.0 * std::max(0.0, e - allowed)); };
+  auto offset_of = [&](double e) { return offset_for(e, options.allowance_m); };
   result.offset_m = offset_of(excess);
   result.smallest_offset_m = offset_of(threshold * threshold) / kOffsetRecovered;
   Rng rng(options.seed, 0x666c69676874ULL);  // "flight"
@@ -158,6 +162,30 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
   // 0.60-0.93 mm.
   result.detected = result.wobble_m > threshold && (resampled.empty() || result.offset_low_m > 0.0);
   return result;
+}
+
+std::optional<FlightHoldout> flight_holdout(const FlightWobble& wobble,
+                                            const std::set<std::pair<std::size_t, std::size_t>>& training,
+                                            const std::set<std::pair<std::size_t, std::size_t>>& heldout,
+                                            int min_flights) {
+  if (!wobble.judged) return std::nullopt;
+  std::vector<std::size_t> train, held;
+  for (std::size_t k = 0; k < wobble.flights.size(); ++k) {
+    const std::pair<std::size_t, std::size_t> trial{wobble.flights[k].recording, wobble.flights[k].trial};
+    if (training.contains(trial)) train.push_back(k);
+    if (heldout.contains(trial)) held.push_back(k);
+  }
+  const auto enough = static_cast<std::size_t>(std::max(1, min_flights));
+  if (train.size() < enough || held.size() < enough) return std::nullopt;
+  FlightHoldout out;
+  out.training_flights = static_cast<int>(train.size());
+  out.heldout_flights = static_cast<int>(held.size());
+  const double trained = median_excess(wobble.flights, train);
+  out.offset_m = offset_for(trained, wobble.allowance_m);
+  out.with_m = std::sqrt(std::max(0.0, trained));
+  out.without_m = wobble.allowance_m;
+  out.wobble_m = std::sqrt(std::max(0.0, median_excess(wobble.flights, held)));
+  return out;
 }
 
 bool would_show_offset(const FlightWobble& wobble, double offset) {

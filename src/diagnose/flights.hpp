@@ -12,6 +12,9 @@
 /// wander is computed from the particle model (silhouette_wander) and allowed for.
 #include <cstdint>
 #include <limits>
+#include <optional>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "core/clump.hpp"
@@ -110,6 +113,33 @@ double offset_upper_bound(const FlightWobble& wobble);
 /// (a few flights' wobble is itself uncertain: 9 flights of a generated tuber 2.8 mm off showed
 /// none, with an interval up to 1.6 mm).
 bool rules_out_offset(const FlightWobble& wobble, double offset);
+
+/// A centre-of-mass offset the free flights show, checked on trials it was not estimated from,
+/// as a name made frame by frame is on its held-out tracks: the training trials' flights give the
+/// offset, and so the wobble a body with it shows in any flight (their median excess, allowance
+/// included); a body with its mass centred shows the allowance alone. Each is set against the
+/// held-out trials' flights' wobble [m].
+struct FlightHoldout {
+  int training_flights = 0, heldout_flights = 0;
+  double offset_m = 0.0;   ///< what the training flights' wobble needs (as FlightWobble::offset_m)
+  double wobble_m = 0.0;   ///< the held-out flights' wobble (as FlightWobble::wobble_m)
+  double without_m = 0.0;  ///< predicted with the mass centred: the allowance
+  double with_m = 0.0;     ///< predicted with the training flights' offset: their wobble
+  /// The share of the centred body's miss of the held-out wobble that the offset removes
+  /// (negative: it predicts worse).
+  double improvement() const {
+    const double miss = std::abs(wobble_m - without_m);
+    return miss > 0.0 ? 1.0 - std::abs(wobble_m - with_m) / miss : 0.0;
+  }
+};
+
+/// flight_holdout of `wobble`'s flights parted by trial: (recording, trial) pairs in `training`
+/// and in `heldout` (a flight of neither is left out). Nullopt when either part has fewer than
+/// `min_flights` flights, or the wobble was not judged.
+std::optional<FlightHoldout> flight_holdout(const FlightWobble& wobble,
+                                            const std::set<std::pair<std::size_t, std::size_t>>& training,
+                                            const std::set<std::pair<std::size_t, std::size_t>>& heldout,
+                                            int min_flights);
 
 /// The free flights of every drop trial with a track (`noise` per recording [m]) and what
 /// they say. Other tests are skipped: a roll or a tilt stays in contact.

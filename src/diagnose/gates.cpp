@@ -305,6 +305,13 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
     retry.seconds_second = seconds_since(second);
     result.gate_retry = std::move(retry);
   }
+  // A name made on the outcomes, checked on the trials it was not calibrated on; with the first
+  // comparison's replays per recording, whichever the verdict rests on: it measures a prediction,
+  // it decides nothing.
+  if (auto ok =
+          heldout_outcomes(c, result, baseline, full_scores, ensemble_options(c, options, options.ensemble_replays));
+      !ok)
+    return ok;
   c.refits.clear();  // only the gates' checks and a second comparison take them again
   reconcile_advice(result);
   return {};

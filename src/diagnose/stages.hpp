@@ -447,6 +447,24 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
 std::optional<FlightWobble> flights_of(const Context& c, const std::vector<Recording>& recordings,
                                        const DiagnoseOptions& options);
 void say_flights(DiagnoseResult& result, const FlightWobble& f);
+/// A name from the free flights checked on the held-out trials' flights (flight_holdout, the
+/// trials parted as every fit parts them; each part needs half the flights a judgement needs).
+std::optional<FlightHoldout> heldout_flights(const Context& c, const FlightWobble& f);
+
+/// The coefficients the outcomes beyond the release horizon calibrate: those the fitted windows
+/// leave unpinned or the parted trials cut, per surface of `baseline` (a tilt's static friction
+/// only when its slip angles are compared as a sample).
+std::vector<FreeCoefficient> calibrated_beyond_horizon(const Context& c, const Model& baseline);
+
+// ---- heldout.cpp -----------------------------------------------------------------------------
+
+/// With a name made on the outcomes at the diagnosed clump (basis Ensemble, rung 0): the null and
+/// the named effect calibrated again on the training trials' outcomes (compare_ensembles on them,
+/// the effect pursued) and both compared, from the same fresh release orientations, with the
+/// held-out trials' outcomes (result.heldout_outcomes). `eo` are the options of the comparison
+/// the verdict rests on. Anything else: nothing done.
+Result<void> heldout_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
+                              const std::vector<TrialScore>& full_scores, const EnsembleOptions& eo);
 
 // ---- verdict.cpp -----------------------------------------------------------------------------
 

@@ -861,8 +861,21 @@ TEST(DiagnoseEnsemble, AKineticFrictionBelowTheStaticOneIsNamedFromFourSquareTil
       EXPECT_EQ(result->verdict, Verdict::Named) << result->statement;
       EXPECT_EQ(result->effect, Effect::StaticKineticFriction) << result->statement;
       EXPECT_EQ(result->basis, Basis::Ensemble) << result->statement;
+      // The name checked on the trials it was not calibrated on: the null and the drop calibrated
+      // again on the three training trials' slip angles and slide times, both compared with the
+      // three held out. The drop predicts them better, and its value from half the trials is
+      // within 0.1 of the 0.25 concealed.
+      ASSERT_TRUE(result->heldout_outcomes.has_value()) << result->statement;
+      const OutcomeHoldout& held = *result->heldout_outcomes;
+      EXPECT_EQ(held.training_trials, 3);
+      EXPECT_EQ(held.heldout_trials, 3);
+      EXPECT_GT(held.statistics, 0);
+      EXPECT_GT(held.improvement(), 0.3) << held.rms_z_null() << " -> " << held.rms_z_named();
+      ASSERT_EQ(held.values.size(), 1u);
+      EXPECT_NEAR(held.values[0], 0.25, 0.1);
     } else {
       EXPECT_EQ(result->verdict, Verdict::None) << result->statement;
+      EXPECT_FALSE(result->heldout_outcomes.has_value());
     }
     const auto& compared = result->ensemble->null_comparisons;
     EXPECT_TRUE(std::any_of(compared.begin(), compared.end(),
