@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -44,6 +45,9 @@ namespace fs = std::filesystem;
 using namespace clumpforge;
 
 namespace {
+
+/// A double NaN: nlohmann::json's value(key, NAN) would read the value as a float.
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct Case {
   std::string id;
@@ -110,6 +114,42 @@ std::vector<std::string> advice_for(const nlohmann::json& report, const std::vec
 /// Whether a report calls the concealed effect (any of `names`) decided: none of them is in its
 /// undecidable list or among its ambiguous candidates (an ambiguous pair that holds the truth does
 /// not call it absent either). False when the report has no undecidable list.
+/// What a report says of its fit on the trials it was not calibrated on, where its name was made:
+/// a name on the outcomes by the held-out outcomes' RMS z (fit.heldout_outcomes), one from the free
+/// flights by how far the held-out flights' wobble lies from each prediction [mm]
+/// (fit.heldout_flights), anything else by the held-out tracks' RMS within the release horizon [mm].
+enum class HeldOutOn { Tracks, Outcomes, Flights };
+struct HeldOut {
+  double before = kNaN, after = kNaN;
+  HeldOutOn on = HeldOutOn::Tracks;
+  double gain() const { return before > 0.0 ? (before - after) / before : kNaN; }
+  std::string_view on_name() const {
+    return on == HeldOutOn::Outcomes ? "outcomes" : on == HeldOutOn::Flights ? "flights" : "tracks";
+  }
+  std::string cell() const {
+    return on == HeldOutOn::Outcomes  ? fmt::format("{:.2f} -> {:.2f} z (outcomes)", before, after)
+           : on == HeldOutOn::Flights ? fmt::format("{:.3f} -> {:.3f} mm (flights)", before, after)
+                                      : fmt::format("{:.3f} -> {:.3f} mm", before, after);
+  }
+};
+HeldOut held_out_of(const nlohmann::json& report) {
+  const nlohmann::json& fit = report.contains("fit") ? report["fit"] : nlohmann::json::object();
+  if (fit.contains("heldout_outcomes") && fit["heldout_outcomes"].is_object()) {
+    const auto& h = fit["heldout_outcomes"];
+    return {h.value("rms_z_null", kNaN), h.value("rms_z_named", kNaN), HeldOutOn::Outcomes};
+  }
+  if (fit.contains("heldout_flights") && fit["heldout_flights"].is_object()) {
+    const auto& h = fit["heldout_flights"];
+    const double wobble = h.value("wobble_m", kNaN);
+    return {1e3 * std::abs(wobble - h.value("without_m", kNaN)), 1e3 * std::abs(wobble - h.value("with_m", kNaN)),
+            HeldOutOn::Flights};
+  }
+  const auto rms = [&](const char* which) {
+    return fit.contains(which) ? fit[which].value("heldout_rms_mm", kNaN) : kNaN;
+  };
+  return {rms("before"), rms("after"), HeldOutOn::Tracks};
+}
+
 bool calls_decided(const nlohmann::json& report, const std::vector<std::string>& names) {
   if (!report.contains("undecidable") || !report["undecidable"].is_array()) return false;
   return !lists_any(report, "undecidable", names) && !lists_any(report, "candidates", names);
@@ -156,7 +196,7 @@ struct GateCase {
   double seconds = NAN, seconds_without = NAN;
 };
 GateCase gate_case(const nlohmann::json& report) {
-  GateCase c{.seconds = report.value("seconds", NAN)};
+  GateCase c{.seconds = report.value("seconds", kNaN)};
   c.seconds_without = c.seconds;
   if (report.contains("gate_retry") && report["gate_retry"].is_object()) {
     const auto& retry = report["gate_retry"];
@@ -440,7 +480,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   if (!team.leader()) return ran ? 0 : 1;
   if (!ran) return 1;
   std::string table =
-      "| case | particle | truth | verdict | basis | right | held-out RMS before -> after [mm] | improvement | time "
+      "| case | particle | truth | verdict | basis | right | held-out RMS before -> after | improvement | time "
       "[s] | summary shift chi^2 / recordings |\n|---|---|---|---|---|---|---|---:|---:|---|\n";
   int effects = 0, effects_right = 0, controls = 0, controls_none = 0, controls_named = 0;
   std::vector<double> seconds, improvements;
@@ -466,9 +506,8 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
     const auto right = right_verdicts(effect);
     const bool is_right = std::find(right.begin(), right.end(), verdict) != right.end();
     const bool named_effect = names_an_effect(verdict);
-    const double before = j["fit"]["before"].value("heldout_rms_mm", NAN),
-                 after = j["fit"]["after"].value("heldout_rms_mm", NAN);
-    const double gain = before > 0.0 ? (before - after) / before : NAN;
+    const HeldOut held = held_out_of(j);
+    const double gain = held.gain();
     const bool missed = effect != "none" && !is_right;
     const std::vector<std::string> advice = missed ? advice_for(j, right) : std::vector<std::string>{};
     const auto twin = bench::twin_shift(answer);
@@ -485,33 +524,35 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       if (missed && named_effect) misnamed.emplace_back(id, verdict);
       if (missed) missed_twins.emplace_back(id, twin);
     }
-    seconds.push_back(j.value("seconds", NAN));
+    seconds.push_back(j.value("seconds", kNaN));
     gates.push_back(gate_case(j));
     fars.push_back(far_case(j, effect == "none"));
     flights.push_back(bench::flight_levels(j, id, effect == "none"));
     contradicts.push_back(advice_contradicts_verdict(j));
-    table +=
-        fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} -> {:.3f} | {:.1f} % | {:.0f} | {} |\n", id,
-                    answer.value("particle", "?"), answer.value("label", effect), verdict, j.value("basis", "?"),
-                    is_right ? "yes" : "no", before, after, 100.0 * gain, j.value("seconds", NAN), twin_cell(twin));
+    table += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {:.1f} % | {:.0f} | {} |\n", id,
+                         answer.value("particle", "?"), answer.value("label", effect), verdict, j.value("basis", "?"),
+                         is_right ? "yes" : "no", held.cell(), 100.0 * gain, j.value("seconds", kNaN), twin_cell(twin));
     rows.push_back({{"case", id},
                     {"truth", effect},
                     {"verdict", verdict},
                     {"basis", j.value("basis", "?")},
                     {"right", is_right},
-                    {"heldout_rms_before_mm", before},
-                    {"heldout_rms_after_mm", after},
-                    {"seconds", j.value("seconds", NAN)},
+                    {"heldout_before", held.before},
+                    {"heldout_after", held.after},
+                    {"heldout_on", held.on_name()},
+                    {"seconds", j.value("seconds", kNaN)},
                     {"summary_shift", twin_json(twin)},
                     {"advice", missed ? nlohmann::json(advice) : nlohmann::json()}});
     std::cout << fmt::format("{}  truth {:18s} verdict {:28s} {}  {:.0f} s\n", id, effect, verdict,
-                             is_right ? "right" : "WRONG", j.value("seconds", NAN))
+                             is_right ? "right" : "WRONG", j.value("seconds", kNaN))
               << std::flush;
   }
   table += fmt::format("\neffects named right: {}/{}; controls 'none': {}/{}; controls named as an effect: {}\n",
                        effects_right, effects, controls_none, controls, controls_named);
-  table += fmt::format("median held-out improvement of the cases named right: {:.1f} % of the held-out RMS\n",
-                       100.0 * median(improvements));
+  table += fmt::format(
+      "median held-out improvement of the cases named right: {:.1f} % of the held-out RMS (where each name was "
+      "made: tracks, outcomes or flights)\n",
+      100.0 * median(improvements));
   table += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
   table += fmt::format(
       "effects missed that the report called decided (neither in its undecidable list nor an ambiguous candidate): "
@@ -546,7 +587,8 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
 /// One diagnosed case as the scorer sees it.
 struct CaseScore {
   std::string truth, magnitude, verdict;
-  double heldout_before = NAN, heldout_after = NAN, seconds = NAN;
+  HeldOut held;
+  double seconds = NAN;
   bool detected = false;
   /// The concealed effect is neither among the report's undecidable ones nor its ambiguous candidates.
   bool called_decided = false;
@@ -586,9 +628,8 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   o.magnitude = magnitude;
   o.verdict = j.value("verdict", "?");
   o.detected = o.verdict == truth;
-  o.heldout_before = j["fit"]["before"].value("heldout_rms_mm", NAN);
-  o.heldout_after = j["fit"]["after"].value("heldout_rms_mm", NAN);
-  o.seconds = j.value("seconds", NAN);
+  o.held = held_out_of(j);
+  o.seconds = j.value("seconds", kNaN);
   o.called_decided = calls_decided(j, {truth});
   if (j.contains("undecidable") && j["undecidable"].is_array()) {
     o.ambiguous_with_truth = o.verdict == "ambiguous" && j.contains("candidates") && j["candidates"].is_array() &&
@@ -606,11 +647,11 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   o.far = far_case(j, truth == "none");
   o.flights = bench::flight_levels(j, "", truth == "none");
   if (j.contains("stage_seconds") && j["stage_seconds"].is_array()) {
-    for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", NAN));
+    for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", kNaN));
   }
   if (j.contains("ensemble") && j["ensemble"].is_object() && j["ensemble"].contains("comparisons")) {
     for (const auto& cmp : j["ensemble"]["comparisons"])
-      o.ensemble_z.emplace_back(cmp.value("statistic", "mean") + " " + cmp.value("outcome", "?"), cmp.value("z", NAN));
+      o.ensemble_z.emplace_back(cmp.value("statistic", "mean") + " " + cmp.value("outcome", "?"), cmp.value("z", kNaN));
   }
   return o;
 }
@@ -711,8 +752,7 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
       // What a `none` on a control rules out: the effects it does not call undecidable.
       if (o.verdict == "none") decided_absent.push_back(static_cast<double>(library.size()) - o.undecidable);
     } else {
-      if (o.detected && o.heldout_before > 0.0)
-        improvements.push_back((o.heldout_before - o.heldout_after) / o.heldout_before);
+      if (o.detected && o.held.before > 0.0) improvements.push_back(o.held.gain());
       strong_count += o.magnitude == "strong";
       // The decidable list speaks of the strong magnitude: a missed realistic one may lie below it.
       missed_decided += o.magnitude == "strong" && !o.detected && o.called_decided;
@@ -755,8 +795,10 @@ void write_generated_summary(const std::vector<CaseScore>& outcomes, const std::
                     ambiguous_right, missed);
   md += fmt::format("effects a control's `none` decides absent (not undecidable), median of {}: {:.0f} of {}\n",
                     decided_absent.size(), median(decided_absent), library.size());
-  md += fmt::format("median held-out improvement (named cases): {:.1f} % of the held-out RMS\n",
-                    100.0 * median(improvements));
+  md += fmt::format(
+      "median held-out improvement (named cases): {:.1f} % of the held-out RMS (where each name was made: tracks, "
+      "outcomes or flights)\n",
+      100.0 * median(improvements));
   md += fmt::format("median diagnosis time: {:.1f} s\n", median(seconds));
   md += time_summary(outcomes, summary);
   md += missed_summary(outcomes, summary);
@@ -1111,8 +1153,8 @@ int score_generated(const std::vector<Case>& cases, const std::string& out) {
       o->null_value = effect_off(effect_spec(library, *c.effect))[0];
       o->twin = bench::twin_shift(answer_recordings(fs::path(out) / c.id / "answer.json"));
     }
-    std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out RMS {:.3f} -> {:.3f} mm  {:.0f} s\n", c.id,
-                             truth, o->verdict, o->heldout_before, o->heldout_after, o->seconds)
+    std::cout << fmt::format("{:40s} truth {:28s} verdict {:28s} held-out {}  {:.0f} s\n", c.id, truth, o->verdict,
+                             o->held.cell(), o->seconds)
               << std::flush;
     outcomes.push_back(*o);
   }
