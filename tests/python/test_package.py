@@ -186,6 +186,14 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
     assert "flights" in dir(cf.DiagnoseResult)
     assert {"judged", "wobble_m", "allowance_m", "detected", "offset_m", "smallest_offset_m"} <= set(dir(cf.FlightWobble))
     assert cf.Basis.free_flights != cf.Basis.ensemble
+    # A name made beyond the release horizon, checked on the held-out trials where it was made.
+    assert {"heldout_outcomes", "heldout_flights"} <= set(dir(cf.DiagnoseResult))
+    assert {"training_trials", "heldout_trials", "rms_z_null", "rms_z_named", "improvement", "values"} <= set(
+        dir(cf.OutcomeHoldout)
+    )
+    assert {"training_flights", "heldout_flights", "offset_m", "wobble_m", "without_m", "with_m"} <= set(
+        dir(cf.FlightHoldout)
+    )
 
 
 def test_diagnose_from_python_names_the_bundled_air_drag_and_reports_each_candidate():
@@ -201,6 +209,10 @@ def test_diagnose_from_python_names_the_bundled_air_drag_and_reports_each_candid
     assert by_name["air_drag"].passes and not by_name["adhesion"].passes
     # delta-BIC margin 10 (DiagnoseOptions::min_delta_bic)
     assert by_name["air_drag"].delta_bic > 10 > by_name["adhesion"].delta_bic
+    # Named from the frames: its held-out trials are the tracks' (after < before), and no check
+    # of a name on the outcomes or the flights ran.
+    assert result.after.heldout_rms_mm < result.before.heldout_rms_mm
+    assert result.heldout_outcomes is None and result.heldout_flights is None
     for h in result.hypotheses:
         assert h.values_used > 0 and isinstance(h.worsened_phases, list)
         # The absence check runs only under verdict none: nothing probed, nothing preferred.
