@@ -230,7 +230,8 @@ struct OutcomeHoldout {
   double chi2_null = 0.0;      ///< the training trials' null against the held-out outcomes
   double chi2_named = 0.0;     ///< the training trials' named effect against them
   std::vector<double> values;  ///< the effect's parameters as the training trials calibrate them
-  int replays = 0;             ///< DEM replays this check ran
+  int replays = 0;             ///< DEM replays of its two held-out comparisons (the training trials' calibration's
+                               ///< are in the diagnosis's evaluations)
   double seconds = 0.0;        ///< [s] its wall clock
   /// RMS of the held-out statistics' z (standard errors of the recorded outcomes).
   double rms_z_null() const { return statistics > 0 ? std::sqrt(chi2_null / statistics) : 0.0; }
