@@ -25,7 +25,8 @@ int report_error(std::string_view command, const Error& error) {
     fmt::print(stderr, "\nclumpforge {}: interrupted; nothing was written\n", command);
     return kExitInterrupted;
   }
-  fmt::print(stderr, "clumpforge {}: error: {}\n", command, error.message);
+  // Printable again: a message made without fail() may quote a path or text given to the command.
+  fmt::print(stderr, "clumpforge {}: error: {}\n", command, printable_text(error.message));
   return kExitFailure;
 }
 

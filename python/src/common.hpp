@@ -34,6 +34,7 @@ struct LibraryError {
 void register_errors(py::module_& m);
 
 [[noreturn]] inline void raise(Error error) {
+  error.message = printable_text(error.message);  // valid UTF-8 for Python's str, whatever it quotes
   throw LibraryError{std::move(error)};
 }
 

@@ -415,6 +415,9 @@ Result<Recording> read_recording(const fs::path& path) {
         1 + static_cast<std::size_t>(std::count(
                 text.begin(), text.begin() + static_cast<long>(std::min<std::size_t>(e.byte, text.size())), '\n'));
     return fail(ErrorCode::ParseError, fmt::format("{}:{}: not valid JSON", manifest_path.string(), line));
+  } catch (const json::exception& e) {
+    // A number beyond a double's range (1e400) is valid JSON the parser cannot hold.
+    return fail(ErrorCode::ParseError, fmt::format("{}: not readable JSON: {}", manifest_path.string(), e.what()));
   }
   try {
     return parse_manifest(ManifestReader(manifest_path.string(), text), manifest, manifest_path.parent_path());

@@ -117,6 +117,15 @@ TEST(MaterialsCli, ShippedFileIsTheBuiltInTableAndOverridesWork) {
   const auto bad = test::run_clumpforge(fmt::format("materials --materials '{}'", (dir / "bad.json").string()));
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("bad.json"), std::string::npos);
+  // A number beyond a double's range is valid JSON no parser holds: a clean error naming the
+  // file, not "internal error" (found by flipping bytes of docs/materials.json).
+  test::write_text(
+      dir / "huge.json",
+      R"({"materials": [{"name": "x", "youngs_modulus_pa": 5e3083, "poisson_ratio": 0.3, "density_kg_m3": 1}]})");
+  const auto huge = test::run_clumpforge(fmt::format("materials --materials '{}'", (dir / "huge.json").string()));
+  EXPECT_EQ(huge.exit_code, 1);
+  EXPECT_NE(huge.err.find("huge.json' is not valid JSON"), std::string::npos) << huge.err;
+  EXPECT_EQ(huge.err.find("internal error"), std::string::npos) << huge.err;
 }
 }  // namespace clumpforge
 

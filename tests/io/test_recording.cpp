@@ -97,6 +97,9 @@ TEST(Recording, BadInputNamesFileAndLine) {
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
        "t_s,x_m,z_m,speed\n0.0,0,0.2,1\n", "t.csv:1: unknown column 'speed'"},
       {"{\"format\": \"recording/1\",\n \"test\": \"drop\" \"surface\": 1}", "", "recording.json:2: not valid JSON"},
+      // Valid JSON, but beyond a double's range: not "internal error" (found by flipping bytes).
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 2e3083}, "trials": []})",
+       "", "recording.json: not readable JSON: [json.exception.out_of_range.406] number overflow"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.expected);
@@ -108,6 +111,21 @@ TEST(Recording, BadInputNamesFileAndLine) {
     ASSERT_FALSE(r);
     EXPECT_NE(r.error().message.find(c.expected), std::string::npos) << r.error().message;
   }
+}
+
+TEST(Recording, AQuotedDamagedByteIsWrittenOutNotPassedOn) {
+  // A byte that is not UTF-8 and an escape sequence in a damaged number: the message names the
+  // file and line and shows both as \xNN, so neither reaches a terminal or a Python str raw.
+  test::ScratchDir dir("rec");
+  test::write_text(dir / "recording.json", R"({"format": "recording/1", "test": "drop", "surface": "Q235",
+  "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})");
+  test::write_text(dir / "t.csv", "t_s,x_m,z_m\n0.000,0,0.2\n0.001,0.0\xFC\x1B[2J,0.2\n");
+  const auto r = read_recording(dir.path());
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("t.csv:3: '0.0\\xFC\\x1B[2J' in column x_m is not a number"), std::string::npos)
+      << r.error().message;
+  EXPECT_EQ(r.error().message.find('\x1B'), std::string::npos);
+  EXPECT_EQ(r.error().message.find('\xFC'), std::string::npos);
 }
 
 // Recordings that cannot hurt the tool (issue 12, item 5): a track outside the recording's

@@ -160,6 +160,22 @@ def test_recordings_read_and_absurd_ones_are_refused(tmp_path):
         cf.read_recording(str(bad))
 
 
+def test_a_damaged_byte_in_a_track_is_a_parse_error_not_a_unicode_error(tmp_path):
+    # Found by flipping bytes in the bundled recordings: a byte that is not UTF-8, quoted in the
+    # error message, came out as UnicodeDecodeError instead of the library's ParseError.
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    (bad / "recording.json").write_text('{"format": "recording/1", "test": "drop", "surface": "Q235", '
+                                        '"setup": {"release_height_m": 0.2}, '
+                                        '"trials": [{"id": "1", "track": "t.csv"}]}')
+    (bad / "t.csv").write_bytes(b"t_s,x_m,z_m\n0.000,0,0.2\n0.001,0.0\xfc\x1b[2J,0.2\n")
+    with pytest.raises(cf.ParseError) as raised:
+        cf.read_recording(str(bad))
+    message = str(raised.value)
+    assert "t.csv:3" in message and "\\xFC\\x1B[2J" in message
+    assert "\x1b" not in message
+
+
 def test_diagnose_takes_finer_clumps_of_the_same_body_only():
     """The particle-model check needs clumps of one body: a finer clump of another is refused by
     name before anything runs; the result carries the check (None without finer clumps)."""

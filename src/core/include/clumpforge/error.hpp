@@ -26,9 +26,17 @@ struct Error {
 template <class T>
 using Result = std::expected<T, Error>;
 
-/// Shorthand for returning a failure: `return fail(ErrorCode::NotFound, "...")`.
-inline std::unexpected<Error> fail(ErrorCode code, std::string message) {
-  return std::unexpected<Error>(Error{code, std::move(message)});
+/// `text` safe to print and to pass on as UTF-8: each byte of an invalid UTF-8 sequence, and
+/// each control character but a newline or a tab, written as \xNN. An error message quotes
+/// what it read from a file (a damaged number, a name), and a file may hold anything: raw bytes
+/// broke the Python module's exception (a UnicodeDecodeError instead of ParseError) and an
+/// escape sequence would reach the user's terminal.
+std::string printable_text(std::string_view text);
+
+/// Shorthand for returning a failure: `return fail(ErrorCode::NotFound, "...")`. The message is
+/// made printable (printable_text).
+inline std::unexpected<Error> fail(ErrorCode code, std::string_view message) {
+  return std::unexpected<Error>(Error{code, printable_text(message)});
 }
 
 std::string_view to_string(ErrorCode code);

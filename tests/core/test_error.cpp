@@ -1,0 +1,33 @@
+// Error messages are printable UTF-8 whatever they quote (printable_text, fail).
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+
+namespace clumpforge {
+
+TEST(PrintableText, KeepsUtf8AndWritesOutEverythingElse) {
+  // Printable ASCII, a newline, a tab and valid multi-byte characters (2, 3 and 4 bytes) stay.
+  const std::string kept = "drop-0.2m: 5 \xC2\xB5m\n\t\xE2\x88\x86 \xF0\x9F\x98\x80";
+  EXPECT_EQ(printable_text(kept), kept);
+  // Control characters other than a newline or a tab, and DEL.
+  EXPECT_EQ(printable_text("a\x1B[2Jb\r\x7F"), "a\\x1B[2Jb\\x0D\\x7F");
+  EXPECT_EQ(printable_text(std::string("x\0y", 3)), "x\\x00y");
+  // Bytes that are not UTF-8: a stray continuation byte, a lead byte no sequence starts with, a
+  // sequence cut short (at the end and in the middle), an overlong form and a surrogate.
+  EXPECT_EQ(printable_text("\x80"), "\\x80");
+  EXPECT_EQ(printable_text("0.0\xFC"), "0.0\\xFC");
+  EXPECT_EQ(printable_text("\xE2\x88"), "\\xE2\\x88");
+  EXPECT_EQ(printable_text("\xE2(x"), "\\xE2(x");
+  EXPECT_EQ(printable_text("\xC0\xAF"), "\\xC0\\xAF");
+  EXPECT_EQ(printable_text("\xED\xA0\x80"), "\\xED\\xA0\\x80");
+  EXPECT_EQ(printable_text("\xF4\x90\x80\x80"), "\\xF4\\x90\\x80\\x80");  // beyond U+10FFFF
+}
+
+TEST(PrintableText, FailMakesEveryMessagePrintable) {
+  const Result<int> r = fail(ErrorCode::ParseError, "t.csv:3: '\xFF' is not a number");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::ParseError);
+  EXPECT_EQ(r.error().message, "t.csv:3: '\\xFF' is not a number");
+}
+
+}  // namespace clumpforge
