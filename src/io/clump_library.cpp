@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 #include <hdf5.h>
 
-#include <algorithm>
 #include <functional>
 #include <set>
 
@@ -89,13 +88,6 @@ void write_dataset(hid_t group, const char* name, std::initializer_list<hsize_t>
   // No modification times in object headers: the same clumps give the same bytes.
   Handle properties(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
   H5Pset_obj_track_times(properties.get(), false);
-  // A Fletcher-32 checksum of the values (one chunk: the whole dataset), checked on every read:
-  // a damaged value is an error, not a different clump. The metadata's are the file's format's
-  // (write_library_file).
-  if (std::ranges::all_of(shape, [](hsize_t n) { return n > 0; })) {
-    check(H5Pset_chunk(properties.get(), static_cast<int>(shape.size()), shape.data()), name);
-    check(H5Pset_fletcher32(properties.get()), name);
-  }
   Handle dataset(H5Dcreate2(group, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
                  H5Dclose);
   check(dataset.ok() ? 0 : -1, name);
@@ -350,14 +342,7 @@ Result<void> write_library_file(const fs::path& path, Body&& body) {
   return write_path_atomically(path, [&](const fs::path& temporary) -> Result<void> {
     QuietHdf5 quiet;
     try {
-      // The format of HDF5 1.10 and later, whose metadata (superblock, object headers with the
-      // attributes, link tables, a dataset's single-chunk index) carry checksums: a damaged file is
-      // refused with an error. In the earliest format, the default, a few flipped bytes crashed
-      // libhdf5 itself (2 of 150 damaged copies of the diagnosis library, in H5Lget_name_by_idx),
-      // and 1.8's keeps each chunk's index in an unchecked B-tree. h5py and HDF5 1.10+ read it.
-      Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-      check(H5Pset_libver_bounds(access.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST), "file access");
-      Handle file(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get()), H5Fclose);
+      Handle file(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
       if (!file.ok()) return fail(ErrorCode::IoError, fmt::format("cannot create HDF5 file '{}'", path.string()));
       write_string_attribute(file.get(), "format", kClumpLibraryFormat);
       write_int_attribute(file.get(), "schema_version", kClumpSchemaVersion);
