@@ -2,11 +2,14 @@
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <fmt/format.h>
 
 #include <assimp/Importer.hpp>
 #include <cmath>
-#include <fmt/format.h>
+#include <fstream>
+#include <string>
 
+#include "mesh/ply.hpp"
 #include "mesh/weld.hpp"
 
 namespace clumpforge {
@@ -25,25 +28,31 @@ Result<void> check_file(const fs::path& path) {
   return {};
 }
 
+/// Point `index` (from 0) of the file, scaled to metres, if it is finite and within 1 km.
+Result<Eigen::Vector3d> checked_point(double x, double y, double z, std::size_t index, const fs::path& path,
+                                      double scale) {
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+    return fail(ErrorCode::ParseError, fmt::format("'{}': vertex {} has a non-finite coordinate ({}, {}, {})",
+                                                   path.string(), index + 1, x, y, z));
+  }
+  const Eigen::Vector3d point(x * scale, y * scale, z * scale);
+  if (point.cwiseAbs().maxCoeff() > 1e3) {
+    return fail(ErrorCode::ParseError, fmt::format("'{}': vertex {} lies {:.3g} m from the origin: not a particle scan "
+                                                   "(wrong --units, or a corrupt file)",
+                                                   path.string(), index + 1, point.cwiseAbs().maxCoeff()));
+  }
+  return point;
+}
+
 Result<void> gather_triangles(const aiScene& scene, const fs::path& path, double scale, LoadResult& result) {
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
     const aiMesh& mesh = *scene.mMeshes[m];
     const int base = static_cast<int>(result.soup.points.size());
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
       const aiVector3D& p = mesh.mVertices[v];
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        return fail(ErrorCode::ParseError,
-                    fmt::format("'{}': vertex {} has a non-finite coordinate ({}, {}, {})", path.string(),
-                                result.soup.points.size() + 1, p.x, p.y, p.z));
-      }
-      const Eigen::Vector3d point(p.x * scale, p.y * scale, p.z * scale);
-      if (point.cwiseAbs().maxCoeff() > 1e3) {
-        return fail(ErrorCode::ParseError,
-                    fmt::format("'{}': vertex {} lies {:.3g} m from the origin: not a particle scan "
-                                "(wrong --units, or a corrupt file)",
-                                path.string(), result.soup.points.size() + 1, point.cwiseAbs().maxCoeff()));
-      }
-      result.soup.points.push_back(point);
+      auto point = checked_point(p.x, p.y, p.z, result.soup.points.size(), path, scale);
+      if (!point) return std::unexpected(point.error());
+      result.soup.points.push_back(*point);
     }
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
@@ -51,12 +60,53 @@ Result<void> gather_triangles(const aiScene& scene, const fs::path& path, double
         ++result.skipped_primitives;
         continue;
       }
-      result.soup.faces.push_back({base + static_cast<int>(face.mIndices[0]),
-                                   base + static_cast<int>(face.mIndices[1]),
+      result.soup.faces.push_back({base + static_cast<int>(face.mIndices[0]), base + static_cast<int>(face.mIndices[1]),
                                    base + static_cast<int>(face.mIndices[2])});
     }
   }
   return {};
+}
+
+/// Every format but PLY, through assimp.
+Result<void> read_with_assimp(const fs::path& path, double scale, LoadResult& result) {
+  Assimp::Importer importer;
+  // No aiProcess_JoinIdenticalVertices: it keeps vertices apart that differ in normal or
+  // texture coordinate. We weld by position below instead; points and lines are skipped.
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFile(path.string(),
+                              aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
+  } catch (const std::exception& e) {
+    return fail(ErrorCode::ParseError, fmt::format("'{}' could not be read: {}", path.string(), e.what()));
+  }
+  if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) {
+    return fail(ErrorCode::ParseError,
+                fmt::format("'{}' could not be read as a mesh: {}", path.string(), importer.GetErrorString()));
+  }
+  return gather_triangles(*scene, path, scale, result);
+}
+
+/// A PLY file, by clumpforge's own reader (ply.hpp: assimp's crashed on damaged ones).
+Result<void> read_ply(const fs::path& path, const std::string& bytes, double scale, LoadResult& result) {
+  auto ply = parse_ply(bytes, path);
+  if (!ply) return std::unexpected(ply.error());
+  for (const Eigen::Vector3d& p : ply->soup.points) {
+    auto point = checked_point(p.x(), p.y(), p.z(), result.soup.points.size(), path, scale);
+    if (!point) return std::unexpected(point.error());
+    result.soup.points.push_back(*point);
+  }
+  result.soup.faces = std::move(ply->soup.faces);
+  result.skipped_primitives = ply->skipped_primitives;
+  return {};
+}
+
+/// The file's first bytes (enough to tell a PLY file), or all of them.
+std::string read_bytes(const fs::path& path, std::size_t limit) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(limit, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(limit));
+  bytes.resize(static_cast<std::size_t>(in.gcount()));
+  return bytes;
 }
 }  // namespace
 
@@ -77,22 +127,14 @@ Result<LoadResult> load_mesh(const fs::path& path, const LoadOptions& options) {
   if (!(options.weld_tolerance_relative >= 0.0 && options.weld_tolerance_relative <= 1e-2)) {
     return fail(ErrorCode::InvalidArgument, "weld tolerance must be in [0, 0.01] of the bounding-box diagonal");
   }
-  Assimp::Importer importer;
-  // No aiProcess_JoinIdenticalVertices: it keeps vertices apart that differ in normal or
-  // texture coordinate. We weld by position below instead; points and lines are skipped.
-  const aiScene* scene = nullptr;
-  try {
-    scene = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                                                 aiProcess_ValidateDataStructure);
-  } catch (const std::exception& e) {
-    return fail(ErrorCode::ParseError, fmt::format("'{}' could not be read: {}", path.string(), e.what()));
-  }
-  if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) {
-    return fail(ErrorCode::ParseError,
-                fmt::format("'{}' could not be read as a mesh: {}", path.string(), importer.GetErrorString()));
-  }
   LoadResult result;
-  if (auto ok = gather_triangles(*scene, path, metres_per(options.unit), result); !ok) {
+  const double scale = metres_per(options.unit);
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (looks_like_ply(read_bytes(path, 8))) {
+    if (auto ok = read_ply(path, read_bytes(path, ec ? 0 : size), scale, result); !ok)
+      return std::unexpected(ok.error());
+  } else if (auto ok = read_with_assimp(path, scale, result); !ok) {
     return std::unexpected(ok.error());
   }
   if (result.soup.faces.empty()) {

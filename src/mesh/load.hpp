@@ -1,5 +1,6 @@
 #pragma once
-/// Reading scans: every format assimp reads (STL ascii and binary, OBJ, PLY, OFF, ...).
+/// Reading scans: PLY by clumpforge's own reader (ply.hpp), every other format assimp reads (STL
+/// ascii and binary, OBJ, OFF, ...).
 #include <filesystem>
 
 #include "core/error.hpp"
@@ -14,13 +15,13 @@ struct LoadOptions {
 };
 
 struct LoadResult {
-  TriangleSoup soup;               ///< welded, in metres
-  int file_triangles = 0;          ///< triangles as read from the file
-  int file_vertices = 0;           ///< vertices as read (before welding)
-  int welded_vertices = 0;         ///< vertices merged by position
-  int skipped_primitives = 0;      ///< points and lines in the file, ignored
-  double weld_tolerance = 0.0;     ///< [m]
-  std::vector<Diagnostic> notes;   ///< e.g. an implausible size for the unit
+  TriangleSoup soup;              ///< welded, in metres
+  int file_triangles = 0;         ///< triangles as read from the file
+  int file_vertices = 0;          ///< vertices as read (before welding)
+  int welded_vertices = 0;        ///< vertices merged by position
+  int skipped_primitives = 0;     ///< points and lines in the file, ignored
+  double weld_tolerance = 0.0;    ///< [m]
+  std::vector<Diagnostic> notes;  ///< e.g. an implausible size for the unit
 };
 
 /// Loads `path`, converts it to metres and welds vertices by position. Fails with a
