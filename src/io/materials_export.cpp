@@ -238,10 +238,9 @@ double rolling_lever_ratio(const Clump& clump, int samples, std::uint64_t seed) 
   return sum / samples;
 }
 
-Result<StoredCalibration> apply_calibration(const std::filesystem::path& path, MaterialTable base,
-                                            const std::string& particle) {
-  std::ifstream in(path);
-  if (!in) return fail(ErrorCode::IoError, fmt::format("cannot read calibration '{}'", path.string()));
+namespace {
+Result<StoredCalibration> apply_calibration_json(const std::filesystem::path& path, MaterialTable base,
+                                                 const std::string& particle, std::ifstream& in) {
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
   auto bad = [&](const std::string& what) {
     return fail(ErrorCode::ParseError, fmt::format("calibration '{}': {}", path.string(), what));
@@ -288,5 +287,17 @@ Result<StoredCalibration> apply_calibration(const std::filesystem::path& path, M
   }
   stored.table = std::move(base);
   return stored;
+}
+}  // namespace
+
+Result<StoredCalibration> apply_calibration(const std::filesystem::path& path, MaterialTable base,
+                                            const std::string& particle) {
+  std::ifstream in(path);
+  if (!in) return fail(ErrorCode::IoError, fmt::format("cannot read calibration '{}'", path.string()));
+  try {
+    return apply_calibration_json(path, std::move(base), particle, in);
+  } catch (const nlohmann::json::exception& e) {  // a key of another type than calibrate writes
+    return fail(ErrorCode::ParseError, fmt::format("calibration '{}': {}", path.string(), e.what()));
+  }
 }
 }  // namespace clumpforge

@@ -126,6 +126,21 @@ TEST(MaterialsCli, ShippedFileIsTheBuiltInTableAndOverridesWork) {
   EXPECT_EQ(huge.exit_code, 1);
   EXPECT_NE(huge.err.find("huge.json' is not valid JSON"), std::string::npos) << huge.err;
   EXPECT_EQ(huge.err.find("internal error"), std::string::npos) << huge.err;
+  // A calibration file whose keys hold another type than calibrate writes: the same clean error
+  // (each was "internal error" from an uncaught type_error).
+  for (const char* text : {R"({"method": 3})", R"({"method": "paper", "results": {"Q235": 3}})",
+                           R"({"method": "joint", "surfaces": [{"surface": "Q235", "restitution": 0.5,
+                              "static_friction": 0.4, "rolling_friction": 0.01}], "conventions": 7})"}) {
+    SCOPED_TRACE(text);
+    test::write_text(dir / "calibration.json", text);
+    const auto cal =
+        test::run_clumpforge(fmt::format("materials --calibration '{}'", (dir / "calibration.json").string()));
+    EXPECT_EQ(cal.exit_code, 1);
+    EXPECT_NE(cal.err.find("calibration '"), std::string::npos) << cal.err;
+    EXPECT_NE(cal.err.find("calibration.json"), std::string::npos) << cal.err;
+    EXPECT_EQ(cal.err.find("internal error"), std::string::npos) << cal.err;
+    EXPECT_TRUE(cal.out.empty()) << cal.out;
+  }
 }
 }  // namespace clumpforge
 
