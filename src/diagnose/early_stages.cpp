@@ -100,9 +100,9 @@ Result<std::vector<std::string>> settle_release_state(Context& c, const Model& m
 /// Stage 0: options a diagnosis cannot run with.
 Result<void> check_options(const DiagnoseOptions& options) {
   if (!(options.model_accuracy_m >= 0.0 && options.model_accuracy_m <= 0.01)) {
-    return fail(
-        ErrorCode::InvalidArgument,
-        fmt::format("the particle model's accuracy must lie in [0, 10] mm, not {} m", options.model_accuracy_m));
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("the particle model's accuracy must lie in [0, 10] mm, not {:g} mm",
+                            1e3 * options.model_accuracy_m));
   }
   if (!(options.impact_accuracy >= 0.0 && options.impact_accuracy <= 0.2)) {
     return fail(ErrorCode::InvalidArgument,

@@ -93,6 +93,12 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   EXPECT_NE(run.exit_code, 0);
   EXPECT_NE(run.err.find("--finer-clumps must be between 0 and 4"), std::string::npos) << run.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "finer"));
+  // An accuracy beyond its range is refused in the unit it was given in (it said "not 0.02 m").
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --model-accuracy 20 --output '{}'",
+                                         (dir / "rec").string(), clump(), (dir / "accuracy").string()));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("must lie in [0, 10] mm, not 20 mm"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "accuracy"));
   // A release posture the tool does not know: refused by name, nothing written.
   run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --roll-release flat --output '{}'",
                                          (dir / "rec").string(), clump(), (dir / "posture").string()));

@@ -113,21 +113,6 @@ TEST(Recording, BadInputNamesFileAndLine) {
   }
 }
 
-TEST(Recording, AQuotedDamagedByteIsWrittenOutNotPassedOn) {
-  // A byte that is not UTF-8 and an escape sequence in a damaged number: the message names the
-  // file and line and shows both as \xNN, so neither reaches a terminal or a Python str raw.
-  test::ScratchDir dir("rec");
-  test::write_text(dir / "recording.json", R"({"format": "recording/1", "test": "drop", "surface": "Q235",
-  "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})");
-  test::write_text(dir / "t.csv", "t_s,x_m,z_m\n0.000,0,0.2\n0.001,0.0\xFC\x1B[2J,0.2\n");
-  const auto r = read_recording(dir.path());
-  ASSERT_FALSE(r);
-  EXPECT_NE(r.error().message.find("t.csv:3: '0.0\\xFC\\x1B[2J' in column x_m is not a number"), std::string::npos)
-      << r.error().message;
-  EXPECT_EQ(r.error().message.find('\x1B'), std::string::npos);
-  EXPECT_EQ(r.error().message.find('\xFC'), std::string::npos);
-}
-
 // Recordings that cannot hurt the tool (issue 12, item 5): a track outside the recording's
 // folder is refused without being opened, and values no experiment produces are refused
 // with the file, the line and the limit broken.
@@ -151,6 +136,16 @@ std::string refusal(const fs::path& dir, const std::string& manifest,
   return r ? std::string("(accepted)") : r.error().message;
 }
 }  // namespace
+
+TEST(RecordingLimits, AQuotedDamagedByteIsWrittenOutNotPassedOn) {
+  // A byte that is not UTF-8 and an escape sequence in a damaged number: the message names the
+  // file and line and shows both as \xNN, so neither reaches a terminal or a Python str raw.
+  test::ScratchDir dir("rec-limits");
+  const std::string m = refusal(dir / "r", with_track("t.csv"), "t_s,x_m,z_m\n0.000,0,0.2\n0.001,0.0\xFC\x1B[2J,0.2\n");
+  EXPECT_NE(m.find("t.csv:3: '0.0\\xFC\\x1B[2J' in column x_m is not a number"), std::string::npos) << m;
+  EXPECT_EQ(m.find('\x1B'), std::string::npos);
+  EXPECT_EQ(m.find('\xFC'), std::string::npos);
+}
 
 TEST(RecordingLimits, TrackPathWithDotDotIsRefusedUnread) {
   test::ScratchDir dir("rec-limits");
