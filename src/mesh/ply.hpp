@@ -1,7 +1,7 @@
 #pragma once
 /// Reading PLY scans (ascii, binary little- and big-endian) without assimp. Scanners write PLY,
 /// and a damaged one must be an error, not a crash: assimp 5.2's PLY reader crashed (SIGSEGV) or
-/// aborted (an ai_assert) on 5 of 250 copies of a cube with a few bytes changed (a property
+/// aborted (an ai_assert) on 7 of 250 copies of a cube with a few bytes changed (a property
 /// line's keyword damaged, a number in the header).
 #include <filesystem>
 #include <string_view>
