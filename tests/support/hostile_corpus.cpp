@@ -40,15 +40,16 @@ std::vector<HostileCase> make_hostile_corpus(const fs::path& dir) {
     const float t[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
     for (int i = 0; i < 3; ++i) write_triangle(out, t);
   }
-  write_text(dir / "nan.stl",
-                   "solid nan\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
-                   "endsolid nan\n");
+  write_text(
+      dir / "nan.stl",
+      "solid nan\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+      "endsolid nan\n");
   write_text(dir / "huge.stl",
-                   "solid huge\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1e30 0 0\nvertex 0 1e30 0\nendloop\n"
-                   "endfacet\nendsolid huge\n");
+             "solid huge\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1e30 0 0\nvertex 0 1e30 0\nendloop\n"
+             "endfacet\nendsolid huge\n");
   write_text(dir / "triangle.stl",
-                   "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\nvertex 0 10 0\nendloop\nendfacet\n"
-                   "endsolid t\n");
+             "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\nvertex 0 10 0\nendloop\nendfacet\n"
+             "endsolid t\n");
   {
     TriangleSoup sheet;
     for (int i = 0; i <= 6; ++i) {
@@ -63,6 +64,10 @@ std::vector<HostileCase> make_hostile_corpus(const fs::path& dir) {
     }
     write_ascii_stl(dir / "sheet.stl", sheet, 1.0);
   }
+  // A scanner's PLY with one header byte damaged: assimp's PLY reader crashed on such files.
+  write_text(dir / "damaged.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\npropert\x82 float y\nproperty float z\n"
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n10 0 0\n0 10 0\n3 0 1 2\n");
   fs::create_directories(dir / "folder.stl");
   return {{"empty.stl", "empty"},
           {"truncated.stl", "could not be read"},
@@ -72,6 +77,7 @@ std::vector<HostileCase> make_hostile_corpus(const fs::path& dir) {
           {"huge.stl", ""},
           {"triangle.stl", ""},
           {"sheet.stl", ""},
+          {"damaged.ply", "line 5: 'propert\\x82' is not a PLY header keyword"},
           {"folder.stl", "is a directory"},
           {"missing.stl", "no such file"}};
 }
