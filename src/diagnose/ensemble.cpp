@@ -184,6 +184,21 @@ double x_after_impact(const PathSample& path, const std::vector<std::size_t>& va
   return median(xs);
 }
 
+/// The lowest running median of five frames from valid position `from` on: a body's resting
+/// height when it rests, and within a few frames' fall of it at a bounce's contact when it does
+/// not (the median of five keeps the camera's noise from pulling it down by more than about one
+/// standard deviation).
+double lowest_after(const PathSample& path, const std::vector<std::size_t>& valid, std::size_t from) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = from; k < valid.size(); ++k) {
+    const std::size_t a = k >= from + 2 ? k - 2 : from, b = std::min(valid.size(), k + 3);
+    std::vector<double> window;
+    for (std::size_t j = a; j < b; ++j) window.push_back(path.z[valid[j]]);
+    lowest = std::min(lowest, median(window));
+  }
+  return lowest;
+}
+
 }  // namespace
 
 std::optional<double> first_impact_time(const PathSample& path, double moved) {
@@ -211,13 +226,15 @@ std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const Pat
     if (std::hypot(path.x[i] - x_rest, path.z[i] - z_rest) > moved) rest_time = path.t[i];
   }
   if (test == LabTest::Roll) return {{Outcome::RollDistance, x_rest}, {Outcome::RollTime, rest_time}};
-  // The first impact; the rebound height is the highest point after it, above the rest height.
+  // The first impact; the rebound height is the highest point after it, above the lowest level
+  // the body reaches after it (lowest_after): not above its last frames, which are at another
+  // phase of a bounce in each track that ends before the body settles.
   const std::optional<std::size_t> impact = first_impact(path, valid, moved);
   double rebound = 0.0;
   if (impact) {
     double apex = -std::numeric_limits<double>::infinity();
     for (std::size_t k = *impact; k < valid.size(); ++k) apex = std::max(apex, path.z[valid[k]]);
-    rebound = std::max(0.0, apex - z_rest);
+    rebound = std::max(0.0, apex - lowest_after(path, valid, *impact));
   }
   // No time to rest for a drop: a lab's track often ends before a tumbling body settles, and
   // the replays' would measure where the replay stops, not the body.
