@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 #include <ranges>
+#include <sstream>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
@@ -34,35 +35,37 @@ struct DiagnoseArgs {
   bool json = false, no_replay_reuse = false;
 };
 
-void print_text(const DiagnoseResult& r) {
+/// The text report. Trial ids, track names and folder names are the recording's free text and can
+/// hold control characters: the caller writes the whole through printable_text.
+void write_text(std::ostream& out, const DiagnoseResult& r) {
   if (r.summaries_only) {
-    std::cout << fmt::format(
+    out << fmt::format(
         "verdict: {} (summaries only: no tracks, so no effect can be named)\n\nwhat these summaries decide:\n",
         verdict_name(r));
-    for (const auto& d : r.decidable) std::cout << "  - " << d << "\n";
-    std::cout << "\nwhat they cannot decide:\n";
-    for (const auto& d : r.undecidable) std::cout << "  - " << d << "\n";
-    std::cout << "\nto decide more: " << r.experiment << "\n";
+    for (const auto& d : r.decidable) out << "  - " << d << "\n";
+    out << "\nwhat they cannot decide:\n";
+    for (const auto& d : r.undecidable) out << "  - " << d << "\n";
+    out << "\nto decide more: " << r.experiment << "\n";
     return;
   }
-  std::cout << fmt::format("verdict: {}\n{}\n", verdict_name(r), r.statement);
+  out << fmt::format("verdict: {}\n{}\n", verdict_name(r), r.statement);
   if (!r.undecidable.empty())
-    std::cout << fmt::format("not decidable from these tracks: {}\n", fmt::join(r.undecidable, ", "));
-  if (!r.experiment.empty()) std::cout << fmt::format("to decide more: {}\n", r.experiment);
-  std::cout << "\nnoise (estimated from the tracks):";
-  for (const auto& [name, s] : r.noise_m) std::cout << fmt::format(" {} {:.3f} mm;", name, s * 1000.0);
-  std::cout << "\n\nwhere the baseline misses (phases beyond the noise):\n";
+    out << fmt::format("not decidable from these tracks: {}\n", fmt::join(r.undecidable, ", "));
+  if (!r.experiment.empty()) out << fmt::format("to decide more: {}\n", r.experiment);
+  out << "\nnoise (estimated from the tracks):";
+  for (const auto& [name, s] : r.noise_m) out << fmt::format(" {} {:.3f} mm;", name, s * 1000.0);
+  out << "\n\nwhere the baseline misses (phases beyond the noise):\n";
   int shown = 0;
   for (const auto& p : r.phases) {
     if (!p.significant) continue;
-    std::cout << "  - " << p.statement << fmt::format(" -> {:.2f} after\n", p.improved_chi2_per_value);
+    out << "  - " << p.statement << fmt::format(" -> {:.2f} after\n", p.improved_chi2_per_value);
     ++shown;
   }
-  if (shown == 0) std::cout << "  (none: every phase is within the noise)\n";
-  std::cout << "\ncandidate effects (training delta-chi^2, delta-BIC, held-out delta-chi^2, checks):\n";
+  if (shown == 0) out << "  (none: every phase is within the noise)\n";
+  out << "\ncandidate effects (training delta-chi^2, delta-BIC, held-out delta-chi^2, checks):\n";
   for (const auto& h : r.hypotheses) {
     if (!h.fitted) {
-      std::cout << fmt::format("  {:28s} not fitted (no large misfit to clear)\n", h.name);
+      out << fmt::format("  {:28s} not fitted (no large misfit to clear)\n", h.name);
       continue;
     }
     std::string values;
@@ -70,35 +73,34 @@ void print_text(const DiagnoseResult& r) {
     const std::string refitted = std::isfinite(h.all_trials_delta_bic) && !h.beats_refitted_null
                                      ? fmt::format(" refitted-coefficients-do-as-well({:.1f})", h.all_trials_delta_bic)
                                      : "";
-    std::cout << fmt::format("  {:28s} {:9.1f} {:9.1f} {:9.1f}  {}{}{}{}{}{}\n", h.name, h.delta_chi2, h.delta_bic,
-                             h.heldout_delta_chi2, h.passes ? "PASS" : "fail", h.plausible ? "" : " implausible",
-                             h.improves_heldout ? "" : " no-held-out-gain", h.clears_signature ? "" : " signature-left",
-                             refitted + (h.clears_large_misfit ? "" : " no-large-misfit-cleared"), values);
+    out << fmt::format("  {:28s} {:9.1f} {:9.1f} {:9.1f}  {}{}{}{}{}{}\n", h.name, h.delta_chi2, h.delta_bic,
+                       h.heldout_delta_chi2, h.passes ? "PASS" : "fail", h.plausible ? "" : " implausible",
+                       h.improves_heldout ? "" : " no-held-out-gain", h.clears_signature ? "" : " signature-left",
+                       refitted + (h.clears_large_misfit ? "" : " no-large-misfit-cleared"), values);
   }
-  std::cout << fmt::format(
-      "\nfit before -> after: training RMS {:.3f} -> {:.3f} mm, held-out RMS {:.3f} -> {:.3f} mm\n",
-      r.before.train_rms_mm, r.after.train_rms_mm, r.before.heldout_rms_mm, r.after.heldout_rms_mm);
+  out << fmt::format("\nfit before -> after: training RMS {:.3f} -> {:.3f} mm, held-out RMS {:.3f} -> {:.3f} mm\n",
+                     r.before.train_rms_mm, r.after.train_rms_mm, r.before.heldout_rms_mm, r.after.heldout_rms_mm);
   for (std::size_t k = 0; k < r.before.summary_error.size() && k < r.after.summary_error.size(); ++k) {
-    std::cout << fmt::format("  summary error {}: {:+.3g} -> {:+.3g}\n", r.before.summary_error[k].first,
-                             r.before.summary_error[k].second, r.after.summary_error[k].second);
+    out << fmt::format("  summary error {}: {:+.3g} -> {:+.3g}\n", r.before.summary_error[k].first,
+                       r.before.summary_error[k].second, r.after.summary_error[k].second);
   }
   if (const auto& h = r.heldout_outcomes) {
-    std::cout << fmt::format(
+    out << fmt::format(
         "held-out outcomes (calibrated on {} training trials, compared on {} held-out): RMS z {:.2f} -> {:.2f} over "
         "{} means and spreads ({:.1f} % better)\n",
         h->training_trials, h->heldout_trials, h->rms_z_null(), h->rms_z_named(), h->statistics,
         100.0 * h->improvement());
   }
   if (const auto& h = r.heldout_flights) {
-    std::cout << fmt::format(
+    out << fmt::format(
         "held-out flights ({} from the training trials give an offset of {:.2f} mm; {} held out): their wobble "
         "{:.3f} mm, predicted {:.3f} mm with the mass centred, {:.3f} mm with the offset ({:.1f} % better)\n",
         h->training_flights, h->offset_m * 1e3, h->heldout_flights, h->wobble_m * 1e3, h->without_m * 1e3,
         h->with_m * 1e3, 100.0 * h->improvement());
   }
-  for (const auto& note : r.notes) std::cout << "note: " << note << "\n";
-  std::cout << fmt::format("{} tracked trials ({} for fitting), {} trial replays, {:.1f} s\n", r.tracked_trials,
-                           r.training_trials, r.evaluations, r.seconds);
+  for (const auto& note : r.notes) out << "note: " << note << "\n";
+  out << fmt::format("{} tracked trials ({} for fitting), {} trial replays, {:.1f} s\n", r.tracked_trials,
+                     r.training_trials, r.evaluations, r.seconds);
 }
 
 int run_diagnose(const DiagnoseArgs& args) {
@@ -159,8 +161,11 @@ int run_diagnose(const DiagnoseArgs& args) {
   }
   if (args.json)
     std::cout << report.dump(2) << "\n";
-  else
-    print_text(*result);
+  else {
+    std::ostringstream text;
+    write_text(text, *result);
+    std::cout << printable_text(text.str());
+  }
   return kExitOk;
 }
 

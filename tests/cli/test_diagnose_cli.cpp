@@ -122,6 +122,15 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
     EXPECT_EQ(j["verdict"], "undecidable");
     EXPECT_EQ(j["wall_mass"], mass);
   }
+  // A trial id is the recording's free text: an escape sequence in it (JSON "\u001b") is written
+  // out as \x1B in the text report's note on the too-short trial, never sent to the terminal.
+  std::string escaped = kManifest;
+  escaped.replace(escaped.find("\"01\""), 4, "\"\\u001b[2J01\"");
+  write(dir / "rec" / "recording.json", escaped);
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}'", (dir / "rec").string(), clump()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("trial \\x1B[2J01 (2 usable frames)"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find('\x1b'), std::string::npos);
 }
 
 // Hostile recordings (issue 12, item 5) through the command: a clean message naming the
