@@ -210,8 +210,10 @@ int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<R
   if (args.json)
     std::cout << report.dump(2) << "\n";
   else
-    fmt::print("joint calibration of clump '{}' ({} orientations per drop and roll evaluation)\n\n{}", clump.name,
-               options.trials, text);
+    // The clump's and the recordings' names are free text: shown escaped (printable_text).
+    fmt::print("{}", printable_text(fmt::format(
+                         "joint calibration of clump '{}' ({} orientations per drop and roll evaluation)\n\n{}",
+                         clump.name, options.trials, text)));
   return kExitOk;
 }
 
@@ -294,9 +296,10 @@ int run_calibrate(const CalibrateArgs& args) {
   if (args.json) {
     std::cout << report.dump(2) << "\n";
   } else {
-    fmt::print("calibration of clump '{}' by the study's method ({} trials per level)\n\n{}\n", clump->name,
-               args.trials_per_level, markdown(*calibration));
-    for (const auto& note : calibration->notes) fmt::print("note: {}\n", note);
+    std::string shown = fmt::format("calibration of clump '{}' by the study's method ({} trials per level)\n\n{}\n",
+                                    clump->name, args.trials_per_level, markdown(*calibration));
+    for (const auto& note : calibration->notes) shown += fmt::format("note: {}\n", note);
+    fmt::print("{}", printable_text(shown));  // names are free text: shown escaped
     if (!args.out.empty()) fmt::print("report, sweeps and plots written to {}/\n", args.out);
   }
   return kExitOk;
