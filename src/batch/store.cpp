@@ -1,13 +1,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "batch/batch.hpp"
 #include "core/atomic_file.hpp"
 #include "core/sha256.hpp"
+#include "core/text.hpp"
 #include "io/clump_library.hpp"
 
 namespace clumpforge {
@@ -53,14 +52,6 @@ ScanShape shape_from(const json& j) {
           j.at("thickness_m"), j.at("sphericity"), j.at("elongation"), j.at("flatness")};
 }
 
-std::optional<std::string> read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 }  // namespace
 
 std::string options_fingerprint(const BatchOptions& options) {
@@ -100,7 +91,7 @@ Result<void> store_item(const fs::path& dir, const ItemResult& r, const BatchOpt
 }
 
 std::optional<ItemResult> load_item(const fs::path& dir, const std::string& scan, const BatchOptions& options) {
-  auto text = read_text(item_json(dir, scan));
+  auto text = read_file_bytes(item_json(dir, scan));
   if (!text) return std::nullopt;
   try {
     const json j = json::parse(*text);

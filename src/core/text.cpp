@@ -1,6 +1,7 @@
 #include "core/text.hpp"
 
 #include <algorithm>
+#include <fstream>
 #include <vector>
 
 namespace clumpforge {
@@ -46,7 +47,30 @@ std::string closest(std::string_view input, const Range& candidates) {
 
 }  // namespace
 
-std::string did_you_mean(std::string_view input, std::initializer_list<std::string_view> candidates) { return closest(input, candidates); }
-std::string did_you_mean(std::string_view input, std::span<const std::string> candidates) { return closest(input, candidates); }
+std::string did_you_mean(std::string_view input, std::initializer_list<std::string_view> candidates) {
+  return closest(input, candidates);
+}
+std::string did_you_mean(std::string_view input, std::span<const std::string> candidates) {
+  return closest(input, candidates);
+}
+
+std::optional<std::string> read_file_bytes(const std::filesystem::path& path, std::size_t limit) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return std::nullopt;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::string bytes;
+  constexpr std::size_t kChunk = 1 << 16;
+  while (bytes.size() < limit) {
+    const std::size_t want = std::min(kChunk, limit - bytes.size());
+    const std::size_t had = bytes.size();
+    bytes.resize(had + want);
+    in.read(bytes.data() + had, static_cast<std::streamsize>(want));
+    bytes.resize(had + static_cast<std::size_t>(in.gcount()));
+    if (!in) break;
+  }
+  if (in.bad()) return std::nullopt;
+  return bytes;
+}
 
 }  // namespace clumpforge

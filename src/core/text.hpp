@@ -1,6 +1,10 @@
 #pragma once
 /// Small text helpers shared by the parsers.
+#include <cstddef>
+#include <filesystem>
 #include <initializer_list>
+#include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -13,5 +17,10 @@ std::size_t edit_distance(std::string_view a, std::string_view b);
 /// " (did you mean 'x'?)" for the closest candidate within two edits, else "".
 std::string did_you_mean(std::string_view input, std::initializer_list<std::string_view> candidates);
 std::string did_you_mean(std::string_view input, std::span<const std::string> candidates);
+
+/// The bytes of the file at `path`, at most `limit` of them; nullopt when it cannot be opened or
+/// read (a missing file, a folder, no permission). The one whole-file reader the parsers share.
+std::optional<std::string> read_file_bytes(const std::filesystem::path& path,
+                                           std::size_t limit = std::numeric_limits<std::size_t>::max());
 
 }  // namespace clumpforge

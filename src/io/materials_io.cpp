@@ -2,21 +2,20 @@
 
 #include <fmt/format.h>
 
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
+
+#include "core/text.hpp"
 
 namespace clumpforge {
 using nlohmann::json;
 
 Result<MaterialTable> read_materials(const std::filesystem::path& path, MaterialTable table) {
-  std::ifstream in(path);
-  if (!in) return fail(ErrorCode::NotFound, fmt::format("'{}': no such materials file", path.string()));
-  std::stringstream text;
-  text << in.rdbuf();
+  const auto text = read_file_bytes(path);
+  if (!text)
+    return fail(ErrorCode::NotFound, fmt::format("'{}': no such materials file, or not readable", path.string()));
   json file;
   try {
-    file = json::parse(text.str());
+    file = json::parse(*text);
   } catch (const json::exception& e) {  // a syntax error, or a number beyond a double's range (1e400)
     return fail(ErrorCode::ParseError, fmt::format("'{}' is not valid JSON: {}", path.string(), e.what()));
   }

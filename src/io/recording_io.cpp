@@ -402,11 +402,9 @@ std::string track_csv(const Track& track) {
 Result<Recording> read_recording(const fs::path& path) {
   std::error_code ec;
   const fs::path manifest_path = fs::is_directory(path, ec) ? path / "recording.json" : path;
-  std::ifstream in(manifest_path);
-  if (!in) return fail(ErrorCode::NotFound, fmt::format("{}: no recording manifest", manifest_path.string()));
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  const auto read = read_file_bytes(manifest_path);
+  if (!read) return fail(ErrorCode::NotFound, fmt::format("{}: no recording manifest", manifest_path.string()));
+  const std::string& text = *read;
   json manifest;
   try {
     manifest = json::parse(text);

@@ -6,9 +6,9 @@
 
 #include <assimp/Importer.hpp>
 #include <cmath>
-#include <fstream>
 #include <string>
 
+#include "core/text.hpp"
 #include "mesh/ply.hpp"
 #include "mesh/weld.hpp"
 
@@ -100,13 +100,9 @@ Result<void> read_ply(const fs::path& path, const std::string& bytes, double sca
   return {};
 }
 
-/// The file's first bytes (enough to tell a PLY file), or all of them.
+/// The file's first bytes (enough to tell a PLY file), or all of them; none when unreadable.
 std::string read_bytes(const fs::path& path, std::size_t limit) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes(limit, '\0');
-  in.read(bytes.data(), static_cast<std::streamsize>(limit));
-  bytes.resize(static_cast<std::size_t>(in.gcount()));
-  return bytes;
+  return read_file_bytes(path, limit).value_or(std::string{});
 }
 }  // namespace
 

@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "core/text.hpp"
 #include "core/units.hpp"
+#include "support/test_support.hpp"
 
 namespace clumpforge {
 
@@ -31,6 +34,22 @@ TEST(Text, EditDistanceAndSuggestion) {
   EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);
   EXPECT_EQ(did_you_mean("adaptiv", {"lattice", "adaptive"}), " (did you mean 'adaptive'?)");
   EXPECT_EQ(did_you_mean("zzzzzz", {"lattice", "adaptive"}), "");
+}
+
+TEST(Text, ReadFileBytesReadsWholeOrUpToALimitAndRefusesWhatIsNotAFile) {
+  test::ScratchDir dir("read-file-bytes");
+  // 200 000 bytes, every value, so more than one 64 KiB chunk and no text-mode translation.
+  std::string bytes(200000, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<char>(i * 7 % 256);
+  std::ofstream(dir / "data.bin", std::ios::binary) << bytes;
+  EXPECT_EQ(read_file_bytes(dir / "data.bin"), bytes);
+  EXPECT_EQ(read_file_bytes(dir / "data.bin", 8), bytes.substr(0, 8));
+  EXPECT_EQ(read_file_bytes(dir / "data.bin", 70000), bytes.substr(0, 70000));
+  EXPECT_EQ(read_file_bytes(dir / "data.bin", 0), std::string{});
+  std::ofstream(dir / "empty.txt");
+  EXPECT_EQ(read_file_bytes(dir / "empty.txt"), std::string{});
+  EXPECT_EQ(read_file_bytes(dir / "missing.txt"), std::nullopt);
+  EXPECT_EQ(read_file_bytes(dir.path()), std::nullopt);  // a folder is not a file
 }
 
 }  // namespace clumpforge
