@@ -265,6 +265,11 @@ Result<void> set_horizons(Context& c, const Model& model, double perturbation);
 /// set to the materials table's value and listed in Context::unpinned) or Keep (the windows are
 /// set: those listed are left as they are and not searched, and the list is not changed).
 enum class Pinning { Decide, Keep };
+/// The grid cells beside a plateau the lowest of a grid's chi^2 values lies on (three or more
+/// neighbouring points within 1 % of it), where fit_baseline refines too: a valley narrower than
+/// a cell can hide there. None when the lowest is not on such a plateau.
+std::vector<std::pair<double, double>> plateau_edges(const std::vector<double>& values,
+                                                     const std::vector<double>& chi2s);
 Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vector<std::size_t>& trials,
                            Pinning pinning = Pinning::Decide);
 Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::vector<FitParameter>& parameters,

@@ -1312,3 +1312,26 @@ TEST(EnsembleReplayMemo, AReplayAskedForAgainIsReadBackTheSameAndNoOtherIs) {
   EXPECT_EQ(memo.reused(), 2 * run_first);
   EXPECT_NE((*finer)[0].ensemble_value, (*first)[0].ensemble_value);
 }
+
+TEST(BaselineGrid, APlateauBesideTheLowestIsRefinedAtItsEdges) {
+  using diagnosis::plateau_edges;
+  // A tilt's chi^2 over mu_s: falling steeply to a valley narrower than a cell, then flat where
+  // the replays never slip within the track. The lowest grid value (1.3, by 0.1) lies on the
+  // plateau: its lower edge's cell holds the valley.
+  const std::vector<double> mu{0.723, 0.819, 0.915, 1.012, 1.108, 1.204, 1.300};
+  const std::vector<double> chi2{2.7e8, 7.1e5, 34728.0, 34728.5, 34728.3, 34728.1, 34727.9};
+  const auto edges = plateau_edges(mu, chi2);
+  ASSERT_EQ(edges.size(), 1u);
+  EXPECT_DOUBLE_EQ(edges[0].first, 0.819);
+  EXPECT_DOUBLE_EQ(edges[0].second, 0.915);
+  // A plateau inside the range: both edges.
+  const auto both = plateau_edges({1, 2, 3, 4, 5, 6}, {90, 50, 50.2, 50.1, 50.3, 80});
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_DOUBLE_EQ(both[0].first, 1.0);
+  EXPECT_DOUBLE_EQ(both[1].second, 6.0);
+  // Two points within 1 % are no plateau, nor is a single lowest point, nor are values beyond
+  // 1 % of it.
+  EXPECT_TRUE(plateau_edges({1, 2, 3, 4, 5}, {90, 50.3, 50, 52, 80}).empty());
+  EXPECT_TRUE(plateau_edges({1, 2, 3, 4, 5}, {90, 60, 50, 60, 80}).empty());
+  EXPECT_TRUE(plateau_edges({1, 2, 3, 4, 5}, {90, 52, 51, 50, 53}).empty());
+}
