@@ -17,14 +17,10 @@ here="$(cd "$(dirname "$0")/.." && pwd)"
 scan=$1
 out=$2
 shift 2
-build="$here/build"
-if [ $# -ge 1 ] && [ "$1" != "--" ]; then build=$1; shift; fi
-[ "${1:-}" = "--" ] && shift
-cli="$build/tools/clumpforge"
-bench="$build/bench/bench_diagnose"
+script=bench_diagnose_other_particle
+source "$here/bench/bench_tools.sh"
 mesh="$here/meshes/$scan.stl"
 library="$here/clumps/$scan.h5"
-for f in "$cli" "$bench"; do [ -x "$f" ] || { echo "bench_diagnose_other_particle: no $f (build first)" >&2; exit 1; }; done
 for f in "$mesh" "$library"; do [ -f "$f" ] || { echo "bench_diagnose_other_particle: no $f" >&2; exit 1; }; done
 # The generator's body: the library's adaptive clump with the most spheres.
 generator=$(h5ls "$library/clumps" | awk '$1 ~ /^adaptive-/ { n = substr($1, 10) + 0; if (n > best) { best = n; name = $1 } } END { print name }')

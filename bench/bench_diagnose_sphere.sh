@@ -18,13 +18,9 @@ here="$(cd "$(dirname "$0")/.." && pwd)"
 [ $# -ge 1 ] || { echo "usage: bench_diagnose_sphere.sh OUT [BUILD_DIR] [-- options]" >&2; exit 2; }
 out=$1
 shift
-build="$here/build"
-if [ $# -ge 1 ] && [ "$1" != "--" ]; then build=$1; shift; fi
-[ "${1:-}" = "--" ] && shift
-cli="$build/tools/clumpforge"
-bench="$build/bench/bench_diagnose"
+script=bench_diagnose_sphere
+source "$here/bench/bench_tools.sh"
 mesh="${SPHERE_MESH:-$here/../shared/data/lab-like/meshes/sphere.stl}"
-for f in "$cli" "$bench"; do [ -x "$f" ] || { echo "bench_diagnose_sphere: no $f (build first)" >&2; exit 1; }; done
 [ -f "$mesh" ] || { echo "bench_diagnose_sphere: no $mesh" >&2; exit 1; }
 mkdir -p "$out"
 work=$(mktemp -d)
