@@ -227,6 +227,14 @@ bool stderr_is_terminal() {
   return ::isatty(STDERR_FILENO) == 1;
 }
 
+std::string report_json_text(const nlohmann::json& report) {
+  return report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+void print_report_text(std::string_view text) {
+  fmt::print("{}", printable_text(text));
+}
+
 void print_progress(std::string_view stage, double fraction) {
   fmt::print(stderr, "\r  [{:>3.0f} %] {:<40}", 100.0 * fraction, stage);
   if (fraction >= 1.0) fmt::print(stderr, "\n");

@@ -84,6 +84,13 @@ std::string density_source(bool given);
 /// Progress on stderr after the first second, when stderr is a terminal and not --json.
 RunContext progress_context(bool json);
 
+/// A text report on stdout, through printable_text: the names it quotes (clumps, recordings,
+/// trials) are the user's free text and can hold control characters.
+void print_report_text(std::string_view text);
+/// A JSON report's text (indented by two): a path that is not UTF-8 (a folder's name on Linux)
+/// is written with U+FFFD for its bad bytes, where nlohmann's dump would throw.
+std::string report_json_text(const nlohmann::json& report);
+
 /// Progress on stderr while a long step runs, only when stderr is a terminal.
 void print_progress(std::string_view stage, double fraction);
 bool stderr_is_terminal();

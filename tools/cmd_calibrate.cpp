@@ -202,18 +202,17 @@ int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<R
     fs::create_directories(args.out, ec);
     auto files = materials_out(args, clump, table, calibrated);
     if (!files) return report_error(kCommand, files.error());
-    files->emplace_back(fs::path(args.out) / "calibration.json", report.dump(2) + "\n");
+    files->emplace_back(fs::path(args.out) / "calibration.json", report_json_text(report) + "\n");
     files->emplace_back(fs::path(args.out) / "calibration.md", "# Joint calibration (" + clump.name + ")\n\n" + text);
     if (auto ok = write_files_atomically(*files); !ok) return report_error(kCommand, ok.error());
     draw_figures(kCommand, "calibration", args.out);
   }
   if (args.json)
-    std::cout << report.dump(2) << "\n";
+    std::cout << report_json_text(report) << "\n";
   else
-    // The clump's and the recordings' names are free text: shown escaped (printable_text).
-    fmt::print("{}", printable_text(fmt::format(
-                         "joint calibration of clump '{}' ({} orientations per drop and roll evaluation)\n\n{}",
-                         clump.name, options.trials, text)));
+    print_report_text(
+        fmt::format("joint calibration of clump '{}' ({} orientations per drop and roll evaluation)\n\n{}", clump.name,
+                    options.trials, text));
   return kExitOk;
 }
 
@@ -287,19 +286,19 @@ int run_calibrate(const CalibrateArgs& args) {
     std::vector<std::pair<fs::path, std::string>> files = std::move(*materials);
     files.insert(
         files.end(),
-        {{fs::path(args.out) / "calibration.json", report.dump(2) + "\n"},
+        {{fs::path(args.out) / "calibration.json", report_json_text(report) + "\n"},
          {fs::path(args.out) / "calibration.md",
           fmt::format("# Calibration by the study's method ({})\n\n{}\n", clump->name, markdown(*calibration))}});
     if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
     draw_figures(kCommand, "calibration", args.out);
   }
   if (args.json) {
-    std::cout << report.dump(2) << "\n";
+    std::cout << report_json_text(report) << "\n";
   } else {
     std::string shown = fmt::format("calibration of clump '{}' by the study's method ({} trials per level)\n\n{}\n",
                                     clump->name, args.trials_per_level, markdown(*calibration));
     for (const auto& note : calibration->notes) shown += fmt::format("note: {}\n", note);
-    fmt::print("{}", printable_text(shown));  // names are free text: shown escaped
+    print_report_text(shown);
     if (!args.out.empty()) fmt::print("report, sweeps and plots written to {}/\n", args.out);
   }
   return kExitOk;

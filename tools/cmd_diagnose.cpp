@@ -36,7 +36,7 @@ struct DiagnoseArgs {
 };
 
 /// The text report. Trial ids, track names and folder names are the recording's free text and can
-/// hold control characters: the caller writes the whole through printable_text.
+/// hold control characters: the caller writes the whole through print_report_text.
 void write_text(std::ostream& out, const DiagnoseResult& r) {
   if (r.summaries_only) {
     out << fmt::format(
@@ -154,17 +154,17 @@ int run_diagnose(const DiagnoseArgs& args) {
     if (ec || !fs::is_directory(args.out))
       return report_error(kCommand, {ErrorCode::IoError, fmt::format("cannot create '{}'", args.out)});
     const std::vector<std::pair<fs::path, std::string>> files{
-        {fs::path(args.out) / "report.json", report.dump(2) + "\n"},
+        {fs::path(args.out) / "report.json", report_json_text(report) + "\n"},
         {fs::path(args.out) / "tracks.json", diagnosis_tracks_json(*result)}};
     if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
     draw_figures(kCommand, "diagnosis", args.out);
   }
   if (args.json)
-    std::cout << report.dump(2) << "\n";
+    std::cout << report_json_text(report) << "\n";
   else {
     std::ostringstream text;
     write_text(text, *result);
-    std::cout << printable_text(text.str());
+    print_report_text(text.str());
   }
   return kExitOk;
 }

@@ -92,7 +92,7 @@ void print_files(const std::string& what, const std::vector<fs::path>& files, bo
   if (json) {
     report["files"] = nlohmann::json::array();
     for (const auto& f : files) report["files"].push_back(f.string());
-    std::cout << report.dump(2) << "\n";
+    std::cout << report_json_text(report) << "\n";
     return;
   }
   fmt::print("{}:\n", what);

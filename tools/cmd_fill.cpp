@@ -126,7 +126,7 @@ int run_fill(const FillArgs& args) {
   if (auto ok = write_clump_library(args.output, clumps); !ok) return report_error(kCommand, ok.error());
   if (report["clumps"].size() == 1) report.update(report["clumps"][0]);
   if (args.json) {
-    std::cout << report.dump(2) << "\n";
+    std::cout << report_json_text(report) << "\n";
   } else {
     fmt::print("fill {} -> {} (signed distance voxel {:.3g} mm; density {:g} kg/m^3, {})\n", args.input, args.output,
                body->sdf.voxel_size() * 1e3, args.density, density_source(args.density_given));

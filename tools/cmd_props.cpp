@@ -54,7 +54,7 @@ int run_props(const PropsArgs& args) {
     nlohmann::json report = to_json(props);
     report["input"] = args.input;
     report["units"] = args.units;
-    std::cout << report.dump(2) << "\n";
+    std::cout << report_json_text(report) << "\n";
   } else {
     print_human(args, props);
   }

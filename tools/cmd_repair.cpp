@@ -86,7 +86,7 @@ int run_repair(const RepairArgs& args) {
     }
     report["warnings"] = nlohmann::json::array();
     for (const auto& note : loaded->notes) report["warnings"].push_back(note.message);
-    std::cout << report.dump(2) << "\n";
+    std::cout << report_json_text(report) << "\n";
   } else {
     print_human(args, *loaded, before, after, *repaired);
   }

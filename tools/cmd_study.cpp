@@ -316,12 +316,12 @@ int run_study(const StudyArgs& args) {
     report["rows"].push_back(row);
   }
   if (dem) report["dem"] = dem_json(*rows, *dem, **dem_options, dem_summary);
-  files.emplace_back(dir / "study.json", report.dump(2) + "\n");
+  files.emplace_back(dir / "study.json", report_json_text(report) + "\n");
   if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
   const bool drawn = draw_figures(kCommand, "study", args.output);
 
   if (args.json) {
-    std::cout << report.dump(2) << "\n";
+    std::cout << report_json_text(report) << "\n";
   } else {
     fmt::print("resolution study of {} -> {}/ (density {:g} kg/m^3, {}; {})\n\n{}\n{}.\n{}", args.input, args.output,
                args.density, density_source(args.density_given), team->describe(), markdown_table(*rows), summary,

@@ -144,7 +144,7 @@ int run_validate(const ValidateArgs& args) {
       report["trials"].push_back(entry);
     }
     if (!args.out.empty()) report["recording"] = args.out;
-    std::cout << report.dump(2) << "\n";
+    std::cout << report_json_text(report) << "\n";
   } else {
     fmt::print("{} test of clump '{}' on {} ({} trials, seed {}): e {} mu_s {} mu_r {} ({}), time step {:.3g} s\n",
                args.test, clump->name, args.surface, args.trials, args.seed, result->interaction.restitution,

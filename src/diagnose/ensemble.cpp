@@ -96,6 +96,18 @@ std::vector<Outcome> outcomes_of(const Recording& rec) {
 
 /// The first time a sequence of (time, value) pairs reaches `level`, interpolated between the
 /// frames on either side; NaN when it never does.
+/// The running median of five values (fewer at the two ends), against the camera's noise: the
+/// tilt's slide and the drop's lowest level read it.
+std::vector<double> running_median_of_five(const std::vector<double>& values) {
+  std::vector<double> out(values.size());
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    const std::size_t a = k >= 2 ? k - 2 : 0, b = std::min(values.size(), k + 3);
+    out[k] = median(std::vector<double>(values.begin() + static_cast<std::ptrdiff_t>(a),
+                                        values.begin() + static_cast<std::ptrdiff_t>(b)));
+  }
+  return out;
+}
+
 double first_reaching(const std::vector<std::pair<double, double>>& series, double level) {
   for (std::size_t k = 1; k < series.size(); ++k) {
     const auto [t1, v1] = series[k];
@@ -122,13 +134,9 @@ std::vector<std::pair<Outcome, double>> tilt_outcomes(const PathSample& path, co
     along.push_back(path.x[i] * std::cos(angle) - path.z[i] * std::sin(angle));
   }
   const double rest = median(std::vector<double>(along.begin(), along.begin() + 10));
+  const std::vector<double> smoothed = running_median_of_five(along);
   std::vector<std::pair<double, double>> series;
-  for (std::size_t k = 0; k < along.size(); ++k) {
-    const std::size_t a = k >= 2 ? k - 2 : 0, b = std::min(along.size(), k + 3);
-    series.emplace_back(path.t[valid[k]], median(std::vector<double>(along.begin() + static_cast<std::ptrdiff_t>(a),
-                                                                     along.begin() + static_cast<std::ptrdiff_t>(b))) -
-                                              rest);
-  }
+  for (std::size_t k = 0; k < along.size(); ++k) series.emplace_back(path.t[valid[k]], smoothed[k] - rest);
   const double onset = std::max(1e-3, 0.5 * moved);
   const double started = first_reaching(series, onset);
   const double slid = first_reaching(series, onset + 3e-3);
@@ -189,14 +197,11 @@ double x_after_impact(const PathSample& path, const std::vector<std::size_t>& va
 /// not (the median of five keeps the camera's noise from pulling it down by more than about one
 /// standard deviation).
 double lowest_after(const PathSample& path, const std::vector<std::size_t>& valid, std::size_t from) {
-  double lowest = std::numeric_limits<double>::infinity();
-  for (std::size_t k = from; k < valid.size(); ++k) {
-    const std::size_t a = k >= from + 2 ? k - 2 : from, b = std::min(valid.size(), k + 3);
-    std::vector<double> window;
-    for (std::size_t j = a; j < b; ++j) window.push_back(path.z[valid[j]]);
-    lowest = std::min(lowest, median(window));
-  }
-  return lowest;
+  std::vector<double> z;
+  for (std::size_t k = from; k < valid.size(); ++k) z.push_back(path.z[valid[k]]);
+  const std::vector<double> smoothed = running_median_of_five(z);
+  return smoothed.empty() ? std::numeric_limits<double>::infinity()
+                          : *std::min_element(smoothed.begin(), smoothed.end());
 }
 
 }  // namespace
@@ -219,13 +224,16 @@ std::vector<std::pair<Outcome, double>> measure_outcomes(LabTest test, const Pat
     xs.push_back(path.x[valid[k]]);
     zs.push_back(path.z[valid[k]]);
   }
-  const double x_rest = median(xs), z_rest = median(zs);
-  // Time to rest: the last frame farther than `moved` from the rest point.
-  double rest_time = 0.0;
-  for (std::size_t i : valid) {
-    if (std::hypot(path.x[i] - x_rest, path.z[i] - z_rest) > moved) rest_time = path.t[i];
+  const double x_rest = median(xs);
+  if (test == LabTest::Roll) {
+    // Time to rest: the last frame farther than `moved` from the rest point.
+    const double z_rest = median(zs);
+    double rest_time = 0.0;
+    for (std::size_t i : valid) {
+      if (std::hypot(path.x[i] - x_rest, path.z[i] - z_rest) > moved) rest_time = path.t[i];
+    }
+    return {{Outcome::RollDistance, x_rest}, {Outcome::RollTime, rest_time}};
   }
-  if (test == LabTest::Roll) return {{Outcome::RollDistance, x_rest}, {Outcome::RollTime, rest_time}};
   // The first impact; the rebound height is the highest point after it, above the lowest level
   // the body reaches after it (lowest_after): not above its last frames, which are at another
   // phase of a bounce in each track that ends before the body settles.

@@ -100,10 +100,6 @@ Result<void> read_ply(const fs::path& path, const std::string& bytes, double sca
   return {};
 }
 
-/// The file's first bytes (enough to tell a PLY file), or all of them; none when unreadable.
-std::string read_bytes(const fs::path& path, std::size_t limit) {
-  return read_file_bytes(path, limit).value_or(std::string{});
-}
 }  // namespace
 
 std::vector<Diagnostic> check_plausible_size(const TriangleSoup& soup, LengthUnit unit) {
@@ -125,10 +121,8 @@ Result<LoadResult> load_mesh(const fs::path& path, const LoadOptions& options) {
   }
   LoadResult result;
   const double scale = metres_per(options.unit);
-  std::error_code ec;
-  const auto size = fs::file_size(path, ec);
-  if (looks_like_ply(read_bytes(path, 8))) {
-    if (auto ok = read_ply(path, read_bytes(path, ec ? 0 : size), scale, result); !ok)
+  if (looks_like_ply(read_file_bytes(path, 8).value_or(std::string{}))) {
+    if (auto ok = read_ply(path, read_file_bytes(path).value_or(std::string{}), scale, result); !ok)
       return std::unexpected(ok.error());
   } else if (auto ok = read_with_assimp(path, scale, result); !ok) {
     return std::unexpected(ok.error());

@@ -131,6 +131,13 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("trial \\x1B[2J01 (2 usable frames)"), std::string::npos) << run.out;
   EXPECT_EQ(run.out.find('\x1b'), std::string::npos);
+  // A folder whose name is not UTF-8 (a Linux file name can hold any byte): the JSON report is
+  // written with U+FFFD for the bad byte; it was "internal error" (nlohmann's dump threw).
+  const auto odd = dir / "r\xffx";
+  std::filesystem::copy(dir / "rec", odd);
+  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --json", odd.string(), clump()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(nlohmann::json::parse(run.out).dump().find("r\xef\xbf\xbdx"), std::string::npos) << run.out;
 }
 
 // Hostile recordings (issue 12, item 5) through the command: a clean message naming the
