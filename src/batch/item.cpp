@@ -46,6 +46,11 @@ Result<std::vector<ScanItem>> list_scans(std::span<const fs::path> inputs) {
   std::map<std::string, ScanItem> by_name;
   for (const auto& file : files) {
     const std::string name = file.stem().string();
+    if (!is_valid_utf8(name))
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("'{}': the scan's file name is not UTF-8 text; it names the results in JSON and CSV "
+                              "records, so rename the file",
+                              file.string()));
     if (by_name.contains(name))
       return fail(ErrorCode::InvalidArgument, fmt::format("two scans are named '{}' ('{}' and '{}'): names must be "
                                                           "unique, they name the results",

@@ -53,6 +53,15 @@ std::size_t utf8_sequence(std::string_view text) {
 
 }  // namespace
 
+bool is_valid_utf8(std::string_view text) {
+  for (std::size_t i = 0; i < text.size();) {
+    const std::size_t n = utf8_sequence(text.substr(i));
+    if (n == 0) return false;
+    i += n;
+  }
+  return true;
+}
+
 std::string printable_text(std::string_view text) {
   std::string out;
   out.reserve(text.size());

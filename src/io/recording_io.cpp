@@ -426,7 +426,27 @@ Result<Recording> read_recording(const fs::path& path) {
   }
 }
 
+namespace {
+/// The names a manifest holds must be UTF-8 text (JSON cannot hold other bytes); a recording
+/// made in code may carry any bytes, one read from a file cannot.
+Result<void> names_are_text(const fs::path& dir, const Recording& r) {
+  std::vector<std::pair<std::string_view, std::string_view>> names{{"surface", r.surface}};
+  if (r.particle_mesh) names.emplace_back("particle mesh", *r.particle_mesh);
+  for (const auto& trial : r.trials) {
+    names.emplace_back("trial id", trial.id);
+    names.emplace_back("track file", trial.track_file);
+  }
+  for (const auto& [what, name] : names)
+    if (!is_valid_utf8(name))
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("'{}': the {} '{}' is not UTF-8 text, which a recording's JSON manifest cannot hold",
+                              dir.string(), what, name));
+  return {};
+}
+}  // namespace
+
 Result<void> write_recording(const fs::path& dir, const Recording& r) {
+  if (auto ok = names_are_text(dir, r); !ok) return ok;
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir, ec)) return fail(ErrorCode::IoError, fmt::format("cannot create '{}'", dir.string()));

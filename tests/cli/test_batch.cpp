@@ -109,6 +109,15 @@ TEST_F(BatchCli, AbsurdOptionsAreRefusedWritingNothing) {
   EXPECT_EQ(twice.exit_code, 1);
   EXPECT_NE(twice.err.find("two scans are named 'tuber-01'"), std::string::npos) << twice.err;
   EXPECT_FALSE(fs::exists(dir_ / "x"));
+  // A scan whose file name is not UTF-8 (a Linux name may hold any byte): its name would go into
+  // the JSON records, so it is refused before any work, not after its fills ('internal error').
+  fs::create_directories(dir_ / "bytes");
+  fs::copy_file(scans() / "tuber-01.stl", dir_ / "bytes" / "tub\xFFr.stl");
+  const auto bytes =
+      test::run_clumpforge(fmt::format("batch '{}' -o '{}'", (dir_ / "bytes").string(), (dir_ / "x").string()));
+  EXPECT_EQ(bytes.exit_code, 1) << bytes.err;
+  EXPECT_NE(bytes.err.find("tub\\xFFr.stl': the scan's file name is not UTF-8 text"), std::string::npos) << bytes.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x"));
 }
 
 }  // namespace

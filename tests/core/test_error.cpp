@@ -23,6 +23,15 @@ TEST(PrintableText, KeepsUtf8AndWritesOutEverythingElse) {
   EXPECT_EQ(printable_text("\xF4\x90\x80\x80"), "\\xF4\\x90\\x80\\x80");  // beyond U+10FFFF
 }
 
+TEST(PrintableText, IsValidUtf8AcceptsTextAndRefusesOtherBytes) {
+  EXPECT_TRUE(is_valid_utf8(""));
+  EXPECT_TRUE(is_valid_utf8("tuber-01"));
+  EXPECT_TRUE(is_valid_utf8("\xC2\xB5m \xE2\x88\x86 \xF0\x9F\x98\x80"));
+  EXPECT_TRUE(is_valid_utf8("a\x1B[2Jb"));  // a control character is text; printing it is another matter
+  for (const std::string bad : {"tub\xFFr", "\x80", "\xE2\x88", "\xC0\xAF", "\xED\xA0\x80", "\xF4\x90\x80\x80"})
+    EXPECT_FALSE(is_valid_utf8(bad)) << printable_text(bad);
+}
+
 TEST(PrintableText, FailMakesEveryMessagePrintable) {
   const Result<int> r = fail(ErrorCode::ParseError, "t.csv:3: '\xFF' is not a number");
   ASSERT_FALSE(r);

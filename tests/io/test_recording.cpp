@@ -64,6 +64,26 @@ TEST(Recording, RoundTripKeepsTracksAndExtraKeys) {
   EXPECT_NE(manifest.find("\"orientation\""), std::string::npos);
 }
 
+TEST(Recording, ANameThatIsNotUtf8IsRefusedWritingNothing) {
+  test::ScratchDir dir("rec-utf8");
+  Recording r;
+  r.test = LabTest::Drop;
+  r.surface = "Q235";
+  r.release_height = 0.2;
+  r.trials.push_back(Trial{.id = "0\xFF", .summary = 0.01});
+  const auto written = write_recording(dir / "out", r);
+  ASSERT_FALSE(written);
+  EXPECT_EQ(written.error().code, ErrorCode::InvalidArgument);
+  EXPECT_NE(written.error().message.find("the trial id '0\\xFF' is not UTF-8 text"), std::string::npos)
+      << written.error().message;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  r.trials[0].id = "01";
+  r.surface = "so\xC0il";
+  EXPECT_FALSE(write_recording(dir / "out", r));
+  r.surface = "soil";
+  ASSERT_TRUE(write_recording(dir / "out", r));
+}
+
 TEST(Recording, ASpreadsheetsByteOrderMarkAndLineEndsAreRead) {
   // "CSV UTF-8" from a spreadsheet opens with a byte-order mark and ends lines with CRLF; the
   // header is still t_s, x_m, z_m (before the commit after a46805e: "unknown column 't_s'").

@@ -33,6 +33,10 @@ using Result = std::expected<T, Error>;
 /// escape sequence would reach the user's terminal.
 std::string printable_text(std::string_view text);
 
+/// Whether `text` is valid UTF-8 throughout. A name that goes into a JSON record (a scan's file
+/// name, a trial's id) must be: a Linux file name may hold any byte, and JSON text cannot.
+bool is_valid_utf8(std::string_view text);
+
 /// Shorthand for returning a failure: `return fail(ErrorCode::NotFound, "...")`. The message is
 /// made printable (printable_text).
 inline std::unexpected<Error> fail(ErrorCode code, std::string_view message) {
