@@ -94,8 +94,6 @@ std::vector<Outcome> outcomes_of(const Recording& rec) {
   return {};
 }
 
-/// The first time a sequence of (time, value) pairs reaches `level`, interpolated between the
-/// frames on either side; NaN when it never does.
 /// The running median of five values (fewer at the two ends), against the camera's noise: the
 /// tilt's slide and the drop's lowest level read it.
 std::vector<double> running_median_of_five(const std::vector<double>& values) {
@@ -108,6 +106,8 @@ std::vector<double> running_median_of_five(const std::vector<double>& values) {
   return out;
 }
 
+/// The first time a sequence of (time, value) pairs reaches `level`, interpolated between the
+/// frames on either side; NaN when it never does.
 double first_reaching(const std::vector<std::pair<double, double>>& series, double level) {
   for (std::size_t k = 1; k < series.size(); ++k) {
     const auto [t1, v1] = series[k];

@@ -432,6 +432,7 @@ namespace {
 Result<void> names_are_text(const fs::path& dir, const Recording& r) {
   std::vector<std::pair<std::string_view, std::string_view>> names{{"surface", r.surface}};
   if (r.particle_mesh) names.emplace_back("particle mesh", *r.particle_mesh);
+  if (r.particle_mesh_units) names.emplace_back("particle mesh units", *r.particle_mesh_units);
   for (const auto& trial : r.trials) {
     names.emplace_back("trial id", trial.id);
     names.emplace_back("track file", trial.track_file);
@@ -443,13 +444,9 @@ Result<void> names_are_text(const fs::path& dir, const Recording& r) {
                               dir.string(), what, name));
   return {};
 }
-}  // namespace
 
-Result<void> write_recording(const fs::path& dir, const Recording& r) {
-  if (auto ok = names_are_text(dir, r); !ok) return ok;
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (!fs::is_directory(dir, ec)) return fail(ErrorCode::IoError, fmt::format("cannot create '{}'", dir.string()));
+/// The manifest and track files of `r` in `dir`, built before anything is written.
+std::vector<std::pair<fs::path, std::string>> recording_files(const fs::path& dir, const Recording& r) {
   json manifest = json::parse(r.extra_json);
   manifest["format"] = "recording/1";
   manifest["test"] = std::string(to_string(r.test));
@@ -496,6 +493,22 @@ Result<void> write_recording(const fs::path& dir, const Recording& r) {
     manifest["trials"].push_back(entry);
   }
   files.emplace_back(dir / "recording.json", manifest.dump(2) + "\n");
+  return files;
+}
+}  // namespace
+
+Result<void> write_recording(const fs::path& dir, const Recording& r) {
+  if (auto ok = names_are_text(dir, r); !ok) return ok;
+  std::vector<std::pair<fs::path, std::string>> files;
+  try {
+    files = recording_files(dir, r);
+  } catch (const json::exception& e) {  // extra keys made in code that are not a JSON object
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("'{}': the recording's extra keys: {}", dir.string(), e.what()));
+  }
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir, ec)) return fail(ErrorCode::IoError, fmt::format("cannot create '{}'", dir.string()));
   return write_files_atomically(files);
 }
 

@@ -113,10 +113,11 @@ TEST_F(BatchCli, AbsurdOptionsAreRefusedWritingNothing) {
   // the JSON records, so it is refused before any work, not after its fills ('internal error').
   fs::create_directories(dir_ / "bytes");
   fs::copy_file(scans() / "tuber-01.stl", dir_ / "bytes" / "tub\xFFr.stl");
-  const auto bytes =
+  const auto not_utf8 =
       test::run_clumpforge(fmt::format("batch '{}' -o '{}'", (dir_ / "bytes").string(), (dir_ / "x").string()));
-  EXPECT_EQ(bytes.exit_code, 1) << bytes.err;
-  EXPECT_NE(bytes.err.find("tub\\xFFr.stl': the scan's file name is not UTF-8 text"), std::string::npos) << bytes.err;
+  EXPECT_EQ(not_utf8.exit_code, 1) << not_utf8.err;
+  EXPECT_NE(not_utf8.err.find("tub\\xFFr.stl': the scan's file name is not UTF-8 text"), std::string::npos)
+      << not_utf8.err;
   EXPECT_FALSE(fs::exists(dir_ / "x"));
 }
 

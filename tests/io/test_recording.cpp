@@ -81,6 +81,12 @@ TEST(Recording, ANameThatIsNotUtf8IsRefusedWritingNothing) {
   r.surface = "so\xC0il";
   EXPECT_FALSE(write_recording(dir / "out", r));
   r.surface = "soil";
+  r.extra_json = "{not json";  // extra keys made in code: an error, not an exception
+  const auto extra = write_recording(dir / "out", r);
+  ASSERT_FALSE(extra);
+  EXPECT_EQ(extra.error().code, ErrorCode::InvalidArgument);
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  r.extra_json = "{}";
   ASSERT_TRUE(write_recording(dir / "out", r));
 }
 
