@@ -51,6 +51,21 @@ std::string effect_name(Effect effect) {
   return effect_spec(library, effect).name;
 }
 
+std::optional<Effect> rival_law(Effect effect) {
+  switch (effect) {
+    case Effect::ViscoelasticRestitution:
+      return Effect::ElasticPlasticRestitution;
+    case Effect::ElasticPlasticRestitution:
+      return Effect::ViscoelasticRestitution;
+    case Effect::ViscousRolling:
+      return Effect::EpsdRolling;
+    case Effect::EpsdRolling:
+      return Effect::ViscousRolling;
+    default:
+      return std::nullopt;
+  }
+}
+
 Result<Effect> parse_effect(std::string_view name) {
   std::vector<std::string> names;
   for (const auto& spec : effect_library()) {

@@ -2,6 +2,7 @@
 /// The diagnosis's library of candidate physics: each effect is a DEM term (or the centre of
 /// mass offset) with one or two parameters, their search and plausible ranges, the tests it
 /// shows in, and how it is switched on in a lab run. Fixed before any data is seen.
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -70,6 +71,11 @@ std::vector<double> effect_off(const EffectSpec& spec);
 /// The effect's name as verdicts write it, e.g. "air_drag".
 std::string effect_name(Effect effect);
 Result<Effect> parse_effect(std::string_view name);
+/// The other law of the same contact, when the library holds two: the viscoelastic and the
+/// elastic-plastic restitution (both make e fall with the impact speed), the viscous and the
+/// EPSD rolling resistance (both stop a roll). Outcomes that favour one law over none favour
+/// its rival too, so one is named only where its rival was judged on the same data.
+std::optional<Effect> rival_law(Effect effect);
 
 /// Switches `effect` on in `options` with parameter values `values` (one per parameter).
 void apply_effect(Effect effect, std::span<const double> values, LabOptions& options);

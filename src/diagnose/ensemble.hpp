@@ -288,6 +288,13 @@ struct EnsembleHypothesis {
   std::vector<OutcomeComparison> comparisons;           ///< its replays against the recordings
 };
 
+/// The laws held back from calibration (`held_back`: their surrogate promised too little) that
+/// are the rival law (rival_law) of a plausible hypothesis reaching `min_delta_bic` on its first
+/// draw, each once: compare_ensembles calibrates them too, so that no law is named while its rival,
+/// which the same outcomes favour, was never judged.
+std::vector<Effect> rivals_to_calibrate(const std::vector<EnsembleHypothesis>& hypotheses,
+                                        const std::vector<Effect>& held_back, double min_delta_bic);
+
 /// A rejection decides an effect absent only beyond this many times the next finer clump's
 /// move of the effect's response (chi^2 against chi^2), besides the delta-BIC margin, frame by
 /// frame and on the outcomes: the diagnosed clump's distance from the recorded body is larger
@@ -411,7 +418,24 @@ struct EnsembleResult {
   std::vector<Detectability> detectability;    ///< per candidate tried
   double trials = 0.0;                         ///< recorded trials per recording (mean)
   int replays = 0;                             ///< DEM replays run
+  int drop_heights = 0;  ///< the most distinct release heights of the drops compared on one surface
 };
+
+/// The most distinct release heights (1 mm apart or more) among the drops of `recordings` listed
+/// in `compared`, on any one surface.
+int drop_heights_on_one_surface(const std::vector<Recording>& recordings, const std::vector<std::size_t>& compared);
+
+/// Drops from this many heights on one surface tell the two restitution laws apart on the
+/// outcomes. From two, each law meets both heights' rebounds with the calibrated restitution, and
+/// the viscoelastic exponent sets the fall of e between the two impact speeds to any value: the
+/// elastic-plastic law's, or what the particle model gets wrong (EnsembleRival tests).
+constexpr int kHeightsToPartRestitutionLaws = 3;
+
+/// Whether outcomes from drops of `drop_heights` heights on one surface can tell `effect` from its
+/// rival law (rival_law): always for an effect without one and for the rolling laws (a viscous
+/// torque's stopping distance grows like the start speed, a constant one's like its square), for
+/// the restitution laws from kHeightsToPartRestitutionLaws heights.
+bool tells_rival_laws_apart(Effect effect, int drop_heights);
 
 /// The coefficient of `surface` a fit may move, with its range.
 struct FreeCoefficient {

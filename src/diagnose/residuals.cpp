@@ -356,9 +356,8 @@ std::string experiment_to_show(const std::string& effect) {
            "plate, its first 10 mm of sliding filmed; a kinetic coefficient below the static one makes it jump ahead "
            "at onset";
   // The set-up that tells a law from its rival also shows it against none.
-  if (effect == "viscoelastic_restitution" || effect == "elastic_plastic_restitution")
-    return experiment_for("viscoelastic_restitution", "elastic_plastic_restitution");
-  if (effect == "viscous_rolling" || effect == "epsd_rolling") return experiment_for("viscous_rolling", "epsd_rolling");
+  if (const auto e = parse_effect(effect))
+    if (const auto rival = rival_law(*e)) return experiment_for(effect, effect_name(*rival));
   return experiment_for(effect, effect);
 }
 

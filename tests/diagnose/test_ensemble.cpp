@@ -920,6 +920,7 @@ TEST(EnsembleConvergedLadder, CandidatesAreJudgedOnTheFinestClumpOnlyOnceItHasCo
     EnsembleResult finest;
     finest.outcomes = 20;
     finest.null_chi2 = 73.0;
+    finest.drop_heights = 3;  // the restitution laws told apart (RestitutionLawsAreToldApart...)
     EnsembleHypothesis h = viscoelastic(0.1, k.delta_bic);
     for (int o = 0; o < 20; ++o)
       h.comparisons.push_back({.statistic = o < 10 ? Statistic::Mean : Statistic::Spread, .z = 0.5});
@@ -1057,6 +1058,7 @@ TEST(EnsembleRival, ACandidateWithinTheMarginOnEitherDrawMakesTheVerdictAmbiguou
     EnsembleResult ens;
     ens.outcomes = 20;
     ens.null_chi2 = 91.3;
+    ens.drop_heights = 3;  // enough to tell the two laws apart (below: two)
     auto hypothesis = [](Effect effect, double first, double fresh, bool plausible) {
       EnsembleHypothesis h;
       h.effect = effect;
@@ -1085,6 +1087,129 @@ TEST(EnsembleRival, ACandidateWithinTheMarginOnEitherDrawMakesTheVerdictAmbiguou
       EXPECT_EQ(result.effect, Effect::ViscoelasticRestitution);
     }
   }
+}
+
+// A law that reaches the margin on its first draw has its rival law calibrated too when the
+// surrogate held that one back: the generated noisy:15 realistic elastic-plastic case at c1a630d
+// was named viscoelastic restitution (delta-BIC 11.9) with the truth never calibrated (its
+// surrogate promised 8.2). Only the two laws of one contact are rivals so; an implausible law, or
+// one short of the margin, calls for none, and a rival already tried or not held back is not
+// calibrated again.
+TEST(EnsembleRival, ALawReachingTheMarginHasItsHeldBackRivalLawCalibrated) {
+  auto hypothesis = [](Effect effect, double first, bool plausible) {
+    EnsembleHypothesis h;
+    h.effect = effect;
+    h.first_delta_bic = first;
+    h.plausible = plausible;
+    return h;
+  };
+  const std::vector<Effect> held{Effect::ElasticPlasticRestitution, Effect::EpsdRolling, Effect::Adhesion};
+  using V = std::vector<Effect>;
+  EXPECT_EQ(rivals_to_calibrate({hypothesis(Effect::ViscoelasticRestitution, 11.9, true)}, held, 10.0),
+            V{Effect::ElasticPlasticRestitution});
+  EXPECT_EQ(rivals_to_calibrate({hypothesis(Effect::ViscousRolling, 30.0, true),
+                                 hypothesis(Effect::ViscoelasticRestitution, 12.0, true)},
+                                held, 10.0),
+            (V{Effect::EpsdRolling, Effect::ElasticPlasticRestitution}));
+  EXPECT_EQ(rivals_to_calibrate({hypothesis(Effect::ViscoelasticRestitution, 9.9, true)}, held, 10.0), V{});
+  EXPECT_EQ(rivals_to_calibrate({hypothesis(Effect::ViscoelasticRestitution, 40.0, false)}, held, 10.0), V{});
+  EXPECT_EQ(rivals_to_calibrate({hypothesis(Effect::AirDrag, 40.0, true)}, held, 10.0), V{});
+  EXPECT_EQ(rivals_to_calibrate({hypothesis(Effect::ElasticPlasticRestitution, 40.0, true)}, held, 10.0),
+            V{});  // its rival, the viscoelastic law, is not held back: tried already, or not asked about
+  EXPECT_EQ(rivals_to_calibrate({hypothesis(Effect::ViscoelasticRestitution, 11.9, true),
+                                 hypothesis(Effect::ViscoelasticRestitution, 15.0, true)},
+                                held, 10.0),
+            V{Effect::ElasticPlasticRestitution});
+  for (const Effect e : {Effect::ViscoelasticRestitution, Effect::ElasticPlasticRestitution, Effect::ViscousRolling,
+                         Effect::EpsdRolling})
+    EXPECT_EQ(rival_law(*rival_law(e)), e);
+  EXPECT_FALSE(rival_law(Effect::StaticKineticFriction).has_value());
+}
+
+// From drops at two heights the two restitution laws are not told apart, however far apart their
+// delta-BICs: the viscoelastic exponent meets any fall of e between the two impact speeds. The
+// generated noisy:15 realistic elastic-plastic case (0.2 and 1 m) at c1a630d was named
+// viscoelastic at delta-BIC 11.9, the elastic-plastic law calibrated at 0.3; it is ambiguous
+// between them now, the experiment asking for more heights. A third height on one surface (not
+// two on each of two) decides, and other effects are named from any heights.
+TEST(EnsembleRival, RestitutionLawsAreToldApartOnlyFromDropsAtThreeHeights) {
+  auto drop = [](std::string surface, double height) {
+    Recording r;
+    r.test = LabTest::Drop;
+    r.surface = std::move(surface);
+    r.release_height = height;
+    return r;
+  };
+  Recording roll;
+  roll.test = LabTest::Roll;
+  roll.surface = "Q235";
+  const std::vector<Recording> four{drop("Q235", 0.2), drop("Q235", 1.0), roll, drop("Q235", 0.2005)};
+  EXPECT_EQ(drop_heights_on_one_surface(four, {0, 1, 2, 3}), 2);
+  EXPECT_EQ(drop_heights_on_one_surface(four, {0, 3}), 1);  // 0.5 mm apart: one height
+  const std::vector<Recording> two_each{drop("Q235", 0.2), drop("Q235", 0.5), drop("soil", 0.2), drop("soil", 1.0)};
+  EXPECT_EQ(drop_heights_on_one_surface(two_each, {0, 1, 2, 3}), 2);
+  const std::vector<Recording> nine{drop("Q235", 0.2), drop("Q235", 0.5), drop("Q235", 1.0), drop("soil", 0.2)};
+  EXPECT_EQ(drop_heights_on_one_surface(nine, {0, 1, 2, 3}), 3);
+  EXPECT_EQ(drop_heights_on_one_surface(nine, {0, 1, 3}), 2);  // only those compared count
+  EXPECT_TRUE(tells_rival_laws_apart(Effect::ViscoelasticRestitution, 3));
+  EXPECT_FALSE(tells_rival_laws_apart(Effect::ElasticPlasticRestitution, 2));
+  EXPECT_TRUE(tells_rival_laws_apart(Effect::ViscousRolling, 0));
+  EXPECT_TRUE(tells_rival_laws_apart(Effect::AirDrag, 1));
+
+  for (const int heights : {2, 3}) {
+    EnsembleResult ens;
+    ens.outcomes = 16;
+    ens.null_chi2 = 44.3;
+    ens.drop_heights = heights;
+    auto hypothesis = [](Effect effect, double first, double fresh) {
+      EnsembleHypothesis h;
+      h.effect = effect;
+      h.values = {0.6};
+      h.plausible = true;
+      h.first_delta_bic = first;
+      h.fresh_delta_bic = fresh;
+      for (int o = 0; o < 16; ++o)
+        h.comparisons.push_back({.statistic = o < 8 ? Statistic::Mean : Statistic::Spread, .z = 0.5});
+      return h;
+    };
+    ens.hypotheses.push_back(hypothesis(Effect::ViscoelasticRestitution, 11.9, 17.8));
+    ens.hypotheses.push_back(hypothesis(Effect::ElasticPlasticRestitution, 0.3, std::nan("")));
+    DiagnoseResult result;
+    result.ensemble = EnsembleReport{};
+    std::vector<std::string> notes;
+    const auto passing = diagnosis::passing_hypotheses(ens, 10.0, notes);
+    ASSERT_EQ(passing.size(), 1u);
+    diagnosis::name_beyond_horizon(result, ens, passing, 10.0);
+    if (heights == 2) {
+      EXPECT_EQ(result.verdict, Verdict::Ambiguous);
+      EXPECT_FALSE(result.effect.has_value());
+      EXPECT_EQ(result.candidates,
+                (std::vector<std::string>{"viscoelastic_restitution", "elastic_plastic_restitution"}));
+      EXPECT_FALSE(result.experiment.empty());
+    } else {
+      EXPECT_EQ(result.verdict, Verdict::Named);
+      EXPECT_EQ(result.effect, Effect::ViscoelasticRestitution);
+    }
+    EXPECT_EQ(result.basis, Basis::Ensemble);
+  }
+  // Air drag beside a restitution law's hypothesis is named from two heights.
+  EnsembleResult ens;
+  ens.outcomes = 16;
+  ens.null_chi2 = 44.3;
+  ens.drop_heights = 2;
+  EnsembleHypothesis drag;
+  drag.effect = Effect::AirDrag;
+  drag.values = {1.0};
+  drag.plausible = true;
+  drag.first_delta_bic = 30.0;
+  for (int o = 0; o < 16; ++o) drag.comparisons.push_back({.statistic = Statistic::Mean, .z = 0.5});
+  ens.hypotheses.push_back(drag);
+  DiagnoseResult result;
+  result.ensemble = EnsembleReport{};
+  std::vector<std::string> notes;
+  diagnosis::name_beyond_horizon(result, ens, diagnosis::passing_hypotheses(ens, 10.0, notes), 10.0);
+  EXPECT_EQ(result.verdict, Verdict::Named);
+  EXPECT_EQ(result.effect, Effect::AirDrag);
 }
 
 // The comparison beyond the horizon is made again with more replays where it decided within the
