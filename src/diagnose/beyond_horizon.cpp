@@ -135,9 +135,9 @@ void ambiguous_untold(DiagnoseResult& result, const EnsembleResult& ens, const E
   result.statement = fmt::format(
       "Frame by frame nothing is named, but the recorded outcomes differ from replays over the unknown release "
       "orientation, and {} explains them (delta-BIC {:.1f}; {} {}). These recordings drop the particle from {} "
-      "height{} on one surface at most, and the two restitution laws part only from {}: from fewer, each meets the "
-      "rebounds of every height with the restitution calibrated, and which one fits better rests on what the "
-      "particle model gets wrong. To separate them: {}.",
+      "height{} on one surface at most, and the two restitution laws part only from {}: from fewer, the "
+      "viscoelastic exponent sets the fall of e between the impact speeds to any value, the elastic-plastic law's "
+      "among them, and which law fits better rests on what the particle model gets wrong. To separate them: {}.",
       name, best.delta_bic(), other,
       tried == ens.hypotheses.end() ? std::string("was not calibrated")
                                     : fmt::format("has delta-BIC {:.1f}", tried->best_delta_bic()),

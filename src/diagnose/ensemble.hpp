@@ -426,9 +426,9 @@ struct EnsembleResult {
 int drop_heights_on_one_surface(const std::vector<Recording>& recordings, const std::vector<std::size_t>& compared);
 
 /// Drops from this many heights on one surface tell the two restitution laws apart on the
-/// outcomes. From two, each law meets both heights' rebounds with the calibrated restitution, and
-/// the viscoelastic exponent sets the fall of e between the two impact speeds to any value: the
-/// elastic-plastic law's, or what the particle model gets wrong (EnsembleRival tests).
+/// outcomes. From two, the viscoelastic exponent sets the fall of e between the two impact speeds
+/// to any value: the elastic-plastic law's, or what the particle model gets wrong (EnsembleRival
+/// tests).
 constexpr int kHeightsToPartRestitutionLaws = 3;
 
 /// Whether outcomes from drops of `drop_heights` heights on one surface can tell `effect` from its
