@@ -1039,6 +1039,23 @@ TEST(EnsembleConvergedLadder, ACandidateLetThroughButUnneededOnTheConvergedFines
   }
 }
 
+namespace {
+/// A candidate with one parameter that leaves `outcomes` recorded means and spreads (half each)
+/// at z 0.5, its delta-BIC `first` and `fresh` on its two draws.
+EnsembleHypothesis consistent_hypothesis(Effect effect, double first, double fresh, int outcomes,
+                                         bool plausible = true) {
+  EnsembleHypothesis h;
+  h.effect = effect;
+  h.values = {0.3};
+  h.plausible = plausible;
+  h.first_delta_bic = first;
+  h.fresh_delta_bic = fresh;
+  for (int o = 0; o < outcomes; ++o)
+    h.comparisons.push_back({.statistic = 2 * o < outcomes ? Statistic::Mean : Statistic::Spread, .z = 0.5});
+  return h;
+}
+}  // namespace
+
 // Two candidates that explain the outcomes about equally well are ambiguous even when one draw
 // of release orientations favoured one: the rival's better draw counts. The generated 8-trial
 // realistic elastic-plastic case: delta-BIC 14.6 and 15.3 on the first draw, 10.2 and 2.4 on
@@ -1059,20 +1076,9 @@ TEST(EnsembleRival, ACandidateWithinTheMarginOnEitherDrawMakesTheVerdictAmbiguou
     ens.outcomes = 20;
     ens.null_chi2 = 91.3;
     ens.drop_heights = 3;  // enough to tell the two laws apart (below: two)
-    auto hypothesis = [](Effect effect, double first, double fresh, bool plausible) {
-      EnsembleHypothesis h;
-      h.effect = effect;
-      h.values = {0.3};
-      h.plausible = plausible;
-      h.first_delta_bic = first;
-      h.fresh_delta_bic = fresh;
-      for (int o = 0; o < 20; ++o)
-        h.comparisons.push_back({.statistic = o < 10 ? Statistic::Mean : Statistic::Spread, .z = 0.5});
-      return h;
-    };
-    ens.hypotheses.push_back(hypothesis(Effect::ViscoelasticRestitution, 14.6, 10.2, true));
+    ens.hypotheses.push_back(consistent_hypothesis(Effect::ViscoelasticRestitution, 14.6, 10.2, 20));
     ens.hypotheses.push_back(
-        hypothesis(Effect::ElasticPlasticRestitution, k.rival_first, k.rival_fresh, k.rival_plausible));
+        consistent_hypothesis(Effect::ElasticPlasticRestitution, k.rival_first, k.rival_fresh, 20, k.rival_plausible));
     DiagnoseResult result;
     result.ensemble = EnsembleReport{};
     std::vector<std::string> notes;
@@ -1161,19 +1167,8 @@ TEST(EnsembleRival, RestitutionLawsAreToldApartOnlyFromDropsAtThreeHeights) {
     ens.outcomes = 16;
     ens.null_chi2 = 44.3;
     ens.drop_heights = heights;
-    auto hypothesis = [](Effect effect, double first, double fresh) {
-      EnsembleHypothesis h;
-      h.effect = effect;
-      h.values = {0.6};
-      h.plausible = true;
-      h.first_delta_bic = first;
-      h.fresh_delta_bic = fresh;
-      for (int o = 0; o < 16; ++o)
-        h.comparisons.push_back({.statistic = o < 8 ? Statistic::Mean : Statistic::Spread, .z = 0.5});
-      return h;
-    };
-    ens.hypotheses.push_back(hypothesis(Effect::ViscoelasticRestitution, 11.9, 17.8));
-    ens.hypotheses.push_back(hypothesis(Effect::ElasticPlasticRestitution, 0.3, std::nan("")));
+    ens.hypotheses.push_back(consistent_hypothesis(Effect::ViscoelasticRestitution, 11.9, 17.8, 16));
+    ens.hypotheses.push_back(consistent_hypothesis(Effect::ElasticPlasticRestitution, 0.3, std::nan(""), 16));
     DiagnoseResult result;
     result.ensemble = EnsembleReport{};
     std::vector<std::string> notes;
@@ -1197,13 +1192,7 @@ TEST(EnsembleRival, RestitutionLawsAreToldApartOnlyFromDropsAtThreeHeights) {
   ens.outcomes = 16;
   ens.null_chi2 = 44.3;
   ens.drop_heights = 2;
-  EnsembleHypothesis drag;
-  drag.effect = Effect::AirDrag;
-  drag.values = {1.0};
-  drag.plausible = true;
-  drag.first_delta_bic = 30.0;
-  for (int o = 0; o < 16; ++o) drag.comparisons.push_back({.statistic = Statistic::Mean, .z = 0.5});
-  ens.hypotheses.push_back(drag);
+  ens.hypotheses.push_back(consistent_hypothesis(Effect::AirDrag, 30.0, std::nan(""), 16));
   DiagnoseResult result;
   result.ensemble = EnsembleReport{};
   std::vector<std::string> notes;
