@@ -73,8 +73,8 @@ std::string effect_name(Effect effect);
 Result<Effect> parse_effect(std::string_view name);
 /// The other law of the same contact, when the library holds two: the viscoelastic and the
 /// elastic-plastic restitution (both make e fall with the impact speed), the viscous and the
-/// EPSD rolling resistance (both stop a roll). Outcomes that favour one law over none favour
-/// its rival too, so one is named only where its rival was judged on the same data.
+/// EPSD rolling resistance (both stop a roll). Outcomes that favour one law over none may
+/// favour its rival as well, so one is named only where its rival was judged on the same data.
 std::optional<Effect> rival_law(Effect effect);
 
 /// Switches `effect` on in `options` with parameter values `values` (one per parameter).

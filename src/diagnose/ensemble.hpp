@@ -291,7 +291,7 @@ struct EnsembleHypothesis {
 /// The laws held back from calibration (`held_back`: their surrogate promised too little) that
 /// are the rival law (rival_law) of a plausible hypothesis reaching `min_delta_bic` on its first
 /// draw, each once: compare_ensembles calibrates them too, so that no law is named while its rival,
-/// which the same outcomes favour, was never judged.
+/// which the same outcomes may favour as well, was never judged.
 std::vector<Effect> rivals_to_calibrate(const std::vector<EnsembleHypothesis>& hypotheses,
                                         const std::vector<Effect>& held_back, double min_delta_bic);
 
