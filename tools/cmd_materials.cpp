@@ -34,7 +34,9 @@ int run_materials(const MaterialsArgs& args) {
   }
   std::string text;
   if (args.format.empty()) {
-    text = materials_json(*table);
+    auto json = materials_json(*table);
+    if (!json) return report_error(kCommand, json.error());
+    text = std::move(*json);
   } else {
     auto format = parse_export_format(args.format);
     if (!format) return report_error(kCommand, format.error());

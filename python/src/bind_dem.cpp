@@ -64,7 +64,7 @@ void bind_materials(py::module_& m) {
             t.set_interaction(a, b, i);
           },
           py::arg("a"), py::arg("b"), py::arg("interaction"))
-      .def("to_json", &materials_json);
+      .def("to_json", [](const MaterialTable& t) { return unwrap(materials_json(t)); });
   m.def("default_materials", &default_material_table, "The study's materials and coefficients.");
   m.def(
       "read_materials", [](const std::filesystem::path& path) { return unwrap(read_materials(path)); }, py::arg("path"),

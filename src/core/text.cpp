@@ -4,6 +4,8 @@
 #include <fstream>
 #include <vector>
 
+#include "core/error.hpp"
+
 namespace clumpforge {
 
 std::string_view trim(std::string_view text) {
@@ -71,6 +73,19 @@ std::optional<std::string> read_file_bytes(const std::filesystem::path& path, st
   }
   if (in.bad()) return std::nullopt;
   return bytes;
+}
+
+std::string one_line_text(std::string_view text) {
+  std::string out;
+  for (char c : printable_text(text)) {
+    if (c == '\n')
+      out += "\\x0A";
+    else if (c == '\t')
+      out += "\\x09";
+    else
+      out += c;
+  }
+  return out;
 }
 
 }  // namespace clumpforge

@@ -18,6 +18,11 @@ std::size_t edit_distance(std::string_view a, std::string_view b);
 std::string did_you_mean(std::string_view input, std::initializer_list<std::string_view> candidates);
 std::string did_you_mean(std::string_view input, std::span<const std::string> candidates);
 
+/// `text` for one line of a comment in a script or a report: printable (printable_text), with
+/// a newline and a tab written as \x0A and \x09. A name or a path written into a script's
+/// comment would otherwise end the comment and start a command.
+std::string one_line_text(std::string_view text);
+
 /// The bytes of the file at `path`, at most `limit` of them; nullopt when it cannot be opened or
 /// read (a missing file, a folder, no permission). The one whole-file reader the parsers share.
 std::optional<std::string> read_file_bytes(const std::filesystem::path& path,

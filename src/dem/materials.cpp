@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace clumpforge {
 namespace {
 std::pair<std::string, std::string> key(std::string_view a, std::string_view b) {
@@ -30,15 +32,31 @@ void MaterialTable::set_interaction(const std::string& a, const std::string& b, 
   interactions[key(a, b)] = value;
 }
 
+Result<void> validate_material_name(std::string_view name, std::string_view where) {
+  constexpr std::size_t kLongest = 64;
+  const bool word = std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+  });
+  if (name.empty() || name.size() > kLongest || !word) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("{}: material name '{}' must be 1 to {} letters, digits or underscores (it is written "
+                            "as it is into the engines' scripts: a LIGGGHTS variable, a YADE label, an EDEM field)",
+                            where, name, kLongest));
+  }
+  return {};
+}
+
 Result<void> validate_interaction(const Interaction& i, std::string_view where) {
   if (!(i.restitution > 0.0 && i.restitution <= 1.0)) {
     return fail(ErrorCode::InvalidArgument, fmt::format("{}: restitution {} is outside (0, 1]", where, i.restitution));
   }
   if (!(i.static_friction >= 0.0) || i.static_friction > 10.0) {
-    return fail(ErrorCode::InvalidArgument, fmt::format("{}: static friction {} must be in [0, 10]", where, i.static_friction));
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("{}: static friction {} must be in [0, 10]", where, i.static_friction));
   }
   if (!(i.rolling_friction >= 0.0) || i.rolling_friction > 10.0) {
-    return fail(ErrorCode::InvalidArgument, fmt::format("{}: rolling friction {} must be in [0, 10]", where, i.rolling_friction));
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("{}: rolling friction {} must be in [0, 10]", where, i.rolling_friction));
   }
   return {};
 }

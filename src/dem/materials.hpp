@@ -39,6 +39,12 @@ struct MaterialTable {
 /// are in each material's `source` and in docs/dem.md.
 MaterialTable default_material_table();
 
+/// Checks a material's name: 1 to 64 letters, digits or underscores. A name is written as it is
+/// into the engines' scripts: a LIGGGHTS variable (`cf_type_<name>`, where a space ends the
+/// command's word and `#` and `$` mean a comment and a substitution), a quoted YADE label and an
+/// EDEM table's tab-separated field. `where` begins the message (the file and the entry).
+Result<void> validate_material_name(std::string_view name, std::string_view where);
+
 /// Checks ranges: E > 0, 0 <= nu < 0.5, density > 0, 0 < e <= 1, friction >= 0.
 Result<void> validate_interaction(const Interaction& interaction, std::string_view where);
 

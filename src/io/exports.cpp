@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -50,10 +51,25 @@ fs::path sibling(const fs::path& output, const std::string& suffix) {
 }
 
 std::string provenance(const Clump& c) {
-  return fmt::format(
+  return one_line_text(fmt::format(
       "clumpforge {} clump '{}' ({} method, {} spheres); source mesh sha256 {}; frame: principal axes, "
       "centre of mass at the origin; SI units",
-      kVersion, c.name, to_string(c.method), c.spheres.size(), c.source_sha256.empty() ? "unknown" : c.source_sha256);
+      kVersion, c.name, to_string(c.method), c.spheres.size(), c.source_sha256.empty() ? "unknown" : c.source_sha256));
+}
+
+// A Python literal of `text` (UTF-8): quotes and backslashes escaped, control characters as \xNN.
+std::string python_string(std::string_view text) {
+  std::string out = "'";
+  for (char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\\' || c == '\'')
+      out += fmt::format("\\{}", c);
+    else if (byte < 0x20 || byte == 0x7F)
+      out += fmt::format("\\x{:02X}", byte);
+    else
+      out += c;
+  }
+  return out + "'";
 }
 
 std::string liggghts_fix(const Clump& c, const std::string& sphere_file, const LiggghtsTemplate& ids) {
@@ -108,7 +124,7 @@ Result<Files> yade(const Clump& c, const fs::path& output) {
   std::string script = fmt::format(
       "# {}\n"
       "# Builds the clump in YADE with the body's centre of mass, principal axes, mass and inertia. In a YADE script:\n"
-      "#   exec(open('{}').read()); clump_id = add_clump(material=my_material, position=Vector3(0, 0, 0.1))\n"
+      "#   exec(open({}).read()); clump_id = add_clump(material=my_material, position=Vector3(0, 0, 0.1))\n"
       "# `position` is where the body's centre of mass goes; `orientation` (a Quaternion) turns the file's frame.\n"
       "# YADE places a clump at its members' volume centroid (overlaps counted twice) with axes along their\n"
       "# principal axes. The members are therefore clumped with the weighting radii below, whose volumes put\n"
@@ -119,7 +135,7 @@ Result<Files> yade(const Clump& c, const fs::path& output) {
       "from math import pi\n"
       "from yade import utils\n"
       "from yade.minieigenHP import Vector3, Matrix3, Quaternion\n"
-      "CF_SPHERES_FILE = os.path.join(os.path.dirname(os.path.abspath(globals().get('__file__', '{}'))), '{}')\n"
+      "CF_SPHERES_FILE = os.path.join(os.path.dirname(os.path.abspath(globals().get('__file__', {}))), {})\n"
       "CF_MASS = {}  # kg\n"
       "CF_INERTIA = Matrix3({}, {}, {},\n                     {}, {}, {},\n                     {}, {}, {})  # kg m^2, "
       "file frame, about the centre of mass\n"
@@ -131,7 +147,7 @@ Result<Files> yade(const Clump& c, const fs::path& output) {
       "    kw = {{}} if material is None else {{'material': material}}\n"
       "    path = spheres_file or CF_SPHERES_FILE\n"
       "    if not os.path.exists(path):\n"
-      "        path = os.path.join(os.getcwd(), '{}')\n"
+      "        path = os.path.join(os.getcwd(), {})\n"
       "    rows = [line.split() for line in open(path) if line.strip() and not line.startswith('#')]\n"
       "    if len(rows) != len(CF_WEIGHTING_RADII):\n"
       "        raise ValueError('%s has %d spheres, this script expects %d' % (path, len(rows), "
@@ -152,10 +168,11 @@ Result<Files> yade(const Clump& c, const fs::path& output) {
       "    state.mass = CF_MASS\n"
       "    state.inertia = Vector3(local[0, 0], local[1, 1], local[2, 2])\n"
       "    return clump_id\n",
-      provenance(c), sibling(output, ".py").filename().string(), sibling(output, ".py").filename().string(),
-      output.filename().string(), number(c.mass), number(I(0, 0)), number(I(0, 1)), number(I(0, 2)), number(I(1, 0)),
-      number(I(1, 1)), number(I(1, 2)), number(I(2, 0)), number(I(2, 1)), number(I(2, 2)), number(c.density), radii,
-      output.filename().string());
+      provenance(c), python_string(sibling(output, ".py").filename().string()),
+      python_string(sibling(output, ".py").filename().string()), python_string(output.filename().string()),
+      number(c.mass), number(I(0, 0)), number(I(0, 1)), number(I(0, 2)), number(I(1, 0)), number(I(1, 1)),
+      number(I(1, 2)), number(I(2, 0)), number(I(2, 1)), number(I(2, 2)), number(c.density), radii,
+      python_string(output.filename().string()));
   return Files{{output, text}, {sibling(output, ".py"), script}};
 }
 
@@ -306,12 +323,39 @@ Result<ExportResult> export_clump(const Clump& clump, ExportFormat format, const
   return export_clump(clump, ExportOptions{.format = format}, output);
 }
 
+namespace {
+// The primary file's name as the engine's script reads it back: LIGGGHTS takes the `spheres
+// file` argument up to the first blank, and reads `#` as a comment, `$` as a substitution and
+// quotes as the argument's bounds; YADE's script is UTF-8 Python source holding it as a literal.
+Result<void> check_name_in_script(ExportFormat format, const fs::path& output) {
+  const std::string name = output.filename().string();
+  if (format == ExportFormat::Liggghts) {
+    const bool readable = std::none_of(name.begin(), name.end(), [](char c) {
+      const auto byte = static_cast<unsigned char>(c);
+      return byte <= 0x20 || byte == 0x7F || c == '#' || c == '$' || c == '"' || c == '\'';
+    });
+    if (!readable) {
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("liggghts export: LIGGGHTS cannot read the file name '{}' in its script (it ends a "
+                              "word at a blank and reads #, $ and quotes as commands): give one without them",
+                              name));
+    }
+  }
+  if (format == ExportFormat::Yade && !is_valid_utf8(name)) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("yade export: the file name '{}' is not UTF-8 text, and YADE's script must name it", name));
+  }
+  return {};
+}
+}  // namespace
+
 namespace export_detail {
 Result<Files> format_files(const Clump& clump, const ExportOptions& options, const fs::path& output) {
   const ExportFormat format = options.format;
   if (clump.spheres.empty() || !(clump.mass > 0.0) || !(clump.density > 0.0)) {
     return fail(ErrorCode::InvalidArgument, fmt::format("clump '{}' has no spheres or no mass", clump.name));
   }
+  if (auto ok = check_name_in_script(format, output); !ok) return std::unexpected(ok.error());
   Files files;
   switch (format) {
     case ExportFormat::Liggghts:

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "core/rng.hpp"
+#include "core/text.hpp"
 #include "core/version.hpp"
 
 namespace clumpforge {
@@ -36,6 +37,7 @@ Result<Resolved> resolve(const MaterialTable& table, const MaterialsExportOption
   for (const auto& name : names) {
     auto m = table.find(name);
     if (!m) return std::unexpected(m.error());
+    if (auto ok = validate_material_name(name, "materials export"); !ok) return std::unexpected(ok.error());
     r.materials.push_back(*m);
   }
   const std::size_t n = names.size();
@@ -76,7 +78,7 @@ std::string liggghts(const Resolved& r, const MaterialsExportOptions& o) {
   const bool edem_lever =
       o.contact.rolling == RollingModel::ConstantTorque && o.contact.rolling_arm == RollingArm::ContactToCentre;
   const double lever = edem_lever && o.rolling_lever_ratio > 0.0 ? o.rolling_lever_ratio : 1.0;
-  std::string text = fmt::format("# clumpforge {} materials for LIGGGHTS: {}\n", kVersion, o.provenance);
+  std::string text = fmt::format("# clumpforge {} materials for LIGGGHTS: {}\n", kVersion, one_line_text(o.provenance));
   text += "# Atom types:";
   for (std::size_t i = 0; i < n; ++i)
     text += fmt::format(" {} {}{}", i + 1, r.materials[i]->name, i + 1 < n ? "," : "");
@@ -131,7 +133,7 @@ std::string liggghts(const Resolved& r, const MaterialsExportOptions& o) {
 
 std::string yade(const Resolved& r, const MaterialsExportOptions& o) {
   const std::size_t n = r.materials.size();
-  std::string text = fmt::format("# clumpforge {} materials for YADE: {}\n", kVersion, o.provenance);
+  std::string text = fmt::format("# clumpforge {} materials for YADE: {}\n", kVersion, one_line_text(o.provenance));
   text += conventions(o.contact, "#");
   text +=
       "# YADE: FrictMat per material; Ip2_FrictMat_FrictMat_MindlinPhys with the pairs' restitution as en and es and\n"
@@ -176,7 +178,7 @@ std::string yade(const Resolved& r, const MaterialsExportOptions& o) {
 }
 
 std::string edem(const Resolved& r, const MaterialsExportOptions& o) {
-  std::string text = fmt::format("clumpforge {} materials for EDEM: {}\n", kVersion, o.provenance);
+  std::string text = fmt::format("clumpforge {} materials for EDEM: {}\n", kVersion, one_line_text(o.provenance));
   text += conventions(o.contact, "");
   text +=
       "\nEDEM Creator > Bulk Material / Equipment Material (physics: Hertz-Mindlin (no slip), rolling friction:\n"

@@ -24,6 +24,8 @@ Result<MaterialTable> read_materials(const std::filesystem::path& path, Material
       Material material{m.at("name").get<std::string>(), m.at("youngs_modulus_pa").get<double>(),
                         m.at("poisson_ratio").get<double>(), m.at("density_kg_m3").get<double>(),
                         m.value("source", std::string("materials file"))};
+      if (auto ok = validate_material_name(material.name, fmt::format("'{}'", path.string())); !ok)
+        return std::unexpected(ok.error());
       if (!(material.youngs_modulus > 0.0) || !(material.poisson_ratio >= 0.0 && material.poisson_ratio < 0.5) ||
           !(material.density > 0.0)) {
         return fail(ErrorCode::InvalidArgument,
@@ -39,6 +41,13 @@ Result<MaterialTable> read_materials(const std::filesystem::path& path, Material
     }
     for (const auto& i : file.value("interactions", json::array())) {
       const std::string a = i.at("a").get<std::string>(), b = i.at("b").get<std::string>();
+      for (const auto& name : {a, b}) {
+        if (!table.find(name))
+          return fail(ErrorCode::InvalidArgument,
+                      fmt::format("'{}': interaction {} - {} names '{}', which is neither a built-in material nor "
+                                  "one of the file's",
+                                  path.string(), a, b, name));
+      }
       const Interaction interaction{i.at("restitution").get<double>(), i.at("static_friction").get<double>(),
                                     i.at("rolling_friction").get<double>()};
       if (auto ok = validate_interaction(interaction, fmt::format("'{}': pair {} - {}", path.string(), a, b)); !ok)
@@ -51,9 +60,13 @@ Result<MaterialTable> read_materials(const std::filesystem::path& path, Material
   return table;
 }
 
-std::string materials_json(const MaterialTable& table) {
+Result<std::string> materials_json(const MaterialTable& table) {
   json file{{"materials", json::array()}, {"interactions", json::array()}};
   for (const auto& m : table.materials) {
+    if (auto ok = validate_material_name(m.name, "materials table"); !ok) return std::unexpected(ok.error());
+    if (!is_valid_utf8(m.source))
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("materials table: the source of material '{}' is not UTF-8 text", m.name));
     file["materials"].push_back({{"name", m.name},
                                  {"youngs_modulus_pa", m.youngs_modulus},
                                  {"poisson_ratio", m.poisson_ratio},

@@ -13,7 +13,8 @@ namespace clumpforge {
 
 /// `base` with the file's entries applied; errors name the file and the entry.
 Result<MaterialTable> read_materials(const std::filesystem::path& path, MaterialTable base = default_material_table());
-/// The table as a materials file.
-std::string materials_json(const MaterialTable& table);
+/// The table as a materials file; an error when a name is not a material name
+/// (validate_material_name) or a source is not UTF-8 text.
+Result<std::string> materials_json(const MaterialTable& table);
 
 }  // namespace clumpforge

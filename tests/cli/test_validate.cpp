@@ -117,6 +117,15 @@ TEST(MaterialsCli, ShippedFileIsTheBuiltInTableAndOverridesWork) {
   const auto bad = test::run_clumpforge(fmt::format("materials --materials '{}'", (dir / "bad.json").string()));
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("bad.json"), std::string::npos);
+  // A name an engine's script cannot hold: refused naming the file, nothing written.
+  test::write_text(
+      dir / "blank.json",
+      R"({"materials": [{"name": "Q235 steel", "youngs_modulus_pa": 2e11, "poisson_ratio": 0.3, "density_kg_m3": 7850}]})");
+  const auto blank = test::run_clumpforge(fmt::format("materials --materials '{}' --export liggghts -o '{}'",
+                                                      (dir / "blank.json").string(), (dir / "out.liggghts").string()));
+  EXPECT_EQ(blank.exit_code, 1);
+  EXPECT_NE(blank.err.find("blank.json': material name 'Q235 steel'"), std::string::npos) << blank.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.liggghts"));
   // A number beyond a double's range is valid JSON no parser holds: a clean error naming the
   // file, not "internal error" (found by flipping bytes of docs/materials.json).
   test::write_text(

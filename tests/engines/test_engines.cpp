@@ -99,4 +99,18 @@ TEST_F(Engines, YadeBuildsTheClumpWithTheTrueMassAndInertia) {
   expect_exported_clump(out, 1e-6);
 }
 
+TEST_F(Engines, YadeLoadsAnExportWhoseFileNameHoldsAQuoteAndABlank) {
+  // The script names its sphere file in Python literals: a quote in the name once ended them.
+  const auto exported = test::run_clumpforge(fmt::format(
+      "export '{}' --format yade -o \"{}\"", (*dir_ / "tuber.h5").string(), (*dir_ / "tuber it's.txt").string()));
+  ASSERT_EQ(exported.exit_code, 0) << exported.err;
+  const auto run = test::run_command(fmt::format("cd '{}' && yade -n -x '{}' \"tuber it's.py\"", dir_->path().string(),
+                                                 (test::source_dir() / "tests/engines/data/drop_yade.py").string()));
+  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+  const auto out = markers(run.out);
+  ASSERT_EQ(out.count("CF_MEMBERS"), 1u) << run.out << run.err;
+  EXPECT_EQ(out.at("CF_MEMBERS")[0], static_cast<double>(clump_->spheres.size()));
+  expect_exported_clump(out, 1e-6);
+}
+
 }  // namespace clumpforge

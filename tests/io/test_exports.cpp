@@ -1,10 +1,12 @@
 // Every export format read back: spheres, mass and inertia as written.
 #include <dirent.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <sstream>
 
@@ -287,6 +289,43 @@ TEST(Exports, UnknownFormatGetsASuggestion) {
   EXPECT_NE(bad.error().message.find("did you mean 'liggghts'"), std::string::npos);
   for (auto f : {ExportFormat::Liggghts, ExportFormat::Yade, ExportFormat::Csv})
     EXPECT_EQ(*parse_export_format(to_string(f)), f);
+}
+
+TEST(Exports, NamesReachTheEnginesScriptsAsNamesNeverAsCommands) {
+  test::ScratchDir dir("export-names");
+  Clump c = clump_for_export();
+  c.name = "tuber\nshell touch pwned";  // a library may hold any name; a newline once ended the comment
+  ASSERT_TRUE(export_clump(c, ExportFormat::Liggghts, dir / "t.multisphere"));
+  ASSERT_TRUE(export_clump(c, ExportFormat::Yade, dir / "it's.txt"));
+  for (const char* file : {"t.multisphere", "t.multisphere.in", "it's.txt", "it's.py"}) {
+    std::ifstream in(dir / file);
+    ASSERT_TRUE(in) << file;
+    std::string line;
+    while (std::getline(in, line)) EXPECT_NE(line.rfind("shell", 0), 0u) << file << ": " << line;
+  }
+  std::ifstream script(dir / "it's.py");
+  const std::string text((std::istreambuf_iterator<char>(script)), {});
+  EXPECT_NE(text.find("os.getcwd(), 'it\\'s.txt')"), std::string::npos) << text;
+  // Python parses the script (YADE runs it in tests/engines).
+  const auto parsed = test::run_command(
+      fmt::format("python3 -c \"import ast, glob; [ast.parse(open(p).read()) for p in glob.glob('{}/*.py')]\"",
+                  dir.path().string()));
+  EXPECT_EQ(parsed.exit_code, 0) << parsed.err;
+}
+
+TEST(Exports, AFileNameLiggghtsCannotReadIsRefusedWritingNothing) {
+  test::ScratchDir dir("export-names");
+  for (const char* name : {"a b.multisphere", "a#b.multisphere", "a$b.multisphere", "a\"b.multisphere"}) {
+    const auto refused = export_clump(clump_for_export(), ExportFormat::Liggghts, dir / name);
+    ASSERT_FALSE(refused) << name;
+    EXPECT_EQ(refused.error().code, ErrorCode::InvalidArgument);
+    EXPECT_NE(refused.error().message.find("LIGGGHTS cannot read the file name"), std::string::npos)
+        << refused.error().message;
+  }
+  const auto not_utf8 = export_clump(clump_for_export(), ExportFormat::Yade, dir / "a\xff.txt");
+  ASSERT_FALSE(not_utf8);
+  EXPECT_NE(not_utf8.error().message.find("not UTF-8"), std::string::npos) << not_utf8.error().message;
+  EXPECT_EQ(test::count_files(dir.path()), 0);
 }
 
 TEST(Exports, NothingIsWrittenWhenAnyFileCannotBe) {

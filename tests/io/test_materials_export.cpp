@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "io/materials_export.hpp"
+#include "io/materials_io.hpp"
 #include "support/test_support.hpp"
 
 namespace clumpforge {
@@ -76,6 +77,50 @@ TEST(MaterialsExport, StoredCalibrationsOfBothMethodsAreApplied) {
   ASSERT_TRUE(paper) << paper.error().message;
   EXPECT_EQ(paper->conventions, ContactConventions::Edem);  // none stated: clumpforge's default
   EXPECT_DOUBLE_EQ(paper->table.interaction("tuber", "soil")->rolling_friction, 0.05);
+}
+
+TEST(MaterialsExport, ANameTheEnginesScriptsCannotHoldIsRefusedInAFileAndInATable) {
+  // A name goes verbatim into a LIGGGHTS variable, a YADE label and an EDEM field: a blank
+  // split LIGGGHTS' command, and a quote ran the rest of the name as Python.
+  test::ScratchDir dir("material-names");
+  const std::vector<std::string> bad{
+      R"({"materials": [{"name": "Q235 steel", "youngs_modulus_pa": 2e11, "poisson_ratio": 0.3, "density_kg_m3": 7850}]})",
+      R"({"materials": [{"name": "", "youngs_modulus_pa": 2e11, "poisson_ratio": 0.3, "density_kg_m3": 7850}]})",
+      R"({"interactions": [{"a": "tuber", "b": "steel2", "restitution": 0.5, "static_friction": 0.5, "rolling_friction": 0}]})"};
+  for (std::size_t k = 0; k < bad.size(); ++k) {
+    const auto path = dir / ("bad" + std::to_string(k) + ".json");
+    test::write_text(path, bad[k]);
+    const auto r = read_materials(path);
+    ASSERT_FALSE(r) << bad[k];
+    EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
+    EXPECT_NE(r.error().message.find(path.string()), std::string::npos) << r.error().message;
+  }
+  MaterialTable table = default_material_table();
+  table.materials.push_back({"x']); import os #", 2e11, 0.3, 7850, "built in C++"});
+  for (auto format : {ExportFormat::Liggghts, ExportFormat::Yade, ExportFormat::Edem}) {
+    const auto refused = export_materials(table, {.format = format});
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("material name"), std::string::npos) << refused.error().message;
+  }
+  EXPECT_FALSE(materials_json(table));
+  MaterialTable raw = default_material_table();
+  raw.materials.front().source = "\xff\xfe";  // JSON text cannot hold it
+  const auto not_utf8 = materials_json(raw);
+  ASSERT_FALSE(not_utf8);
+  EXPECT_NE(not_utf8.error().message.find("not UTF-8"), std::string::npos);
+  EXPECT_TRUE(materials_json(default_material_table()));
+}
+
+TEST(MaterialsExport, TheProvenanceStaysInItsCommentLine) {
+  MaterialsExportOptions options{.format = ExportFormat::Liggghts};
+  options.provenance = "materials file a\nshell touch pwned\n.json";  // a Linux path may hold newlines
+  for (auto format : {ExportFormat::Liggghts, ExportFormat::Yade, ExportFormat::Edem}) {
+    options.format = format;
+    const auto text = export_materials(default_material_table(), options);
+    ASSERT_TRUE(text) << text.error().message;
+    EXPECT_NE(text->find("materials file a\\x0Ashell touch pwned\\x0A.json"), std::string::npos) << *text;
+    EXPECT_EQ(text->find("\nshell"), std::string::npos) << *text;
+  }
 }
 
 TEST(MaterialsExport, MalformedCalibrationsAreRefusedNamingTheFile) {

@@ -1,6 +1,7 @@
 """The Python package, imported as a user imports it (PYTHONPATH=build/python), against
 analytic answers and the files the library writes. Run by ctest (label python)."""
 
+import json
 import math
 import pathlib
 import threading
@@ -247,6 +248,8 @@ def test_materials_export_names_its_conventions():
     assert "coefficientRestitution" in text and "Tsuji" in text
     assert "lever arm R = the element sphere's radius" in text
     assert cf.default_materials().interaction("tuber", "Q235").restitution > 0
+    table = json.loads(cf.default_materials().to_json())
+    assert [m["name"] for m in table["materials"]] == ["tuber", "Q235", "soil"]
 
 
 def test_ctrl_c_stops_a_long_call_within_a_second():
