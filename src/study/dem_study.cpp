@@ -138,7 +138,8 @@ void compare(DemStudyResult& r, std::size_t clumps, const DemStudyOptions& o) {
                                .detectable = w.detectable,
                                .welch_p = w.p_value,
                                .ks_p = ks.p_value,
-                               .ks_statistic = ks.statistic});
+                               .ks_statistic = ks.statistic,
+                               .quantile_shift = largest_decile_shift(s.values, ref.values)});
       family.push_back(w.p_value);
       family.push_back(ks.p_value);
     }

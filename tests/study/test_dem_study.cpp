@@ -66,9 +66,16 @@ TEST(DemStudy, TellsABallFromTheTuberButNotACopyOfTheReference) {
   EXPECT_NE(clumps[r->coarsest].name, "ball");
   for (const auto& v : r->verdicts)
     if (v.spheres >= static_cast<int>(clumps[r->coarsest].spheres.size())) EXPECT_FALSE(v.distinguishable);
-  // A ball rolls further than the tuber: the comparison's sign and its interval say so.
-  for (const auto& c : r->comparisons)
-    if (c.clump == 3 && c.test == LabTest::Roll) EXPECT_GT(c.difference - c.difference_ci, 0.0);
+  // A ball rolls further than the tuber: the comparison's sign and its interval say so, and
+  // its deciles move by more than the tolerance (the KS rejection's measure; it was never
+  // set before, so a KS rejection alone counted for nothing).
+  for (const auto& c : r->comparisons) {
+    EXPECT_GT(c.quantile_shift, 0.0) << c.clump;
+    if (c.clump == 3 && c.test == LabTest::Roll) {
+      EXPECT_GT(c.difference - c.difference_ci, 0.0);
+      EXPECT_GT(c.quantile_shift, quick().length_tolerance);
+    }
+  }
   // The same seed gives the same values.
   auto again = run_dem_study(clumps, quick());
   ASSERT_TRUE(again);
