@@ -89,7 +89,7 @@ TEST_F(BatchCli, RunsShardsAndResumeGiveTheSameBytes) {
 }
 
 TEST_F(BatchCli, AbsurdOptionsAreRefusedWritingNothing) {
-  for (const std::string& extra :
+  for (const char* extra :
        {"--shard 3/2", "--validate adaptive-99", "--tests bounce", "--budgets 0", "--trials 0", "--density -5"}) {
     const auto run =
         test::run_clumpforge(fmt::format("batch '{}' -o '{}' {}", scans().string(), (dir_ / "x").string(), extra));

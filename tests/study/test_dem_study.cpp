@@ -64,8 +64,11 @@ TEST(DemStudy, TellsABallFromTheTuberButNotACopyOfTheReference) {
   EXPECT_TRUE(r->verdicts[1].reference);
   // The coarsest alike never is the ball, and every clump finer than it passes.
   EXPECT_NE(clumps[r->coarsest].name, "ball");
-  for (const auto& v : r->verdicts)
-    if (v.spheres >= static_cast<int>(clumps[r->coarsest].spheres.size())) EXPECT_FALSE(v.distinguishable);
+  for (const auto& v : r->verdicts) {
+    if (v.spheres >= static_cast<int>(clumps[r->coarsest].spheres.size())) {
+      EXPECT_FALSE(v.distinguishable);
+    }
+  }
   // A ball rolls further than the tuber: the comparison's sign and its interval say so, and
   // its deciles move by more than the tolerance (the KS rejection's measure; it was never
   // set before, so a KS rejection alone counted for nothing).
