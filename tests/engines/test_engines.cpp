@@ -64,6 +64,21 @@ class Engines : public ::testing::Test {
     EXPECT_GT(out.at("CF_Z1")[0], 0.5 * half_thickness);
     EXPECT_LT(out.at("CF_SPEED")[0], 2e-3);
   }
+  // Exports the clump as STEM.txt and STEM.py, and runs YADE's drop on them.
+  static void expect_yade_builds_the_clump(const std::string& stem) {
+    const auto exported = test::run_clumpforge(
+        fmt::format("export '{}' --format yade -o \"{}.txt\"", (*dir_ / "tuber.h5").string(), (*dir_ / stem).string()));
+    ASSERT_EQ(exported.exit_code, 0) << exported.err;
+    const auto run =
+        test::run_command(fmt::format("cd '{}' && yade -n -x '{}' \"{}.py\"", dir_->path().string(),
+                                      (test::source_dir() / "tests/engines/data/drop_yade.py").string(), stem));
+    ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+    const auto out = markers(run.out);
+    ASSERT_EQ(out.count("CF_MEMBERS"), 1u) << run.out << run.err;
+    EXPECT_EQ(out.at("CF_MEMBERS")[0], static_cast<double>(clump_->spheres.size()));
+    // The export puts YADE's clump frame on the body's principal axes (docs/exports/yade.md).
+    expect_exported_clump(out, 1e-6);
+  }
   static test::ScratchDir* dir_;
   static Clump* clump_;
 };
@@ -86,31 +101,12 @@ TEST_F(Engines, LiggghtsReadsEverySphereTheMassAndTheInertia) {
 }
 
 TEST_F(Engines, YadeBuildsTheClumpWithTheTrueMassAndInertia) {
-  const auto exported = test::run_clumpforge(fmt::format(
-      "export '{}' --format yade -o '{}'", (*dir_ / "tuber.h5").string(), (*dir_ / "tuber-yade.txt").string()));
-  ASSERT_EQ(exported.exit_code, 0) << exported.err;
-  const auto run = test::run_command(fmt::format("cd '{}' && yade -n -x '{}' tuber-yade.py", dir_->path().string(),
-                                                 (test::source_dir() / "tests/engines/data/drop_yade.py").string()));
-  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
-  const auto out = markers(run.out);
-  ASSERT_EQ(out.count("CF_MEMBERS"), 1u) << run.out << run.err;
-  EXPECT_EQ(out.at("CF_MEMBERS")[0], static_cast<double>(clump_->spheres.size()));
-  // The export puts YADE's clump frame on the body's principal axes (docs/exports/yade.md).
-  expect_exported_clump(out, 1e-6);
+  expect_yade_builds_the_clump("tuber-yade");
 }
 
 TEST_F(Engines, YadeLoadsAnExportWhoseFileNameHoldsAQuoteAndABlank) {
   // The script names its sphere file in Python literals: a quote in the name once ended them.
-  const auto exported = test::run_clumpforge(fmt::format(
-      "export '{}' --format yade -o \"{}\"", (*dir_ / "tuber.h5").string(), (*dir_ / "tuber it's.txt").string()));
-  ASSERT_EQ(exported.exit_code, 0) << exported.err;
-  const auto run = test::run_command(fmt::format("cd '{}' && yade -n -x '{}' \"tuber it's.py\"", dir_->path().string(),
-                                                 (test::source_dir() / "tests/engines/data/drop_yade.py").string()));
-  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
-  const auto out = markers(run.out);
-  ASSERT_EQ(out.count("CF_MEMBERS"), 1u) << run.out << run.err;
-  EXPECT_EQ(out.at("CF_MEMBERS")[0], static_cast<double>(clump_->spheres.size()));
-  expect_exported_clump(out, 1e-6);
+  expect_yade_builds_the_clump("tuber it's");
 }
 
 }  // namespace clumpforge
