@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/recording.hpp"
+#include "core/text.hpp"
 #include "fill/study.hpp"
 #include "fill_report.hpp"
 #include "parallel/team.hpp"
@@ -190,7 +191,7 @@ std::string csv_table(const std::vector<StudyRow>& rows) {
     const auto& e = r.clump.error;
     text += fmt::format(
         "{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4g},{:.6g},{:.6g},{:.5f},{:.3f}\n",
-        r.name, to_string(r.method), e.sphere_count, e.volume_error, e.mass_error, e.com_offset_norm,
+        csv_field(r.name), to_string(r.method), e.sphere_count, e.volume_error, e.mass_error, e.com_offset_norm,
         e.principal_moment_errors[0], e.principal_moment_errors[1], e.principal_moment_errors[2],
         e.principal_moment_errors_mass_matched[0], e.principal_moment_errors_mass_matched[1],
         e.principal_moment_errors_mass_matched[2], e.axis_error_deg, e.surface_rms, e.surface_max, e.dice,

@@ -8,6 +8,7 @@
 
 #include "batch/batch.hpp"
 #include "core/atomic_file.hpp"
+#include "core/text.hpp"
 #include "io/clump_library.hpp"
 #include "mesh/load.hpp"
 #include "mesh/triangle_mesh.hpp"
@@ -34,9 +35,9 @@ std::string population_csv(const std::vector<ItemResult>& items, const BatchOpti
     if (!r.error.empty()) continue;
     for (const Clump& c : r.clumps) {
       const ClumpError& e = c.error;
-      csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", r.scan, r.sha256, c.name,
-                         to_string(c.method), c.spheres.size(), number(r.shape.volume), number(r.shape.mass),
-                         number(r.shape.length), number(r.shape.width), number(r.shape.thickness),
+      csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", csv_field(r.scan), r.sha256,
+                         csv_field(c.name), to_string(c.method), c.spheres.size(), number(r.shape.volume),
+                         number(r.shape.mass), number(r.shape.length), number(r.shape.width), number(r.shape.thickness),
                          number(r.shape.sphericity), number(r.shape.elongation), number(r.shape.flatness),
                          number(e.mass_error), number(e.principal_moment_errors_mass_matched.cwiseAbs().maxCoeff()),
                          number(e.com_offset_norm), number(e.axis_error_deg), number(e.surface_rms), number(e.dice));

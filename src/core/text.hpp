@@ -23,6 +23,10 @@ std::string did_you_mean(std::string_view input, std::span<const std::string> ca
 /// comment would otherwise end the comment and start a command.
 std::string one_line_text(std::string_view text);
 
+/// `text` as one field of a CSV row (RFC 4180): quoted, with each quote doubled, when it holds a
+/// comma, a quote or a line break; else as it is. A scan's file name may hold any of them.
+std::string csv_field(std::string_view text);
+
 /// The bytes of the file at `path`, at most `limit` of them; nullopt when it cannot be opened or
 /// read (a missing file, a folder, no permission). The one whole-file reader the parsers share.
 std::optional<std::string> read_file_bytes(const std::filesystem::path& path,

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "core/atomic_file.hpp"
+#include "core/text.hpp"
 #include "io/export_detail.hpp"
 #include "io/exports.hpp"
 
@@ -164,9 +165,9 @@ std::string population_table(const std::vector<Clump>& clumps, const std::vector
   std::string csv = "name,identifier,file,mass_kg,volume_m3,density_kg_m3,spheres,number_fraction,mass_fraction\n";
   for (std::size_t k = 0; k < clumps.size(); ++k) {
     const Clump& c = clumps[k];
-    csv += fmt::format("{},{},{},{},{},{},{},{},{}\n", c.name, identifier(c.name), primaries[k].generic_string(),
-                       number(c.mass), number(c.body_volume), number(c.density), c.spheres.size(), number(by_number[k]),
-                       number(by_mass[k]));
+    csv += fmt::format("{},{},{},{},{},{},{},{},{}\n", csv_field(c.name), identifier(c.name),
+                       csv_field(primaries[k].generic_string()), number(c.mass), number(c.body_volume),
+                       number(c.density), c.spheres.size(), number(by_number[k]), number(by_mass[k]));
   }
   return csv;
 }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 
 namespace clumpforge {
 
@@ -37,6 +38,20 @@ TEST(PrintableText, FailMakesEveryMessagePrintable) {
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::ParseError);
   EXPECT_EQ(r.error().message, "t.csv:3: '\\xFF' is not a number");
+}
+
+TEST(PrintableText, OneLineTextKeepsACommentOnItsLine) {
+  EXPECT_EQ(one_line_text("a\nshell x\tb"), "a\\x0Ashell x\\x09b");
+  EXPECT_EQ(one_line_text("tuber \xCE\xB1"), "tuber \xCE\xB1");
+  EXPECT_EQ(one_line_text("\x1b[2J"), "\\x1B[2J");
+}
+
+TEST(PrintableText, CsvFieldQuotesOnlyWhatWouldSplitARow) {
+  EXPECT_EQ(csv_field("tuber-01.stl"), "tuber-01.stl");
+  EXPECT_EQ(csv_field("tuber, left.stl"), "\"tuber, left.stl\"");
+  EXPECT_EQ(csv_field("the \"big\" one"), "\"the \"\"big\"\" one\"");
+  EXPECT_EQ(csv_field("two\nlines"), "\"two\nlines\"");
+  EXPECT_EQ(csv_field(""), "");
 }
 
 }  // namespace clumpforge

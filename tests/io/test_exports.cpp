@@ -268,6 +268,23 @@ TEST(Exports, APopulationHasEveryClumpsFilesAndItsFractionsInEveryFormat) {
   }
 }
 
+TEST(Exports, APopulationTableReadsBackWithCommasAndQuotesInItsNames) {
+  test::ScratchDir dir("population, \"quoted\"");
+  Clump a = clump_for_export();
+  a.name = "tuber, left";
+  Clump b = clump_for_export();
+  b.name = "tuber \"right\"";
+  const auto out = dir / "mix";
+  ASSERT_TRUE(export_population({a, b}, {.format = ExportFormat::Csv}, out));
+  // Python's csv module, as a user reads it: every row as wide as the header, the names whole.
+  const auto read =
+      test::run_command(fmt::format("python3 -c \"import csv, sys; rows = list(csv.reader(open(sys.argv[1]))); "
+                                    "print(len(set(map(len, rows))), rows[1][0], '|', rows[2][0])\" '{}'",
+                                    (out / "population.csv").string()));
+  ASSERT_EQ(read.exit_code, 0) << read.err;
+  EXPECT_EQ(read.out, "1 tuber, left | tuber \"right\"\n");
+}
+
 TEST(Exports, APopulationRefusesClashingNamesAndWrongFractionsAndWritesNothing) {
   test::ScratchDir dir("population");
   const Clump a = clump_for_export();
