@@ -265,6 +265,12 @@ Files chrono(const Clump& c, const fs::path& output) {
   return {{output, csv}, {sibling(output, "-properties.json"), props}};
 }
 
+// `text` inside an XML comment, which may not hold "--".
+std::string xml_comment(std::string text) {
+  for (std::size_t at = text.find("--"); at != std::string::npos; at = text.find("--", at)) text.insert(at + 1, " ");
+  return text;
+}
+
 Files vtk(const Clump& c, const fs::path& output) {
   // VTK XML PolyData: one vertex per sphere centre with "radius" point data; in ParaView
   // apply Glyph (sphere, scale by radius, factor 2 for diameter-sized glyphs).
@@ -289,7 +295,7 @@ Files vtk(const Clump& c, const fs::path& output) {
       "     </DataArray>\n"
       "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n{}        </DataArray>\n      </Verts>\n"
       "    </Piece>\n  </PolyData>\n</VTKFile>\n",
-      provenance(c), c.spheres.size(), c.spheres.size(), radii, points, connectivity, offsets);
+      xml_comment(provenance(c)), c.spheres.size(), c.spheres.size(), radii, points, connectivity, offsets);
   return {{output, text}};
 }
 

@@ -311,9 +311,11 @@ TEST(Exports, UnknownFormatGetsASuggestion) {
 TEST(Exports, NamesReachTheEnginesScriptsAsNamesNeverAsCommands) {
   test::ScratchDir dir("export-names");
   Clump c = clump_for_export();
-  c.name = "tuber\nshell touch pwned";  // a library may hold any name; a newline once ended the comment
+  // A library may hold any name: a newline once ended the comment, and "--" an XML comment.
+  c.name = "tuber--> \nshell touch pwned";
   ASSERT_TRUE(export_clump(c, ExportFormat::Liggghts, dir / "t.multisphere"));
   ASSERT_TRUE(export_clump(c, ExportFormat::Yade, dir / "it's.txt"));
+  ASSERT_TRUE(export_clump(c, ExportFormat::Vtk, dir / "t.vtp"));
   for (const char* file : {"t.multisphere", "t.multisphere.in", "it's.txt", "it's.py"}) {
     std::ifstream in(dir / file);
     ASSERT_TRUE(in) << file;
@@ -328,6 +330,9 @@ TEST(Exports, NamesReachTheEnginesScriptsAsNamesNeverAsCommands) {
       fmt::format("python3 -c \"import ast, glob; [ast.parse(open(p).read()) for p in glob.glob('{}/*.py')]\"",
                   dir.path().string()));
   EXPECT_EQ(parsed.exit_code, 0) << parsed.err;
+  const auto xml = test::run_command(
+      fmt::format("python3 -c \"import xml.etree.ElementTree as E; E.parse('{}')\"", (dir / "t.vtp").string()));
+  EXPECT_EQ(xml.exit_code, 0) << xml.err;
 }
 
 TEST(Exports, AFileNameLiggghtsCannotReadIsRefusedWritingNothing) {
