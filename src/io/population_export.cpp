@@ -165,9 +165,10 @@ std::string population_table(const std::vector<Clump>& clumps, const std::vector
   std::string csv = "name,identifier,file,mass_kg,volume_m3,density_kg_m3,spheres,number_fraction,mass_fraction\n";
   for (std::size_t k = 0; k < clumps.size(); ++k) {
     const Clump& c = clumps[k];
+    // The file is relative to the population's folder and named by the identifier: no quoting.
     csv += fmt::format("{},{},{},{},{},{},{},{},{}\n", csv_field(c.name), identifier(c.name),
-                       csv_field(primaries[k].generic_string()), number(c.mass), number(c.body_volume),
-                       number(c.density), c.spheres.size(), number(by_number[k]), number(by_mass[k]));
+                       primaries[k].generic_string(), number(c.mass), number(c.body_volume), number(c.density),
+                       c.spheres.size(), number(by_number[k]), number(by_mass[k]));
   }
   return csv;
 }

@@ -269,7 +269,7 @@ TEST(Exports, APopulationHasEveryClumpsFilesAndItsFractionsInEveryFormat) {
 }
 
 TEST(Exports, APopulationTableReadsBackWithCommasAndQuotesInItsNames) {
-  test::ScratchDir dir("population, \"quoted\"");
+  test::ScratchDir dir("population-names");
   Clump a = clump_for_export();
   a.name = "tuber, left";
   Clump b = clump_for_export();
