@@ -858,6 +858,7 @@ struct BenchOptions {
   std::uint64_t seed = 1;
   std::vector<std::string> only;
   bool full_set = false, nine_set_ups = false, existing_only = false, generate_only = false;
+  bool one_start = false;  ///< DiagnoseOptions::held_starts off
   // The recordings come from a finer clump of the same scan than the one diagnosed (340 spheres
   // against the diagnosis's 64), as real data never comes from the diagnoser's own model.
   /// The mass in each clump sphere's wall-contact damping, of the generator and the diagnosis alike
@@ -943,6 +944,9 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "Where the diagnosis reads a drop's drift, recorded and replayed alike: track-end (default) or "
                  "after-impact (as diagnose's)")
       ->check(CLI::IsMember({"track-end", "after-impact"}));
+  app.add_flag("--one-start", o.one_start,
+               "A candidate's frame-by-frame fit that ends on the null is not started again from the library's "
+               "realistic and strong magnitudes (as diagnose's)");
   app.add_option("--ensemble-replays-at-gate", o.replays_at_gate,
                  "Replays per recording of a case's second comparison beyond the release horizon when the first "
                  "decided at a gate (as diagnose's; 0: never)")
@@ -1078,6 +1082,7 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
   job.options.ensemble_replays_at_gate = o.replays_at_gate;
   job.options.lab.contact.wall_mass = o.contact_wall_mass();
   job.options.drift_at = o.drift_at();
+  job.options.held_starts = !o.one_start;
   // Recordings already made (their answer is written last) are diagnosed as they are: delete a
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
@@ -1204,6 +1209,7 @@ int main(int argc, char** argv) {
     job.options.ensemble_replays_at_gate = o.replays_at_gate;
     job.options.lab.contact.wall_mass = o.contact_wall_mass();
     job.options.drift_at = o.drift_at();
+    job.options.held_starts = !o.one_start;
     return compared(run_recordings_set(o.recordings_set, o.out, job, o.existing_only, *team));
   }
   const MaterialTable table = default_material_table();

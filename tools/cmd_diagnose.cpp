@@ -32,7 +32,7 @@ struct DiagnoseArgs {
   int ensemble_replays = 12, ensemble_replays_at_gate = 48;
   int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
   std::uint64_t seed = 1;
-  bool json = false, no_replay_reuse = false;
+  bool json = false, no_replay_reuse = false, one_start = false;
 };
 
 /// The text report. Trial ids, track names and folder names are the recording's free text and can
@@ -138,6 +138,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.ensemble_replays_at_gate = args.ensemble_replays_at_gate;
   options.release_orientations = args.release_orientations;
   options.reuse_replays = !args.no_replay_reuse;
+  options.held_starts = !args.one_start;
   for (const auto& name : args.effects) {
     auto e = parse_effect(name);
     if (!e) return report_error(kCommand, e.error());
@@ -234,6 +235,11 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_flag("--no-replay-reuse", args->no_replay_reuse,
                 "Run every replay beyond the release horizon, even one already run with the same clump, model and "
                 "release orientation (by default read back, the same bits: report.json's replays_reused counts them)");
+  sub->add_flag("--one-start", args->one_start,
+                "Fit each candidate from the null only: by default a fit that ends there (the effect switched off) "
+                "is started again from the library's realistic and strong magnitudes of the effect, the "
+                "coefficients refitted there first (two rolling laws can need the effect up and a coefficient down "
+                "together)");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   add_output_option(*sub, args->out, "Directory for report.json, tracks.json and the figures (PNG, SVG)");

@@ -471,6 +471,7 @@ Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& c
   run.report = diagnosis_report_json(run.result, run.clump.name);
   run.report["wall_mass"] = std::string(wall_mass_name(job.options.lab.contact.wall_mass));
   run.report["drop_drift"] = std::string(drift_at_name(job.options.drift_at));
+  run.report["held_starts"] = job.options.held_starts;
   return run;
 }
 

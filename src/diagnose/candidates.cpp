@@ -168,7 +168,7 @@ Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result,
       continue;
     }
     // Every coefficient stays free: the fair null is the baseline itself, polished the same way.
-    auto fit = fit_hypothesis(c, baseline, spec, train, options.max_evaluations);
+    auto fit = fit_hypothesis(c, baseline, spec, train, options.max_evaluations, options.held_starts);
     if (!fit) return std::unexpected(fit.error());
     HypothesisReport report;
     report.name = spec.name;

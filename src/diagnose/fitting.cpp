@@ -382,10 +382,37 @@ Result<Fitted> fit_coefficients_near(Context& c, const Model& start, const std::
   return refit(c, *narrow, nullptr, trials, max_evaluations);
 }
 
+/// The fit from `from` with the effect's first parameter held at `value`: the coefficients
+/// refitted there first, then everything from that point. Two models of one contact (constant
+/// rolling torque and the EPSD spring) can need the effect up and a coefficient down together,
+/// a move a fit from the null never starts, since each alone makes the misfit worse.
+Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<FitParameter>& parameters,
+                              const std::vector<std::size_t>& which, const std::vector<double>& from, double value,
+                              int iterations) {
+  Model held = apply_parameters(start, parameters, from);
+  held.values[0] = value;
+  std::vector<FitParameter> coefficients;
+  for (const FitParameter& p : parameters)
+    if (!p.effect) coefficients.push_back(p);
+  int evaluations = 0;
+  if (!coefficients.empty()) {
+    auto refitted = levenberg_marquardt(c, held, coefficients, which, unit_point(held, coefficients), iterations);
+    if (!refitted) return std::unexpected(refitted.error());
+    held = apply_parameters(held, coefficients, refitted->x);
+    evaluations += refitted->evaluations;
+  }
+  auto all = levenberg_marquardt(c, start, parameters, which, unit_point(held, parameters), iterations);
+  if (!all) return std::unexpected(all.error());
+  all->evaluations += evaluations;
+  return all;
+}
+
 /// `spec`'s effect fitted with every base coefficient free on `which`, from the baseline (a
-/// nested model: its null is the baseline, refitted the same way by fit_coefficients).
+/// nested model: its null is the baseline, refitted the same way by fit_coefficients). With
+/// `held_starts`, a fit that ends on the null is started again from the library's realistic and
+/// strong magnitudes of its first parameter (fit_from_held).
 Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpec& spec,
-                              const std::vector<std::size_t>& which, int max_evaluations) {
+                              const std::vector<std::size_t>& which, int max_evaluations, bool held_starts) {
   auto [start, parameters] = fit_parameters(c, baseline, &spec, which, true);
   std::optional<Error> failure;
   Fitted out;
@@ -469,6 +496,18 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
       if (again->value < best_value) {
         best_value = again->value;
         best_unit = again->x;
+      }
+    }
+  }
+  const double off = parameters[0].to_unit(effect_off(spec)[0]);
+  if (held_starts && std::abs(best_unit[0] - off) < 0.01) {
+    for (double value : {spec.parameters[0].realistic, spec.parameters[0].strong}) {
+      auto held = fit_from_held(c, start, parameters, which, best_unit, value, max_evaluations / 5);
+      if (!held) return std::unexpected(held.error());
+      out.evaluations += held->evaluations;
+      if (held->value < best_value) {
+        best_value = held->value;
+        best_unit = held->x;
       }
     }
   }

@@ -284,7 +284,7 @@ Result<Fitted> fit_coefficients(Context& c, const Model& start, const std::vecto
 Result<Fitted> fit_coefficients_near(Context& c, const Model& start, const std::vector<std::size_t>& trials,
                                      int max_evaluations);
 Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpec& spec,
-                              const std::vector<std::size_t>& which, int max_evaluations);
+                              const std::vector<std::size_t>& which, int max_evaluations, bool held_starts);
 
 // ---- early_stages.cpp ------------------------------------------------------------------------
 
