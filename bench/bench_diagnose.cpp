@@ -945,8 +945,8 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "after-impact (as diagnose's)")
       ->check(CLI::IsMember({"track-end", "after-impact"}));
   app.add_flag("--one-start", o.one_start,
-               "A candidate's frame-by-frame fit that ends on the null is not started again from the library's "
-               "realistic and strong magnitudes (as diagnose's)");
+               "A candidate's frame-by-frame fit that ends on the null is not started again from the effect held "
+               "near it (as diagnose's)");
   app.add_option("--ensemble-replays-at-gate", o.replays_at_gate,
                  "Replays per recording of a case's second comparison beyond the release horizon when the first "
                  "decided at a gate (as diagnose's; 0: never)")

@@ -237,7 +237,7 @@ Command add_diagnose_command(CLI::App& app) {
                 "release orientation (by default read back, the same bits: report.json's replays_reused counts them)");
   sub->add_flag("--one-start", args->one_start,
                 "Fit each candidate from the null only: by default a fit that ends there (the effect switched off) "
-                "is started again from the library's realistic and strong magnitudes of the effect, the "
+                "is started again from the effect held at the two points of its first search nearest the null, the "
                 "coefficients refitted there first (two rolling laws can need the effect up and a coefficient down "
                 "together)");
   sub->add_option("--release-orientations", args->release_orientations,

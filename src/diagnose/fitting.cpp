@@ -382,6 +382,23 @@ Result<Fitted> fit_coefficients_near(Context& c, const Model& start, const std::
   return refit(c, *narrow, nullptr, trials, max_evaluations);
 }
 
+namespace {
+
+/// Where the first search of a candidate's first parameter looks, in its unit range (0 and 1 its
+/// ends; the null is 0, or 1 for a log-scale parameter switched off at its upper end).
+constexpr std::array<double, 5> kFirstParameterGrid = {0.0, 0.08, 0.2, 0.4, 0.7};
+
+/// The `count` points of kFirstParameterGrid nearest `off` (a unit value), nearest first, `off`
+/// itself left out.
+std::vector<double> grid_points_nearest(double off, std::size_t count) {
+  std::vector<double> points;
+  for (double u : kFirstParameterGrid)
+    if (std::abs(u - off) >= 0.01) points.push_back(u);
+  std::ranges::stable_sort(points, {}, [off](double u) { return std::abs(u - off); });
+  points.resize(std::min(count, points.size()));
+  return points;
+}
+
 /// The fit from `from` with the effect's first parameter held at `value`: the coefficients
 /// refitted there first, then everything from that point. Two models of one contact (constant
 /// rolling torque and the EPSD spring) can need the effect up and a coefficient down together,
@@ -407,10 +424,13 @@ Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<
   return all;
 }
 
+}  // namespace
+
 /// `spec`'s effect fitted with every base coefficient free on `which`, from the baseline (a
 /// nested model: its null is the baseline, refitted the same way by fit_coefficients). With
-/// `held_starts`, a fit that ends on the null is started again from the library's realistic and
-/// strong magnitudes of its first parameter (fit_from_held).
+/// `held_starts`, a fit that ends on the null is started again from its first parameter held at
+/// the two points of the first search nearest the null (fit_from_held): a sphere's EPSD rolling at
+/// compliance 30 ended on the null from every start of the first search, coefficients held.
 Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpec& spec,
                               const std::vector<std::size_t>& which, int max_evaluations, bool held_starts) {
   auto [start, parameters] = fit_parameters(c, baseline, &spec, which, true);
@@ -429,7 +449,7 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
   // The effect's first parameter alone first (a grid over its range), then everything.
   double best_value = chi2(unit);
   std::vector<double> best_unit = unit;
-  for (double u : {0.0, 0.08, 0.2, 0.4, 0.7}) {
+  for (double u : kFirstParameterGrid) {
     std::vector<double> trial = unit;
     trial[0] = u;
     const double f = chi2(trial);
@@ -501,8 +521,9 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
   }
   const double off = parameters[0].to_unit(effect_off(spec)[0]);
   if (held_starts && std::abs(best_unit[0] - off) < 0.01) {
-    for (double value : {spec.parameters[0].realistic, spec.parameters[0].strong}) {
-      auto held = fit_from_held(c, start, parameters, which, best_unit, value, max_evaluations / 5);
+    for (double u : grid_points_nearest(off, 2)) {
+      auto held =
+          fit_from_held(c, start, parameters, which, best_unit, parameters[0].from_unit(u), max_evaluations / 5);
       if (!held) return std::unexpected(held.error());
       out.evaluations += held->evaluations;
       if (held->value < best_value) {
