@@ -868,6 +868,13 @@ struct BenchOptions {
   std::string drop_drift = "track-end";
   DriftAt drift_at() const { return parse_drift_at(drop_drift).value_or(DriftAt::TrackEnd); }  // CLI11 checked it
   ClumpWallMass contact_wall_mass() const { return parse_wall_mass(wall_mass).value_or(ClumpWallMass::Whole); }
+  /// The diagnosis options every case of a run shares (as diagnose's flags of the same names).
+  void set_diagnosis_options(DiagnoseOptions& options) const {
+    options.ensemble_replays_at_gate = replays_at_gate;
+    options.lab.contact.wall_mass = contact_wall_mass();
+    options.drift_at = drift_at();
+    options.held_starts = !one_start;
+  }
   std::string recordings_set, orientation = "none",
                               generator_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default.h5",
                               generator_name = "adaptive-340";
@@ -1079,10 +1086,7 @@ bool make_and_diagnose(const Case& c, const Clump& generator, const MaterialTabl
                        .library = o.clump_file,
                        .clump_name = o.clump_name,
                        .finer_clumps = o.finer_clumps};
-  job.options.ensemble_replays_at_gate = o.replays_at_gate;
-  job.options.lab.contact.wall_mass = o.contact_wall_mass();
-  job.options.drift_at = o.drift_at();
-  job.options.held_starts = !o.one_start;
+  o.set_diagnosis_options(job.options);
   // Recordings already made (their answer is written last) are diagnosed as they are: delete a
   // run's reports to diagnose its recordings again with another build.
   if (fs::exists(dir / "answer.json") && fs::is_directory(dir / "recordings"))
@@ -1206,10 +1210,7 @@ int main(int argc, char** argv) {
   };
   if (!o.recordings_set.empty()) {
     cli::DiagnoseJob job{.spheres = o.spheres, .finer_clumps = o.finer_clumps};
-    job.options.ensemble_replays_at_gate = o.replays_at_gate;
-    job.options.lab.contact.wall_mass = o.contact_wall_mass();
-    job.options.drift_at = o.drift_at();
-    job.options.held_starts = !o.one_start;
+    o.set_diagnosis_options(job.options);
     return compared(run_recordings_set(o.recordings_set, o.out, job, o.existing_only, *team));
   }
   const MaterialTable table = default_material_table();
