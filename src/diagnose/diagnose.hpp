@@ -40,8 +40,9 @@ struct DiagnoseOptions {
   int max_evaluations = 45;  ///< fit budget per candidate: Levenberg-Marquardt iterations are a fifth of it
   /// A candidate whose frame-by-frame fit ends on the null (its first parameter switched off) is
   /// fitted again from that parameter held at each of the two points of its first search nearest
-  /// the null, the coefficients refitted there first (fit_hypothesis). False: the one fit from the
-  /// null.
+  /// the null, the coefficients calibrated there first the baseline's way, and, when either lies
+  /// below the null, from the minimum of that profile between the null and them (fit_hypothesis).
+  /// False: the one fit from the null.
   bool held_starts = true;
   double horizon_perturbation = 1e-4;  ///< [rad] release-orientation perturbation for the predictability horizon
   int release_orientations = 12;  ///< drawn from each release prior to find how long the trials stay predictable, >= 2
