@@ -168,6 +168,21 @@ std::vector<std::pair<double, double>> plateau_edges(const std::vector<double>& 
   return edges;
 }
 
+std::optional<std::pair<double, double>> profile_bracket(double off, const std::vector<double>& points,
+                                                         const std::vector<double>& chi2s, double null_chi2) {
+  const auto best = std::ranges::min_element(chi2s);
+  if (best == chi2s.end() || !(*best < null_chi2)) return std::nullopt;
+  const double side = points[static_cast<std::size_t>(best - chi2s.begin())] - off;
+  double low = off, high = off;
+  for (double u : points) {
+    if ((u - off) * side > 0.0) {
+      low = std::min(low, u);
+      high = std::max(high, u);
+    }
+  }
+  return std::pair{low, high};
+}
+
 /// Block-coordinate fit of the base coefficients: each on its own test's training trials.
 Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vector<std::size_t>& trials,
                            Pinning pinning) {
@@ -445,10 +460,11 @@ Result<HeldPoint> calibrate_held(Context& c, Model from, double value, const std
 /// realistic EPSD rolling, compliance 3: the null's restitution 0.965 against the drops' 0.728;
 /// refitted jointly with the compliance held at 3 they stayed there, chi^2 2.19e6 against the
 /// null's 1.47e6). When a held point's profile lies below the null, the profile falls from the
-/// null towards it, and its minimum is searched between the null and the farther held point (a
-/// golden section, each point calibrated narrowly from the nearest held one's coefficients), and
-/// fitted from there too: from compliance 16 alone the fit crept to 9.65 (chi^2 3.0e5) along a
-/// valley the profile descends to 3.0 (1.6e3). The lowest chi^2 of all is returned.
+/// null towards it, and its minimum is searched between the null and the held points on the best
+/// one's side (a golden section, each point calibrated narrowly from the nearest held one's
+/// coefficients), and fitted from there too: from compliance 16 alone the fit crept to 9.65
+/// (chi^2 3.0e5) along a valley the profile descends to 3.0 (1.6e3). The lowest chi^2 of all is
+/// returned.
 Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<FitParameter>& parameters,
                               const std::vector<std::size_t>& which, const std::vector<double>& best, double best_value,
                               double off, int iterations) {
@@ -456,7 +472,6 @@ Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<
   const Model from = apply_parameters(start, parameters, best);
   const FitParameter& first = parameters[0];
   std::vector<std::pair<double, Model>> held;  // unit value, calibrated model
-  bool below_null = false;
   auto fit_all_from = [&](const Model& model) -> Result<void> {
     auto all = levenberg_marquardt(c, start, parameters, which, unit_point(model, parameters), iterations);
     if (!all) return std::unexpected(all.error());
@@ -465,14 +480,16 @@ Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<
     return {};
   };
   const std::vector<double> points = grid_points_nearest(off, 2);
+  std::vector<double> held_chi2s;
   for (double u : points) {
     auto point = calibrate_held(c, from, first.from_unit(u), which, false, out.evaluations);
     if (!point) return std::unexpected(point.error());
-    below_null = below_null || point->chi2 < best_value;
+    held_chi2s.push_back(point->chi2);
     held.emplace_back(u, point->model);
     if (auto ok = fit_all_from(point->model); !ok) return std::unexpected(ok.error());
   }
-  if (!below_null || points.empty()) return out;
+  const auto bracket = profile_bracket(off, points, held_chi2s, best_value);
+  if (!bracket) return out;
   std::optional<Error> failure;
   std::optional<HeldPoint> lowest;
   auto profile = [&](double u) {
@@ -485,7 +502,7 @@ Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<
     if (!lowest || point->chi2 < lowest->chi2) lowest = *point;
     return point->chi2;
   };
-  golden_section(profile, std::min(off, points.back()), std::max(off, points.back()), 1e-3, 12);
+  golden_section(profile, bracket->first, bracket->second, 1e-3, 12);
   if (failure) return std::unexpected(*failure);
   if (lowest) {
     if (auto ok = fit_all_from(lowest->model); !ok) return std::unexpected(ok.error());

@@ -270,6 +270,13 @@ enum class Pinning { Decide, Keep };
 /// a cell can hide there. None when the lowest is not on such a plateau.
 std::vector<std::pair<double, double>> plateau_edges(const std::vector<double>& values,
                                                      const std::vector<double>& chi2s);
+/// Where a held start's profile is searched (fit_from_held): when a held point (`points`, unit
+/// values, with their calibrated `chi2s`) fits better than the null's `null_chi2`, between `off`
+/// (the null, a unit value) and the held points on the best one's side of it: both, for an effect
+/// off at an end of its range; one, for a centre-of-mass offset, off in the middle. None when no
+/// held point fits better than the null.
+std::optional<std::pair<double, double>> profile_bracket(double off, const std::vector<double>& points,
+                                                         const std::vector<double>& chi2s, double null_chi2);
 Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vector<std::size_t>& trials,
                            Pinning pinning = Pinning::Decide);
 Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::vector<FitParameter>& parameters,

@@ -1427,6 +1427,35 @@ TEST(EnsembleReplayMemo, AReplayAskedForAgainIsReadBackTheSameAndNoOtherIs) {
   EXPECT_NE((*finer)[0].ensemble_value, (*first)[0].ensemble_value);
 }
 
+TEST(HeldStarts, TheProfileIsSearchedOnTheSideOfTheNullTheBestHeldPointLiesOn) {
+  using diagnosis::profile_bracket;
+  // The sphere's realistic EPSD rolling (compliance 0-200, off at 0): held at 16 and 40 (unit 0.08
+  // and 0.2), calibrated, chi^2 7.0e5 and more, both below the null's 1.47e6: searched from the
+  // null to the farther, where the profile's minimum (compliance 3) lies.
+  const auto rolling = profile_bracket(0.0, {0.08, 0.2}, {7.0e5, 1.2e6}, 1.47e6);
+  ASSERT_TRUE(rolling);
+  EXPECT_DOUBLE_EQ(rolling->first, 0.0);
+  EXPECT_DOUBLE_EQ(rolling->second, 0.2);
+  // Off at the upper end (the elastic-plastic yield speed, log scale): from the farther to it.
+  const auto yield = profile_bracket(1.0, {0.7, 0.4}, {9.0, 20.0}, 10.0);
+  ASSERT_TRUE(yield);
+  EXPECT_DOUBLE_EQ(yield->first, 0.4);
+  EXPECT_DOUBLE_EQ(yield->second, 1.0);
+  // Off in the middle (a centre-of-mass offset, +-4 mm: unit 0.5): only the best point's side,
+  // whichever is nearer.
+  const auto below = profile_bracket(0.5, {0.4, 0.7}, {8.0, 9.0}, 10.0);
+  ASSERT_TRUE(below);
+  EXPECT_DOUBLE_EQ(below->first, 0.4);
+  EXPECT_DOUBLE_EQ(below->second, 0.5);
+  const auto above = profile_bracket(0.5, {0.4, 0.7}, {11.0, 9.0}, 10.0);
+  ASSERT_TRUE(above);
+  EXPECT_DOUBLE_EQ(above->first, 0.5);
+  EXPECT_DOUBLE_EQ(above->second, 0.7);
+  // No held point below the null (an equal one is not below): no search.
+  EXPECT_FALSE(profile_bracket(0.0, {0.08, 0.2}, {10.0, 12.0}, 10.0));
+  EXPECT_FALSE(profile_bracket(0.0, {}, {}, 10.0));
+}
+
 TEST(BaselineGrid, APlateauBesideTheLowestIsRefinedAtItsEdges) {
   using diagnosis::plateau_edges;
   // A tilt's chi^2 over mu_s: falling steeply to a valley narrower than a cell, then flat where
