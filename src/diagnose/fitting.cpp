@@ -147,6 +147,21 @@ bool ends_on_narrow_edge(const Context& c, const Model& from, const Model& fitte
   return false;
 }
 
+/// The base coefficients calibrated on `trials` the baseline's way, each on its own test's
+/// trials (fit_baseline): over the whole range, then narrowly; or, `near`, only narrowly from
+/// `start`'s (Pinning::Keep), the whole range when that ends on its edge.
+Result<Model> calibrate_each_test(Context& c, const Model& start, const std::vector<std::size_t>& trials, bool near,
+                                  Pinning pinning) {
+  if (near) {
+    auto narrow = fit_baseline(c, start, true, trials, Pinning::Keep);
+    if (!narrow) return std::unexpected(narrow.error());
+    if (!ends_on_narrow_edge(c, start, *narrow)) return narrow;
+  }
+  auto wide = fit_baseline(c, start, false, trials, pinning);
+  if (!wide) return std::unexpected(wide.error());
+  return fit_baseline(c, *wide, true, trials, pinning);
+}
+
 }  // namespace
 
 // A sphere's four-square composite on soil, mu_s 0.854: chi^2 7.1e5 at the wide grid's 0.819,
@@ -376,11 +391,9 @@ Result<Fitted> refit(Context& c, const Model& model, const EffectSpec* spec, con
 /// the others).
 Result<Fitted> fit_coefficients(Context& c, const Model& start, const std::vector<std::size_t>& trials,
                                 int max_evaluations, Pinning pinning) {
-  auto wide = fit_baseline(c, start, false, trials, pinning);
-  if (!wide) return std::unexpected(wide.error());
-  auto narrow = fit_baseline(c, *wide, true, trials, pinning);
-  if (!narrow) return std::unexpected(narrow.error());
-  return refit(c, *narrow, nullptr, trials, max_evaluations);
+  auto calibrated = calibrate_each_test(c, start, trials, false, pinning);
+  if (!calibrated) return std::unexpected(calibrated.error());
+  return refit(c, *calibrated, nullptr, trials, max_evaluations);
 }
 
 /// The base coefficients fitted on `trials` from another clump's of the same body (`start`): a
@@ -391,10 +404,9 @@ Result<Fitted> fit_coefficients(Context& c, const Model& start, const std::vecto
 /// windows leave unpinned stay as they are (Pinning::Keep).
 Result<Fitted> fit_coefficients_near(Context& c, const Model& start, const std::vector<std::size_t>& trials,
                                      int max_evaluations) {
-  auto narrow = fit_baseline(c, start, true, trials, Pinning::Keep);
-  if (!narrow) return std::unexpected(narrow.error());
-  if (ends_on_narrow_edge(c, start, *narrow)) return fit_coefficients(c, start, trials, max_evaluations, Pinning::Keep);
-  return refit(c, *narrow, nullptr, trials, max_evaluations);
+  auto calibrated = calibrate_each_test(c, start, trials, true, Pinning::Keep);
+  if (!calibrated) return std::unexpected(calibrated.error());
+  return refit(c, *calibrated, nullptr, trials, max_evaluations);
 }
 
 namespace {
@@ -429,25 +441,13 @@ Result<HeldPoint> calibrate_held(Context& c, Model from, double value, const std
                                  int& evaluations) {
   const int before = c.evaluations;
   from.values[0] = value;
-  Model held = from;
-  for (bool narrow : {false, true}) {
-    if (near && !narrow) continue;
-    auto calibrated = fit_baseline(c, held, narrow, which, Pinning::Keep);
-    if (!calibrated) return std::unexpected(calibrated.error());
-    held = *calibrated;
-  }
-  const auto count = [&] {
-    const auto replays = static_cast<std::size_t>(c.evaluations - before);
-    evaluations += static_cast<int>((replays + which.size() - 1) / std::max<std::size_t>(1, which.size()));
-  };
-  if (near && ends_on_narrow_edge(c, from, held)) {
-    count();
-    return calibrate_held(c, from, value, which, false, evaluations);
-  }
-  auto scores = score(c, held, which, false);
-  count();
+  auto held = calibrate_each_test(c, from, which, near, Pinning::Keep);
+  if (!held) return std::unexpected(held.error());
+  auto scores = score(c, *held, which, false);
+  const auto replays = static_cast<std::size_t>(c.evaluations - before);
+  evaluations += static_cast<int>((replays + which.size() - 1) / std::max<std::size_t>(1, which.size()));
   if (!scores) return std::unexpected(scores.error());
-  return HeldPoint{held, total_chi_squared(*scores)};
+  return HeldPoint{*held, total_chi_squared(*scores)};
 }
 
 /// The held starts of a fit that ended on the null (`best`, at `best_value`): the effect's first

@@ -1429,31 +1429,31 @@ TEST(EnsembleReplayMemo, AReplayAskedForAgainIsReadBackTheSameAndNoOtherIs) {
 
 TEST(HeldStarts, TheProfileIsSearchedOnTheSideOfTheNullTheBestHeldPointLiesOn) {
   using diagnosis::profile_bracket;
-  // The sphere's realistic EPSD rolling (compliance 0-200, off at 0): held at 16 and 40 (unit 0.08
-  // and 0.2), calibrated, chi^2 7.0e5 and more, both below the null's 1.47e6: searched from the
-  // null to the farther, where the profile's minimum (compliance 3) lies.
-  const auto rolling = profile_bracket(0.0, {0.08, 0.2}, {7.0e5, 1.2e6}, 1.47e6);
-  ASSERT_TRUE(rolling);
-  EXPECT_DOUBLE_EQ(rolling->first, 0.0);
-  EXPECT_DOUBLE_EQ(rolling->second, 0.2);
-  // Off at the upper end (the elastic-plastic yield speed, log scale): from the farther to it.
-  const auto yield = profile_bracket(1.0, {0.7, 0.4}, {9.0, 20.0}, 10.0);
-  ASSERT_TRUE(yield);
-  EXPECT_DOUBLE_EQ(yield->first, 0.4);
-  EXPECT_DOUBLE_EQ(yield->second, 1.0);
-  // Off in the middle (a centre-of-mass offset, +-4 mm: unit 0.5): only the best point's side,
-  // whichever is nearer.
-  const auto below = profile_bracket(0.5, {0.4, 0.7}, {8.0, 9.0}, 10.0);
-  ASSERT_TRUE(below);
-  EXPECT_DOUBLE_EQ(below->first, 0.4);
-  EXPECT_DOUBLE_EQ(below->second, 0.5);
-  const auto above = profile_bracket(0.5, {0.4, 0.7}, {11.0, 9.0}, 10.0);
-  ASSERT_TRUE(above);
-  EXPECT_DOUBLE_EQ(above->first, 0.5);
-  EXPECT_DOUBLE_EQ(above->second, 0.7);
+  struct Case {
+    double off;
+    std::vector<double> points, chi2s;
+    double low, high;
+  };
+  const std::vector<Case> cases{
+      // A rolling compliance (0-200, off at 0) held at 16 and 40 (unit 0.08 and 0.2), the nearer
+      // below the null once calibrated: searched from the null to the farther (the sphere's
+      // realistic EPSD rolling: the profile's minimum at compliance 3).
+      {0.0, {0.08, 0.2}, {7.0e5, 1.2e6}, 0.0, 0.2},
+      // Off at the upper end (the elastic-plastic yield speed, log scale): from the farther to it.
+      {1.0, {0.7, 0.4}, {9.0e5, 2.0e6}, 0.4, 1.0},
+      // Off in the middle (a centre-of-mass offset, +-4 mm: unit 0.5): only the best point's
+      // side, whichever is nearer.
+      {0.5, {0.4, 0.7}, {8.0e5, 9.0e5}, 0.4, 0.5},
+      {0.5, {0.4, 0.7}, {1.1e6, 9.0e5}, 0.5, 0.7}};
+  for (const Case& k : cases) {
+    const auto bracket = profile_bracket(k.off, k.points, k.chi2s, 1.0e6);
+    ASSERT_TRUE(bracket) << k.off;
+    EXPECT_DOUBLE_EQ(bracket->first, k.low);
+    EXPECT_DOUBLE_EQ(bracket->second, k.high);
+  }
   // No held point below the null (an equal one is not below): no search.
-  EXPECT_FALSE(profile_bracket(0.0, {0.08, 0.2}, {10.0, 12.0}, 10.0));
-  EXPECT_FALSE(profile_bracket(0.0, {}, {}, 10.0));
+  EXPECT_FALSE(profile_bracket(0.0, {0.08, 0.2}, {1.0e6, 1.2e6}, 1.0e6));
+  EXPECT_FALSE(profile_bracket(0.0, {}, {}, 1.0e6));
 }
 
 TEST(BaselineGrid, APlateauBesideTheLowestIsRefinedAtItsEdges) {
