@@ -238,8 +238,9 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_flag("--one-start", args->one_start,
                 "Fit each candidate from the null only: by default a fit that ends there (the effect switched off) "
                 "is started again from the effect held at the two points of its first search nearest the null, the "
-                "coefficients calibrated there first, and from the profile's minimum between them and the null when "
-                "it falls below the null (two rolling laws can need the effect up and a coefficient down together)");
+                "coefficients calibrated there first, and from the profile's minimum between the null and the better "
+                "one when that fits better than the null (two rolling laws can need the effect up and a coefficient "
+                "down together)");
   sub->add_option("--release-orientations", args->release_orientations,
                   "Release orientations drawn from each prior to find how long each trial stays predictable");
   add_output_option(*sub, args->out, "Directory for report.json, tracks.json and the figures (PNG, SVG)");

@@ -41,7 +41,8 @@ struct DiagnoseOptions {
   /// A candidate whose frame-by-frame fit ends on the null (its first parameter switched off) is
   /// fitted again from that parameter held at each of the two points of its first search nearest
   /// the null, the coefficients calibrated there first the baseline's way, and, when either lies
-  /// below the null, from the minimum of that profile between the null and them (fit_hypothesis).
+  /// below the null, from the minimum of that profile between the null and the held points on the
+  /// better one's side (fit_hypothesis).
   /// False: the one fit from the null.
   bool held_starts = true;
   double horizon_perturbation = 1e-4;  ///< [rad] release-orientation perturbation for the predictability horizon

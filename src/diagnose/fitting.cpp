@@ -471,7 +471,9 @@ Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<
   Minimum out{best, best_value, 0};
   const Model from = apply_parameters(start, parameters, best);
   const FitParameter& first = parameters[0];
-  std::vector<std::pair<double, Model>> held;  // unit value, calibrated model
+  const std::vector<double> points = grid_points_nearest(off, 2);
+  std::vector<Model> held;  // calibrated at each of `points`
+  std::vector<double> held_chi2s;
   auto fit_all_from = [&](const Model& model) -> Result<void> {
     auto all = levenberg_marquardt(c, start, parameters, which, unit_point(model, parameters), iterations);
     if (!all) return std::unexpected(all.error());
@@ -479,13 +481,11 @@ Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<
     if (all->value < out.value) out = Minimum{all->x, all->value, out.evaluations};
     return {};
   };
-  const std::vector<double> points = grid_points_nearest(off, 2);
-  std::vector<double> held_chi2s;
   for (double u : points) {
     auto point = calibrate_held(c, from, first.from_unit(u), which, false, out.evaluations);
     if (!point) return std::unexpected(point.error());
     held_chi2s.push_back(point->chi2);
-    held.emplace_back(u, point->model);
+    held.push_back(point->model);
     if (auto ok = fit_all_from(point->model); !ok) return std::unexpected(ok.error());
   }
   const auto bracket = profile_bracket(off, points, held_chi2s, best_value);
@@ -493,8 +493,9 @@ Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<
   std::optional<Error> failure;
   std::optional<HeldPoint> lowest;
   auto profile = [&](double u) {
-    const auto nearest = std::ranges::min_element(held, {}, [u](const auto& h) { return std::abs(h.first - u); });
-    auto point = calibrate_held(c, nearest->second, first.from_unit(u), which, true, out.evaluations);
+    const auto nearest = std::ranges::min_element(points, {}, [u](double p) { return std::abs(p - u); });
+    const Model& near = held[static_cast<std::size_t>(nearest - points.begin())];
+    auto point = calibrate_held(c, near, first.from_unit(u), which, true, out.evaluations);
     if (!point) {
       failure = point.error();
       return kNever;
