@@ -301,6 +301,8 @@ nlohmann::json hypotheses_json(const std::vector<HypothesisReport>& hypotheses) 
                    {"worsened_phases", h.worsened_phases},
                    {"passes", h.passes},
                    {"evaluations", h.evaluations},
+                   {"fit_start", std::string(fit_start_name(h.fit_start))},
+                   {"profile_searched", h.profile_searched},
                    {"smallest_detectable", finite_or_null(h.smallest_detectable)},
                    {"replay_shown", finite_or_null(h.replay_shown)},
                    {"strong_delta_chi2", finite_or_null(h.strong_delta_chi2)},

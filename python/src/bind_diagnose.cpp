@@ -26,6 +26,9 @@ void bind_enums(py::module_& m) {
   for (UndecidedBecause u : {UndecidedBecause::Nothing, UndecidedBecause::UnknownRelease,
                              UndecidedBecause::PartedTrials, UndecidedBecause::SetUps})
     because.value(std::string(undecided_because_name(u)).c_str(), u);
+  py::enum_<FitStart> fit_start(m, "FitStart");
+  for (FitStart f : {FitStart::FirstSearch, FitStart::NullKept, FitStart::HeldPoint, FitStart::Profile})
+    fit_start.value(std::string(fit_start_name(f)).c_str(), f);
   py::enum_<Phase> phase(m, "Phase");
   for (Phase p : {Phase::Hold, Phase::Flight, Phase::Impact, Phase::Rebound, Phase::SecondFlight, Phase::LaterBounces,
                   Phase::Incline, Phase::Transition, Phase::Flat, Phase::Rest, Phase::Stick, Phase::Slip})
@@ -86,6 +89,10 @@ void bind_parts(py::module_& m) {
       .def_readonly("passes", &HypothesisReport::passes)
       .def_readonly("worsened_phases", &HypothesisReport::worsened_phases)
       .def_readonly("evaluations", &HypothesisReport::evaluations)
+      .def_readonly("fit_start", &HypothesisReport::fit_start,
+                    "where the fit ended: first_search, or with held starts null_kept, held_point or profile")
+      .def_readonly("profile_searched", &HypothesisReport::profile_searched,
+                    "whether the held starts searched the first parameter's profile")
       .def_readonly("smallest_detectable", &HypothesisReport::smallest_detectable,
                     "with verdict none: the smallest magnitude of its first parameter these recordings would have "
                     "revealed (NaN where they do not decide the effect, and under any other verdict)")

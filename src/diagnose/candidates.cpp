@@ -173,6 +173,8 @@ Result<std::vector<Fitted>> candidates_stage(Context& c, DiagnoseResult& result,
     HypothesisReport report;
     report.name = spec.name;
     report.evaluations = fit->evaluations;
+    report.fit_start = fit->start;
+    report.profile_searched = fit->profile_searched;
     for (std::size_t k = 0; k < spec.parameters.size(); ++k)
       report.values.push_back({spec.parameters[k].name, fit->model.values[k], NAN, NAN});
     report.base = fit->model.base;

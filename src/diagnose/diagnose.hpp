@@ -167,6 +167,13 @@ struct SetUpShare {
   double delta_chi2 = 0.0;
 };
 
+/// Where a candidate's fit ended: from its first search (the grid over its first parameter, then
+/// Levenberg-Marquardt), or, when that ended on the null and held starts are on (fit_hypothesis),
+/// on the null still (no held start fitted better), from a held point, or from the profile's
+/// minimum between the null and the held points.
+enum class FitStart { FirstSearch, NullKept, HeldPoint, Profile };
+std::string_view fit_start_name(FitStart start);
+
 struct HypothesisReport {
   std::string name;
   /// False when no flagged phase had a large misfit for any candidate to clear: then none can
@@ -189,6 +196,10 @@ struct HypothesisReport {
   std::vector<std::string>
       worsened_phases;  ///< flagged phases it makes worse (training trials), with chi^2 per value before -> after
   int evaluations = 0;
+  FitStart fit_start = FitStart::FirstSearch;
+  /// Whether the held starts searched the first parameter's profile (a held point fitted better
+  /// than the null), whichever start won.
+  bool profile_searched = false;
   /// With verdict "none": the smallest magnitude of its first parameter these recordings would
   /// have revealed. Claimed only for an effect they decide (they reject its strong magnitude, see
   /// strong_delta_chi2); NaN otherwise (under any other verdict too), whatever a replay showed.

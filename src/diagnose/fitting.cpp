@@ -465,20 +465,31 @@ Result<HeldPoint> calibrate_held(Context& c, Model from, double value, const std
 /// coefficients), and fitted from there too: from compliance 16 alone the fit crept to 9.65
 /// (chi^2 3.0e5) along a valley the profile descends to 3.0 (1.6e3). The lowest chi^2 of all is
 /// returned.
-Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<FitParameter>& parameters,
+/// fit_from_held's lowest fit and where it came from.
+struct HeldFit {
+  Minimum minimum;
+  FitStart start = FitStart::NullKept;
+  bool profile_searched = false;
+};
+
+Result<HeldFit> fit_from_held(Context& c, const Model& start, const std::vector<FitParameter>& parameters,
                               const std::vector<std::size_t>& which, const std::vector<double>& best, double best_value,
                               double off, int iterations) {
-  Minimum out{best, best_value, 0};
+  HeldFit result{Minimum{best, best_value, 0}};
+  Minimum& out = result.minimum;
   const Model from = apply_parameters(start, parameters, best);
   const FitParameter& first = parameters[0];
   const std::vector<double> points = grid_points_nearest(off, 2);
   std::vector<Model> held;  // calibrated at each of `points`
   std::vector<double> held_chi2s;
-  auto fit_all_from = [&](const Model& model) -> Result<void> {
+  auto fit_all_from = [&](const Model& model, FitStart from_start) -> Result<void> {
     auto all = levenberg_marquardt(c, start, parameters, which, unit_point(model, parameters), iterations);
     if (!all) return std::unexpected(all.error());
     out.evaluations += all->evaluations;
-    if (all->value < out.value) out = Minimum{all->x, all->value, out.evaluations};
+    if (all->value < out.value) {
+      out = Minimum{all->x, all->value, out.evaluations};
+      result.start = from_start;
+    }
     return {};
   };
   for (double u : points) {
@@ -486,10 +497,11 @@ Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<
     if (!point) return std::unexpected(point.error());
     held_chi2s.push_back(point->chi2);
     held.push_back(point->model);
-    if (auto ok = fit_all_from(point->model); !ok) return std::unexpected(ok.error());
+    if (auto ok = fit_all_from(point->model, FitStart::HeldPoint); !ok) return std::unexpected(ok.error());
   }
   const auto bracket = profile_bracket(off, points, held_chi2s, best_value);
-  if (!bracket) return out;
+  if (!bracket) return result;
+  result.profile_searched = true;
   std::optional<Error> failure;
   std::optional<HeldPoint> lowest;
   auto profile = [&](double u) {
@@ -506,9 +518,9 @@ Result<Minimum> fit_from_held(Context& c, const Model& start, const std::vector<
   golden_section(profile, bracket->first, bracket->second, 1e-3, 12);
   if (failure) return std::unexpected(*failure);
   if (lowest) {
-    if (auto ok = fit_all_from(lowest->model); !ok) return std::unexpected(ok.error());
+    if (auto ok = fit_all_from(lowest->model, FitStart::Profile); !ok) return std::unexpected(ok.error());
   }
-  return out;
+  return result;
 }
 
 }  // namespace
@@ -611,9 +623,11 @@ Result<Fitted> fit_hypothesis(Context& c, const Model& baseline, const EffectSpe
   if (held_starts && std::abs(best_unit[0] - off) < 0.01) {
     auto held = fit_from_held(c, start, parameters, which, best_unit, best_value, off, max_evaluations / 5);
     if (!held) return std::unexpected(held.error());
-    out.evaluations += held->evaluations;
-    best_value = held->value;
-    best_unit = held->x;
+    out.evaluations += held->minimum.evaluations;
+    best_value = held->minimum.value;
+    best_unit = held->minimum.x;
+    out.start = held->start;
+    out.profile_searched = held->profile_searched;
   }
   out.model = apply_parameters(start, parameters, best_unit);
   out.chi2 = best_value;

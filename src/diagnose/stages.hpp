@@ -147,7 +147,9 @@ struct Fitted {
   Model model;
   double chi2 = 0.0;
   int evaluations = 0;
-  int values = 0;  ///< residual values behind chi2 (set by refit)
+  int values = 0;                          ///< residual values behind chi2 (set by refit)
+  FitStart start = FitStart::FirstSearch;  ///< set by fit_hypothesis
+  bool profile_searched = false;           ///< set by fit_hypothesis
 };
 
 /// [s] the wall clock since `t` (the report's comparison and rung times).

@@ -379,6 +379,20 @@ std::string_view undecided_because_name(UndecidedBecause because) {
   return "?";
 }
 
+std::string_view fit_start_name(FitStart start) {
+  switch (start) {
+    case FitStart::FirstSearch:
+      return "first_search";
+    case FitStart::NullKept:
+      return "null_kept";
+    case FitStart::HeldPoint:
+      return "held_point";
+    case FitStart::Profile:
+      return "profile";
+  }
+  return "?";
+}
+
 std::string_view basis_name(Basis basis) {
   switch (basis) {
     case Basis::Consistent:
