@@ -340,6 +340,13 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["noise_m"] = nlohmann::json::object();
   for (const auto& [name, s] : r.noise_m) j["noise_m"][name] = s;
   j["baseline"] = coefficients_json(r.baseline);
+  j["calibrated_per_test"] = coefficients_json(r.calibrated_per_test);
+  j["polish"] = nlohmann::json::array();
+  for (const PolishShare& p : r.polish)
+    j["polish"].push_back({{"surface", p.surface},
+                           {"test", std::string(to_string(p.test))},
+                           {"chi2_calibrated", p.chi2_calibrated},
+                           {"chi2_polished", p.chi2_polished}});
   j["refitted_on_all"] = r.refitted_on_all.empty() ? nlohmann::json() : coefficients_json(r.refitted_on_all);
   j["improved"] = coefficients_json(r.improved);
   j["uncalibrated"] = r.uncalibrated;

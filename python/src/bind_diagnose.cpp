@@ -75,6 +75,13 @@ void bind_parts(py::module_& m) {
       .def_readonly("surface", &SetUpShare::surface)
       .def_readonly("test", &SetUpShare::test)
       .def_readonly("delta_chi2", &SetUpShare::delta_chi2);
+  py::class_<PolishShare>(m, "PolishShare",
+                          "One set-up's training chi^2 with each coefficient calibrated on its own test, and "
+                          "after the joint polish.")
+      .def_readonly("surface", &PolishShare::surface)
+      .def_readonly("test", &PolishShare::test)
+      .def_readonly("chi2_calibrated", &PolishShare::chi2_calibrated)
+      .def_readonly("chi2_polished", &PolishShare::chi2_polished);
   py::class_<HypothesisReport>(m, "HypothesisReport", "One candidate effect as fitted and tested.")
       .def_readonly("name", &HypothesisReport::name)
       .def_readonly("fitted", &HypothesisReport::fitted)
@@ -243,6 +250,9 @@ void bind_result(py::module_& m) {
       .def_readonly("experiment", &DiagnoseResult::experiment)
       .def_readonly("effect_parameters", &DiagnoseResult::effect_parameters)
       .def_readonly("baseline", &DiagnoseResult::baseline)
+      .def_readonly("calibrated_per_test", &DiagnoseResult::calibrated_per_test,
+                    "the base coefficients each calibrated on its own test's trials, before the joint polish")
+      .def_readonly("polish", &DiagnoseResult::polish)
       .def_readonly("improved", &DiagnoseResult::improved)
       .def_readonly("uncalibrated", &DiagnoseResult::uncalibrated)
       .def_readonly("before", &DiagnoseResult::before)

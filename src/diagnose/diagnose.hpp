@@ -174,6 +174,15 @@ struct SetUpShare {
 enum class FitStart { FirstSearch, NullKept, HeldPoint, Profile };
 std::string_view fit_start_name(FitStart start);
 
+/// One set-up's training chi^2 under the base coefficients each calibrated on its own test's
+/// trials, and under the baseline they are then polished to jointly (DiagnoseResult::polish).
+struct PolishShare {
+  std::string surface;
+  LabTest test = LabTest::Drop;
+  double chi2_calibrated = 0.0;
+  double chi2_polished = 0.0;
+};
+
 struct HypothesisReport {
   std::string name;
   /// False when no flagged phase had a large misfit for any candidate to clear: then none can
@@ -400,6 +409,12 @@ struct DiagnoseResult {
   std::vector<ParameterValue> effect_parameters;
   std::vector<std::pair<std::string, double>> noise_m;  ///< per recording, estimated
   std::vector<SurfaceParameters> baseline, improved;
+  /// The base coefficients each calibrated on its own test's training trials, before the joint
+  /// polish that gives `baseline`. A coefficient the polish moves far from its own test's value is
+  /// pulled there by the other tests' misfit: what it gains there and loses in its own test is in
+  /// `polish`.
+  std::vector<SurfaceParameters> calibrated_per_test;
+  std::vector<PolishShare> polish;  ///< each set-up's training chi^2 before and after the polish
   std::vector<std::string>
       uncalibrated;  ///< "surface:coefficient" the fitted parts of the tracks do not pin (the starting value kept)
   std::vector<SurfaceParameters> refitted_on_all;  ///< the second null's coefficients (every trial), when it was needed

@@ -291,6 +291,30 @@ Result<bool> recorded_horizons(Context& c, DiagnoseResult& result, const Model& 
   return changed;
 }
 
+/// Each set-up's training chi^2 under `calibrated` (the coefficients each on its own test) and
+/// `polished` (the joint polish from there).
+namespace {
+
+Result<std::vector<PolishShare>> polish_shares(Context& c, const Model& calibrated, const Model& polished) {
+  const auto& recs = *c.ev.recordings;
+  auto before = score(c, calibrated, c.training, false);
+  if (!before) return std::unexpected(before.error());
+  auto after = score(c, polished, c.training, false);
+  if (!after) return std::unexpected(after.error());
+  std::vector<PolishShare> out;
+  for (std::size_t k = 0; k < c.training.size(); ++k) {
+    const Recording& r = recs[c.ev.trials[c.training[k]].recording];
+    auto it =
+        std::ranges::find_if(out, [&](const PolishShare& p) { return p.surface == r.surface && p.test == r.test; });
+    if (it == out.end()) it = out.insert(out.end(), PolishShare{r.surface, r.test, 0.0, 0.0});
+    it->chi2_calibrated += (*before)[k].alignment.chi_squared;
+    it->chi2_polished += (*after)[k].alignment.chi_squared;
+  }
+  return out;
+}
+
+}  // namespace
+
 /// Stage 4, baseline: e, mu_s and mu_r per surface on the training trials (each on its own
 /// test over a wide grid, then together), the horizons set again under it; the coefficients
 /// the fitted windows do not pin are said to be uncalibrated.
@@ -317,6 +341,10 @@ Result<Model> baseline_stage(Context& c, DiagnoseResult& result, Model baseline,
   // Again: each coefficient now fitted with the others near their values.
   auto polished = fit_coefficients(c, baseline, c.training, options.max_evaluations);
   if (!polished) return std::unexpected(polished.error());
+  auto shares = polish_shares(c, polished->calibrated, polished->model);
+  if (!shares) return std::unexpected(shares.error());
+  result.calibrated_per_test = polished->calibrated.base;
+  result.polish = std::move(*shares);
   baseline = polished->model;
   result.baseline = baseline.base;
   for (const auto& [surface, coefficient] : c.unpinned) {

@@ -393,7 +393,9 @@ Result<Fitted> fit_coefficients(Context& c, const Model& start, const std::vecto
                                 int max_evaluations, Pinning pinning) {
   auto calibrated = calibrate_each_test(c, start, trials, false, pinning);
   if (!calibrated) return std::unexpected(calibrated.error());
-  return refit(c, *calibrated, nullptr, trials, max_evaluations);
+  auto polished = refit(c, *calibrated, nullptr, trials, max_evaluations);
+  if (polished) polished->calibrated = std::move(*calibrated);
+  return polished;
 }
 
 /// The base coefficients fitted on `trials` from another clump's of the same body (`start`): a

@@ -150,6 +150,8 @@ struct Fitted {
   int values = 0;                          ///< residual values behind chi2 (set by refit)
   FitStart start = FitStart::FirstSearch;  ///< set by fit_hypothesis
   bool profile_searched = false;           ///< set by fit_hypothesis
+  /// fit_coefficients' start for its joint polish: each coefficient calibrated on its own test.
+  Model calibrated;
 };
 
 /// [s] the wall clock since `t` (the report's comparison and rung times).

@@ -282,6 +282,20 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
       EXPECT_GE(flight_misfit, 2.0);
     else
       EXPECT_NEAR(flight_misfit, 1.0, 0.5);
+    // The baseline's polish: each set-up's chi^2 before and after, once each; the polish never
+    // makes the whole worse (Levenberg-Marquardt from the per-test calibration keeps its start
+    // unless it gains).
+    ASSERT_EQ(result->calibrated_per_test.size(), result->baseline.size());
+    ASSERT_FALSE(result->polish.empty());
+    double calibrated = 0.0, polished = 0.0;
+    for (std::size_t k = 0; k < result->polish.size(); ++k) {
+      const PolishShare& p = result->polish[k];
+      EXPECT_EQ(p.test, LabTest::Drop) << p.surface;
+      for (std::size_t m = 0; m < k; ++m) EXPECT_NE(result->polish[m].surface, p.surface);
+      calibrated += p.chi2_calibrated;
+      polished += p.chi2_polished;
+    }
+    EXPECT_LE(polished, calibrated * (1.0 + 1e-9));
     if (!with_drag) {
       EXPECT_EQ(result->verdict, Verdict::None) << result->statement;
       EXPECT_NEAR(result->before.train_rms_mm, 0.1, 0.02);  // the camera's noise, nothing else
@@ -301,6 +315,11 @@ TEST(DiagnoseBlind, ControlGivesNoneAndStrongDragIsNamed) {
     } else {
       ASSERT_EQ(result->verdict, Verdict::Named) << result->statement;
       ASSERT_EQ(result->effect, Effect::AirDrag);
+      // Strong drag is found by the first search; no held start is needed.
+      const auto drag = std::ranges::find(result->hypotheses, std::string("air_drag"), &HypothesisReport::name);
+      ASSERT_NE(drag, result->hypotheses.end());
+      EXPECT_EQ(drag->fit_start, FitStart::FirstSearch);
+      EXPECT_FALSE(drag->profile_searched);
       ASSERT_EQ(result->effect_parameters.size(), 1u);
       EXPECT_NEAR(result->effect_parameters[0].value, 1.5, 0.3);
       EXPECT_LT(result->after.heldout_rms_mm, 0.5 * result->before.heldout_rms_mm);
