@@ -236,6 +236,14 @@ def test_diagnose_from_python_names_the_bundled_air_drag_and_reports_each_candid
         assert math.isnan(h.strong_delta_chi2) and math.isnan(h.strong_resolution_chi2)
         assert h.strong_preferred_in == [] and h.preferred_alone() is None
     assert {"surface", "test", "delta_chi2"} <= set(dir(cf.SetUpShare))
+    # Strong enough to be found by the first search: no held start was needed.
+    assert by_name["air_drag"].fit_start == cf.FitStart.first_search
+    assert not by_name["air_drag"].profile_searched
+    # The baseline's polish, per set-up: what each test's chi^2 was with the coefficients each
+    # calibrated on its own test, and after; the polish never makes the whole worse.
+    assert len(result.calibrated_per_test) == len(result.baseline)
+    assert result.polish and all(isinstance(p.test, cf.LabTest) for p in result.polish)
+    assert sum(p.chi2_polished for p in result.polish) <= sum(p.chi2_calibrated for p in result.polish) * (1 + 1e-9)
     # The drag shows in the drops' first flights: their misfit against the camera noise reaches
     # the level (2) at which candidates are fitted frame by frame.
     flights = [p for p in result.phases if p.phase == cf.Phase.flight]
