@@ -9,6 +9,7 @@
 #include "batch/batch.hpp"
 #include "core/rng.hpp"
 #include "core/sha256.hpp"
+#include "core/text.hpp"
 #include "dem/lab.hpp"
 #include "dem/materials.hpp"
 #include "fill/body.hpp"
@@ -51,6 +52,14 @@ Result<std::vector<ScanItem>> list_scans(std::span<const fs::path> inputs) {
                   fmt::format("'{}': the scan's file name is not UTF-8 text; it names the results in JSON and CSV "
                               "records, so rename the file",
                               file.string()));
+    // The name is also an HDF5 group of library.h5 ("." names the group itself) and a field of
+    // the records the ranks exchange, separated by a control character (joined in run_batch).
+    if (name == "." || std::ranges::any_of(name, [](unsigned char ch) { return ch < 0x20 || ch == 0x7f; }))
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("'{}': the scan's file name {}; it names the scan's group in library.h5 and its "
+                              "records, so rename the file",
+                              one_line_text(file.string()),
+                              name == "." ? "is '.' before its extension" : "holds a control character"));
     if (by_name.contains(name))
       return fail(ErrorCode::InvalidArgument, fmt::format("two scans are named '{}' ('{}' and '{}'): names must be "
                                                           "unique, they name the results",

@@ -119,6 +119,25 @@ TEST_F(BatchCli, AbsurdOptionsAreRefusedWritingNothing) {
   EXPECT_NE(not_utf8.err.find("tub\\xFFr.stl': the scan's file name is not UTF-8 text"), std::string::npos)
       << not_utf8.err;
   EXPECT_FALSE(fs::exists(dir_ / "x"));
+  // Names the library cannot hold as a group ('.': "..stl") or that hold a control character (a
+  // line break, the ranks' record separator): refused before any work, the name on one line.
+  for (const auto& [file, problem] : {std::pair<std::string, std::string>{"..stl", "is '.' before its extension"},
+                                      {"tub\ner.stl", "holds a control character"},
+                                      {"tub\x1F"
+                                       "er.stl",
+                                       "holds a control character"}}) {
+    SCOPED_TRACE(file);
+    const fs::path folder = dir_ / "names";
+    fs::remove_all(folder);
+    fs::create_directories(folder);
+    fs::copy_file(scans() / "tuber-01.stl", folder / file);
+    const auto refused =
+        test::run_clumpforge(fmt::format("batch '{}' -o '{}'", folder.string(), (dir_ / "x").string()));
+    EXPECT_EQ(refused.exit_code, 1) << refused.err;
+    EXPECT_NE(refused.err.find("the scan's file name " + problem), std::string::npos) << refused.err;
+    EXPECT_EQ(refused.err.find('\n'), refused.err.size() - 1) << refused.err;  // one line
+    EXPECT_FALSE(fs::exists(dir_ / "x"));
+  }
 }
 
 }  // namespace
