@@ -35,6 +35,7 @@
 #include "diagnose/ensemble.hpp"
 #include "diagnose/flights.hpp"
 #include "diagnose_job.hpp"
+#include "fit_starts.hpp"
 #include "flight_levels.hpp"
 #include "io/clump_library.hpp"
 #include "io/recording_io.hpp"
@@ -491,6 +492,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   std::vector<GateCase> gates;
   std::vector<FarCase> fars;
   std::vector<bench::FlightLevels> flights;
+  std::vector<bench::FitStarts> starts;
   std::vector<std::pair<std::string, std::optional<bench::TwinShift>>> missed_twins;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
@@ -528,6 +530,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
     gates.push_back(gate_case(j));
     fars.push_back(far_case(j, effect == "none"));
     flights.push_back(bench::flight_levels(j, id, effect == "none"));
+    starts.push_back(bench::fit_starts(j, id));
     contradicts.push_back(advice_contradicts_verdict(j));
     table += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {:.1f} % | {:.0f} | {} |\n", id,
                          answer.value("particle", "?"), answer.value("label", effect), verdict, j.value("basis", "?"),
@@ -568,6 +571,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   table += gate_line(gates, summary);
   table += far_outcome_line(fars, summary);
   table += bench::flight_level_lines(flights, FlightWobbleOptions{}.noise_margin, summary);
+  table += bench::fit_start_line(starts, summary);
   std::cout << "\n" << table;
   summary.update(nlohmann::json{{"set", set.string()},
                                 {"effects", effects},
@@ -614,6 +618,7 @@ struct CaseScore {
   GateCase gate;                           ///< gate_case of its report
   FarCase far;                             ///< far_case of its report
   bench::FlightLevels flights;             ///< flight_levels of its report
+  bench::FitStarts starts;                 ///< fit_starts of its report
   std::optional<bench::TwinShift> twin;    ///< from its answer's twins (nullopt: a control, or none stored)
 };
 
@@ -646,6 +651,7 @@ std::optional<CaseScore> read_case_score(const fs::path& report, const std::stri
   o.gate = gate_case(j);
   o.far = far_case(j, truth == "none");
   o.flights = bench::flight_levels(j, "", truth == "none");
+  o.starts = bench::fit_starts(j, "");
   if (j.contains("stage_seconds") && j["stage_seconds"].is_array()) {
     for (const auto& st : j["stage_seconds"]) o.stages.emplace_back(st.value("stage", "?"), st.value("seconds", kNaN));
   }
@@ -676,14 +682,17 @@ std::string time_summary(const std::vector<CaseScore>& outcomes, nlohmann::json&
   std::vector<GateCase> gates;
   std::vector<FarCase> fars;
   std::vector<bench::FlightLevels> flights;
+  std::vector<bench::FitStarts> starts;
   for (const auto& o : outcomes) {
     gates.push_back(o.gate);
     fars.push_back(o.far);
     flights.push_back(o.flights);
+    starts.push_back(o.starts);
   }
   md += gate_line(gates, summary);
   md += far_outcome_line(fars, summary);
   md += bench::flight_level_lines(flights, FlightWobbleOptions{}.noise_margin, summary);
+  md += bench::fit_start_line(starts, summary);
   if (order.empty()) return md;
   md += "\n| stage | median share of a case |\n|---|---:|\n";
   for (const auto& stage : order) {
@@ -1157,6 +1166,7 @@ int score_generated(const std::vector<Case>& cases, const std::string& out) {
     }
     o->id = c.id;
     o->flights.id = c.id;
+    o->starts.id = c.id;
     if (c.effect) {
       o->concealed = effect_part(c).values.at(0);
       o->null_value = effect_off(effect_spec(library, *c.effect))[0];
