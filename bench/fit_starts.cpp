@@ -3,15 +3,9 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <array>
-#include <string_view>
+#include "diagnose/diagnose.hpp"
 
 namespace clumpforge::bench {
-
-namespace {
-/// The report's fit_start values, in the order the line gives them.
-constexpr std::array<std::string_view, 4> kStarts = {"first_search", "null_kept", "held_point", "profile"};
-}  // namespace
 
 FitStarts fit_starts(const nlohmann::json& report, const std::string& id) {
   FitStarts out;
@@ -44,10 +38,11 @@ std::string fit_start_line(const std::vector<FitStarts>& cases, nlohmann::json& 
   }
   std::vector<std::string> parts;
   nlohmann::json& j = summary["fit_starts"];
-  for (std::string_view start : kStarts) {
-    const int n = counts.contains(std::string(start)) ? counts[std::string(start)] : 0;
+  for (FitStart f : {FitStart::FirstSearch, FitStart::NullKept, FitStart::HeldPoint, FitStart::Profile}) {
+    const std::string start(fit_start_name(f));
+    const int n = counts[start];
     parts.push_back(fmt::format("{} {}", start, n));
-    j["counts"][std::string(start)] = n;
+    j["counts"][start] = n;
   }
   j["cases_read"] = read;
   j["profile_searched"] = profiled;

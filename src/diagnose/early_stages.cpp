@@ -291,10 +291,10 @@ Result<bool> recorded_horizons(Context& c, DiagnoseResult& result, const Model& 
   return changed;
 }
 
-/// Each set-up's training chi^2 under `calibrated` (the coefficients each on its own test) and
-/// `polished` (the joint polish from there).
 namespace {
 
+/// Each set-up's training chi^2 under `calibrated` (the coefficients each on its own test) and
+/// `polished` (the joint polish from there).
 Result<std::vector<PolishShare>> polish_shares(Context& c, const Model& calibrated, const Model& polished) {
   const auto& recs = *c.ev.recordings;
   auto before = score(c, calibrated, c.training, false);
@@ -338,12 +338,15 @@ Result<Model> baseline_stage(Context& c, DiagnoseResult& result, Model baseline,
     baseline = *again;
     if (auto ok = set_horizons(c, baseline, options.horizon_perturbation); !ok) return std::unexpected(ok.error());
   }
-  // Again: each coefficient now fitted with the others near their values.
-  auto polished = fit_coefficients(c, baseline, c.training, options.max_evaluations);
+  // Again: each coefficient now fitted with the others near their values (fit_coefficients'
+  // two steps, each kept for the report).
+  auto calibrated = calibrate_each_test(c, baseline, c.training, false, Pinning::Decide);
+  if (!calibrated) return std::unexpected(calibrated.error());
+  auto polished = refit(c, *calibrated, nullptr, c.training, options.max_evaluations);
   if (!polished) return std::unexpected(polished.error());
-  auto shares = polish_shares(c, polished->calibrated, polished->model);
+  auto shares = polish_shares(c, *calibrated, polished->model);
   if (!shares) return std::unexpected(shares.error());
-  result.calibrated_per_test = polished->calibrated.base;
+  result.calibrated_per_test = calibrated->base;
   result.polish = std::move(*shares);
   baseline = polished->model;
   result.baseline = baseline.base;

@@ -147,9 +147,8 @@ bool ends_on_narrow_edge(const Context& c, const Model& from, const Model& fitte
   return false;
 }
 
-/// The base coefficients calibrated on `trials` the baseline's way, each on its own test's
-/// trials (fit_baseline): over the whole range, then narrowly; or, `near`, only narrowly from
-/// `start`'s (Pinning::Keep), the whole range when that ends on its edge.
+}  // namespace
+
 Result<Model> calibrate_each_test(Context& c, const Model& start, const std::vector<std::size_t>& trials, bool near,
                                   Pinning pinning) {
   if (near) {
@@ -161,8 +160,6 @@ Result<Model> calibrate_each_test(Context& c, const Model& start, const std::vec
   if (!wide) return std::unexpected(wide.error());
   return fit_baseline(c, *wide, true, trials, pinning);
 }
-
-}  // namespace
 
 // A sphere's four-square composite on soil, mu_s 0.854: chi^2 7.1e5 at the wide grid's 0.819,
 // 3.50e4 from 0.915 to 1.3 within 0.1 %, and the minimum near 0.852. The grid's lowest, 1.3 by
@@ -393,9 +390,7 @@ Result<Fitted> fit_coefficients(Context& c, const Model& start, const std::vecto
                                 int max_evaluations, Pinning pinning) {
   auto calibrated = calibrate_each_test(c, start, trials, false, pinning);
   if (!calibrated) return std::unexpected(calibrated.error());
-  auto polished = refit(c, *calibrated, nullptr, trials, max_evaluations);
-  if (polished) polished->calibrated = std::move(*calibrated);
-  return polished;
+  return refit(c, *calibrated, nullptr, trials, max_evaluations);
 }
 
 /// The base coefficients fitted on `trials` from another clump's of the same body (`start`): a
@@ -452,6 +447,13 @@ Result<HeldPoint> calibrate_held(Context& c, Model from, double value, const std
   return HeldPoint{*held, total_chi_squared(*scores)};
 }
 
+/// fit_from_held's lowest fit and where it came from.
+struct HeldFit {
+  Minimum minimum;
+  FitStart start = FitStart::NullKept;
+  bool profile_searched = false;
+};
+
 /// The held starts of a fit that ended on the null (`best`, at `best_value`): the effect's first
 /// parameter held at the two points of the first search nearest the null, the coefficients
 /// calibrated there the baseline's way (calibrate_held), then everything fitted from there by
@@ -467,13 +469,6 @@ Result<HeldPoint> calibrate_held(Context& c, Model from, double value, const std
 /// coefficients), and fitted from there too: from compliance 16 alone the fit crept to 9.65
 /// (chi^2 3.0e5) along a valley the profile descends to 3.0 (1.6e3). The lowest chi^2 of all is
 /// returned.
-/// fit_from_held's lowest fit and where it came from.
-struct HeldFit {
-  Minimum minimum;
-  FitStart start = FitStart::NullKept;
-  bool profile_searched = false;
-};
-
 Result<HeldFit> fit_from_held(Context& c, const Model& start, const std::vector<FitParameter>& parameters,
                               const std::vector<std::size_t>& which, const std::vector<double>& best, double best_value,
                               double off, int iterations) {

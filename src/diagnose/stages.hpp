@@ -150,8 +150,6 @@ struct Fitted {
   int values = 0;                          ///< residual values behind chi2 (set by refit)
   FitStart start = FitStart::FirstSearch;  ///< set by fit_hypothesis
   bool profile_searched = false;           ///< set by fit_hypothesis
-  /// fit_coefficients' start for its joint polish: each coefficient calibrated on its own test.
-  Model calibrated;
 };
 
 /// [s] the wall clock since `t` (the report's comparison and rung times).
@@ -283,6 +281,12 @@ std::optional<std::pair<double, double>> profile_bracket(double off, const std::
                                                          const std::vector<double>& chi2s, double null_chi2);
 Result<Model> fit_baseline(Context& c, Model model, bool narrow, const std::vector<std::size_t>& trials,
                            Pinning pinning = Pinning::Decide);
+/// The base coefficients calibrated on `trials` the baseline's way, each on its own test's
+/// trials (fit_baseline): over the whole range, then narrowly; or, `near`, only narrowly from
+/// `start`'s (Pinning::Keep), the whole range when that ends on its edge. fit_coefficients and
+/// fit_coefficients_near polish the result jointly (refit).
+Result<Model> calibrate_each_test(Context& c, const Model& start, const std::vector<std::size_t>& trials, bool near,
+                                  Pinning pinning);
 Result<Minimum> levenberg_marquardt(Context& c, const Model& start, const std::vector<FitParameter>& parameters,
                                     const std::vector<std::size_t>& which, std::vector<double> unit, int iterations);
 std::pair<Model, std::vector<FitParameter>> fit_parameters(const Context& c, const Model& model, const EffectSpec* spec,
