@@ -100,9 +100,11 @@ void bind_parts(py::module_& m) {
                     "where the fit ended: first_search, or with held starts null_kept, held_point or profile")
       .def_readonly("profile_searched", &HypothesisReport::profile_searched,
                     "whether the held starts searched the first parameter's profile")
-      .def_readonly("smallest_detectable", &HypothesisReport::smallest_detectable,
-                    "with verdict none: the smallest magnitude of its first parameter these recordings would have "
-                    "revealed (NaN where they do not decide the effect, and under any other verdict)")
+      .def_readonly(
+          "smallest_detectable", &HypothesisReport::smallest_detectable,
+          "with verdict none: the smallest magnitude of its first parameter these recordings would have "
+          "revealed: a replay shows it and the recordings reject it (NaN where they do not decide the effect, and "
+          "under any other verdict)")
       .def_readonly("replay_shown", &HypothesisReport::replay_shown,
                     "with verdict none: the smallest magnitude a replay of the diagnosed clump showed (NaN: none)")
       .def_readonly("strong_delta_chi2", &HypothesisReport::strong_delta_chi2,

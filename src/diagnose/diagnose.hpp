@@ -212,6 +212,8 @@ struct HypothesisReport {
   /// With verdict "none": the smallest magnitude of its first parameter these recordings would
   /// have revealed. Claimed only for an effect they decide (they reject its strong magnitude, see
   /// strong_delta_chi2); NaN otherwise (under any other verdict too), whatever a replay showed.
+  /// The smallest tried that a replay showed (replay_shown or above) and the recordings reject by
+  /// the same whole check as the strong magnitude (releases, refit, finer clump, recalibration).
   double smallest_detectable = NAN;
   /// With verdict "none": the smallest magnitude of its first parameter at which a replay of the
   /// diagnosed clump showed against the baseline (the coefficients absorbing what they can to

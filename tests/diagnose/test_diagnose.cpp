@@ -423,9 +423,11 @@ TEST(DiagnoseBlind, AStrongEffectWhosePathHangsOnTheReleaseIsNotCalledAbsent) {
 // at 6ac3aa3 claimed 0.0009 and 0.0006 with 0.1 and 0.25 hidden, and lab-like case-21, a sphere
 // with adhesion of about 0.08 J/m^2 left unnamed, 0.0096 (0.079 replay-checked).
 // A limit is claimed only for an effect the recordings decide (they reject its strong
-// magnitude); here they reject the strong 0.25, and the replay figure, 0.078, is claimed with
-// 0.1 hidden: the 32-sphere clump responds more than the 340-sphere body. Refitting the
-// coefficients to the replays at 0.078 (tried, not kept) still shows it.
+// magnitude); here they reject the strong 0.25. Until f01998e the replay's figure, 0.078, was
+// claimed with 0.1 hidden: the 32-sphere clump responds more than the 340-sphere body. Since
+// the commit after it the claim must pass the strong magnitude's whole check itself
+// (checked_limit): the recordings do not reject 0.078, nor the two magnitudes tried above it,
+// and the strong 0.25 is claimed. No limit at or below the hidden 0.1 may be claimed.
 TEST(DiagnoseBlind, TheSmallestDetectableEffectIsOneAReplayShowed) {
   ConcealOptions conceal = test::one_metre_drops(Effect::StaticKineticFriction, {0.1});
   conceal.drop_heights = {};
@@ -440,10 +442,13 @@ TEST(DiagnoseBlind, TheSmallestDetectableEffectIsOneAReplayShowed) {
   const HypothesisReport* drop = hypothesis_named(*result, "static_kinetic_friction");
   ASSERT_NE(drop, nullptr);
   RecordProperty("replay_shown", std::to_string(drop->replay_shown));
+  RecordProperty("smallest_detectable", std::to_string(drop->smallest_detectable));
   EXPECT_GT(drop->replay_shown, 0.5 * 0.1) << result->statement;
   const bool undecided =
       std::count(result->undecidable.begin(), result->undecidable.end(), "static_kinetic_friction") == 1;
   EXPECT_EQ(std::isfinite(drop->smallest_detectable), !undecided) << result->statement;
+  EXPECT_FALSE(drop->smallest_detectable <= 0.1) << result->statement;
+  EXPECT_FALSE(drop->smallest_detectable < drop->replay_shown) << result->statement;
 }
 
 // A `none` must not call absent an effect whose strong magnitude the null's coefficients could
