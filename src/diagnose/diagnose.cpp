@@ -156,6 +156,7 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     if (auto ok = ensemble_stage(c, result, baseline, *full_base, effects, options); !ok)
       return std::unexpected(ok.error());
   }
+  withdraw_limits(result);
   ask_for_deciding_experiments(result);
   say_which_were_asked(result, options);
   track_plots(c, result, *full_base, *full_improved);

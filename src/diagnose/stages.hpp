@@ -497,6 +497,12 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
                       const Groups& final_groups, const DiagnoseOptions& options);
 
 void ask_for_deciding_experiments(DiagnoseResult& result);
+/// A smallest detectable magnitude is a `none`'s claim (HypothesisReport::smallest_detectable):
+/// where a later stage (the flights, the ensembles) made the verdict another one, each is set to
+/// NaN, and a note keeps what was withdrawn (the generated 240 fps set's strong friction drop at
+/// f783278: a frame-by-frame `none` claimed a drop of 0.070 with 0.25 hidden, and the ensembles
+/// then made the verdict `undecidable`, the claim left standing).
+void withdraw_limits(DiagnoseResult& result);
 /// When DiagnoseOptions::effects asks about only part of the library, the statement says which
 /// were asked: a verdict among them is not one over the library (lab-like case-10's 35 mm roll,
 /// a sphere with its mass off its centre, asked about the static-kinetic friction drop alone,

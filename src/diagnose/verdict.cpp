@@ -318,6 +318,21 @@ void ask_for_deciding_experiments(DiagnoseResult& result) {
   }
 }
 
+void withdraw_limits(DiagnoseResult& result) {
+  if (result.verdict == Verdict::None) return;
+  std::vector<std::string> withdrawn;
+  for (HypothesisReport& h : result.hypotheses) {
+    if (!std::isfinite(h.smallest_detectable)) continue;
+    withdrawn.push_back(fmt::format("{} {:.3g}", h.name, h.smallest_detectable));
+    h.smallest_detectable = NAN;
+  }
+  if (!withdrawn.empty())
+    result.notes.push_back(fmt::format(
+        "the smallest detectable effects found before the verdict became {} are withdrawn (a limit is a none's "
+        "claim): {}",
+        verdict_name(result), fmt::join(withdrawn, ", ")));
+}
+
 void say_which_were_asked(DiagnoseResult& result, const DiagnoseOptions& options) {
   const std::size_t library = effect_library().size();
   if (options.effects.empty() || options.effects.size() >= library) return;

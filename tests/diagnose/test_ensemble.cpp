@@ -1007,6 +1007,40 @@ TEST(EnsembleUnconvergedLadder, AnAgreementThatMovesWithTheResolutionLeavesEvery
   EXPECT_NE(result.statement.find("from 128 to 256 spheres"), std::string::npos) << result.statement;
 }
 
+// A smallest detectable magnitude is a `none`'s claim: where the ensembles made the verdict
+// `undecidable` after a frame-by-frame `none` had claimed limits (the generated 240 fps set's
+// strong friction drop at f783278: 0.070 claimed with 0.25 hidden), each is withdrawn, with a
+// note; a `none` keeps its own.
+TEST(EnsembleUnconvergedLadder, AVerdictThatIsNoLongerNoneWithdrawsTheLimits) {
+  for (const Verdict verdict : {Verdict::Undecidable, Verdict::None}) {
+    DiagnoseResult result;
+    result.verdict = Verdict::None;
+    for (const char* name : {"static_kinetic_friction", "air_drag", "adhesion"})
+      result.hypotheses.push_back({.name = name});
+    result.hypotheses[0].smallest_detectable = 0.0702;
+    result.hypotheses[1].smallest_detectable = 0.179;
+    result.hypotheses[0].replay_shown = 0.0702;
+    if (verdict == Verdict::Undecidable) {
+      const ParticleModelCheck check = ladder(64, 3, 16, 1e-5, 3.3);
+      diagnosis::undecided_by_resolution(result, check.rungs[1], check.rungs[2], {Effect::StaticKineticFriction});
+      ASSERT_EQ(result.verdict, Verdict::Undecidable);
+    }
+    const std::size_t notes = result.notes.size();
+    diagnosis::withdraw_limits(result);
+    if (verdict == Verdict::None) {
+      EXPECT_EQ(result.hypotheses[0].smallest_detectable, 0.0702);
+      EXPECT_EQ(result.hypotheses[1].smallest_detectable, 0.179);
+      EXPECT_EQ(result.notes.size(), notes);
+      continue;
+    }
+    for (const HypothesisReport& h : result.hypotheses) EXPECT_TRUE(std::isnan(h.smallest_detectable)) << h.name;
+    EXPECT_EQ(result.hypotheses[0].replay_shown, 0.0702);  // what a replay showed is not a claim
+    ASSERT_EQ(result.notes.size(), notes + 1);
+    EXPECT_NE(result.notes.back().find("static_kinetic_friction 0.0702, air_drag 0.179"), std::string::npos)
+        << result.notes.back();
+  }
+}
+
 // The same candidate on a converged ladder where no candidate passes on the finest clump
 // (judge_on_converged_clump): not needed on the converged particle model, whose null still
 // misses, so the verdict is unexplained on the finest clump's comparison, never the diagnosed
