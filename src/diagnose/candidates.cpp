@@ -652,25 +652,35 @@ Result<ReplayShown> replay_shown(Context& c, CellProbe& cells, const Model& base
 /// How many magnitudes the check of a claimed limit tries at most (checked_limit).
 constexpr int kLimitChecks = 3;
 
+/// What the whole check said of a candidate at a fraction of its strong magnitude (rejected_at).
+struct CheckedAt {
+  bool rejected = false;
+  double delta_chi2 = NAN;       ///< the least rejection found (negative: the recordings prefer it)
+  double resolution_chi2 = NAN;  ///< the next finer clump's move of its response (NaN: not asked)
+  /// In words, for the note: by how much, or which part of the check it failed.
+  std::string said(double needed) const {
+    if (rejected) return fmt::format("rejected by {:.4g}", delta_chi2);
+    if (delta_chi2 >= needed && std::isfinite(resolution_chi2))
+      return fmt::format("not rejected: {:.4g}, within {:.3g} plus twice the next finer clump's move, {:.4g}",
+                         delta_chi2, needed, resolution_chi2);
+    return fmt::format("not rejected: {:.4g}", delta_chi2);
+  }
+};
+
 /// Whether the recordings reject a candidate at a fraction `t` of its strong magnitude by the
-/// whole of rejected()'s check, as its strong magnitude was; `delta_chi2` gets the least
-/// rejection found (negative: the recordings prefer it).
-Result<bool> rejected_at(Context& c, CellProbe& cells, AbsenceCheck& check, const Model& baseline,
-                         const EffectSpec& spec, double t, double needed, double& delta_chi2,
-                         const DiagnoseOptions& options) {
+/// whole of rejected()'s check, as its strong magnitude was.
+Result<CheckedAt> rejected_at(Context& c, CellProbe& cells, AbsenceCheck& check, const Model& baseline,
+                              const EffectSpec& spec, double t, double needed, const DiagnoseOptions& options) {
   const Model probe = effect_at(baseline, spec, t);
   auto probed = cells(probe);
   if (!probed) return std::unexpected(probed.error());
   const Eigen::VectorXd& base_cells = check.bases.front().values;
-  if (probed->values.size() != base_cells.size()) {
-    delta_chi2 = NAN;
-    return false;
-  }
+  if (probed->values.size() != base_cells.size()) return CheckedAt{};
   HypothesisReport scratch;  // the candidate's report keeps its strong magnitude's figures
   scratch.strong_delta_chi2 = check.keep(probed->values).squaredNorm() - check.keep(base_cells).squaredNorm();
   auto rejects = rejected(c, cells, check, baseline, probe, *probed, needed, scratch, options);
-  delta_chi2 = scratch.strong_delta_chi2;
-  return rejects;
+  if (!rejects) return std::unexpected(rejects.error());
+  return CheckedAt{*rejects, scratch.strong_delta_chi2, scratch.strong_resolution_chi2};
 }
 
 /// The smallest fraction of its strong magnitude a `none` claims a decided candidate would have
@@ -691,13 +701,11 @@ Result<double> checked_limit(Context& c, CellProbe& cells, AbsenceCheck& check, 
   std::vector<std::string> tried;
   for (int k = 0; k < kLimitChecks && accepted < refused; ++k) {
     const double t = k == 0 ? shown : std::sqrt(accepted * refused);
-    double delta = NAN;
-    auto rejects = rejected_at(c, cells, check, baseline, spec, t, needed, delta, options);
-    if (!rejects) return std::unexpected(rejects.error());
-    tried.push_back(
-        fmt::format("{:.3g} ({} {:.4g})", magnitude_at(spec, 0, t), *rejects ? "rejected by" : "not rejected:", delta));
-    (*rejects ? refused : accepted) = t;
-    if (*rejects && k == 0) break;
+    auto at = rejected_at(c, cells, check, baseline, spec, t, needed, options);
+    if (!at) return std::unexpected(at.error());
+    tried.push_back(fmt::format("{:.3g} ({})", magnitude_at(spec, 0, t), at->said(needed)));
+    (at->rejected ? refused : accepted) = t;
+    if (at->rejected && k == 0) break;
     if (refused < kBracketRatio * accepted) break;
   }
   if (!tried.empty())
