@@ -10,12 +10,8 @@
 # Usage: sphere_adhesion_limit.sh SOURCE_DIR BUILD_DIR SPHERE_MESH
 set -u
 export SPHERE_MESH=$3
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-bash "$1/bench/bench_diagnose_sphere.sh" "$dir/gen" "$2" -- --effects adhesion --controls 0 --generate-only \
-  >"$dir/gen.log" 2>&1 || { cat "$dir/gen.log"; exit 1; }
-"$2/tools/clumpforge" diagnose --recordings "$dir/gen/adhesion-realistic/recordings" --library "$dir/gen/sphere.h5" \
-  --finer-clumps 0 --output "$dir/out" --json >"$dir/report.json" 2>"$dir/err" || { cat "$dir/err"; exit 1; }
+source "$(dirname "$0")/sphere_case.sh"
+sphere_case "$1" "$2" adhesion realistic
 python3 - "$dir/out/report.json" "$dir/gen/adhesion-realistic/answer.json" <<'PY' || exit 1
 import json, sys
 r = json.load(open(sys.argv[1]))
