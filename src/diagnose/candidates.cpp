@@ -542,6 +542,14 @@ struct Shown {
   double linear_scale() const { return std::max(std::sqrt(needed / signal), std::sqrt(1.0 / misfit)); }
 };
 
+/// The recordings' own answer to a probe (cells are residuals): its chi^2 minus the baseline's,
+/// each after the coefficients absorb what they can to first order (the first of rejected()'s
+/// checks).
+double first_order_rejection(const ResidualProjection& keep, const Eigen::VectorXd& base_cells,
+                             const Eigen::VectorXd& probe_cells) {
+  return keep(probe_cells).squaredNorm() - keep(base_cells).squaredNorm();
+}
+
 /// What a probe's cells show against the baseline's once the coefficients absorb what they can.
 Shown measure(const Context& c, const std::vector<std::pair<GroupKey, Axis>>& keys, const ResidualProjection& keep,
               const Eigen::VectorXd& base_cells, const Eigen::VectorXd& probe_cells, double needed) {
@@ -677,7 +685,7 @@ Result<CheckedAt> rejected_at(Context& c, CellProbe& cells, AbsenceCheck& check,
   const Eigen::VectorXd& base_cells = check.bases.front().values;
   if (probed->values.size() != base_cells.size()) return CheckedAt{};
   HypothesisReport scratch;  // the candidate's report keeps its strong magnitude's figures
-  scratch.strong_delta_chi2 = check.keep(probed->values).squaredNorm() - check.keep(base_cells).squaredNorm();
+  scratch.strong_delta_chi2 = first_order_rejection(check.keep, base_cells, probed->values);
   auto rejects = rejected(c, cells, check, baseline, probe, *probed, needed, scratch, options);
   if (!rejects) return std::unexpected(rejects.error());
   return CheckedAt{*rejects, scratch.strong_delta_chi2, scratch.strong_resolution_chi2};
@@ -807,9 +815,7 @@ Result<DetectionLimits> detection_limits(Context& c, DiagnoseResult& result, con
     report.strong_delta_chi2 = NAN;
     if (probe_cells.size() == base_cells.size()) {
       strong = measure(c, cells.keys, keep, base_cells, probe_cells, needed);
-      // The recordings' own answer (cells are residuals): chi^2 at the strong magnitude minus
-      // the null's, each after the coefficients absorb what they can.
-      report.strong_delta_chi2 = keep(probe_cells).squaredNorm() - keep(base_cells).squaredNorm();
+      report.strong_delta_chi2 = first_order_rejection(keep, base_cells, probe_cells);
     }
     auto shown = replay_shown(c, cells, baseline, spec, base_cells, keep, strong, result);
     if (!shown) return std::unexpected(shown.error());

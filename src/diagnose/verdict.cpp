@@ -294,9 +294,8 @@ Result<void> say_none(Context& c, DiagnoseResult& result, const Model& baseline,
         " Smallest effects these recordings would have revealed (at delta-BIC {:g} and a phase misfit of three times "
         "hypot(noise, model accuracy), after the coefficients absorb what they can to first order; each a magnitude "
         "a replay showed that the recordings also reject, as they reject its strong magnitude; each for the effect's "
-        "law in "
-        "the library, docs/diagnose.md 'The candidate library': the same effect under another law can hide below "
-        "it): {}.",
+        "law in the library, docs/diagnose.md 'The candidate library': the same effect under another law can hide "
+        "below it): {}.",
         options.min_delta_bic, fmt::join(limits, "; "));
   if (untestable.empty()) return {};
   result.undecidable = untestable;
