@@ -3,10 +3,13 @@
 #include <fmt/format.h>
 #include <hdf5.h>
 
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <set>
 
 #include "core/atomic_file.hpp"
+#include "core/sha256.hpp"
 #include "core/version.hpp"
 
 namespace clumpforge {
@@ -336,13 +339,74 @@ Result<void> check_names(std::span<const Clump> clumps, std::string_view where) 
   return {};
 }
 
-// Writes the file's header attributes, then `body(file)`, atomically.
+// ---- the seal: a checksum of the whole file in its first bytes ------------------------------
+//
+// HDF5's default format carries no checksums, and libhdf5 can crash or hang on a damaged file
+// before it reports anything. So the file is written with a user block (bytes HDF5 leaves to the
+// writer; readers find the superblock after it), and once HDF5 has closed it those bytes are set
+// to a header holding the SHA-256 and length of everything after them. A reader checks the seal
+// before libhdf5 opens the file.
+
+constexpr std::size_t kSealBytes = 512;  // HDF5's smallest user block
+constexpr std::string_view kSealMagic = "clumpforge sealed HDF5 file v1\n";
+constexpr std::string_view kHdf5Signature = "\x89HDF\r\n\x1a\n";
+
+std::string seal_header(std::string_view sealed) {
+  std::string header = fmt::format("{}sha256 {}\nbytes {}\n", kSealMagic, sha256_hex(sealed), sealed.size());
+  header.resize(kSealBytes, '\0');
+  return header;
+}
+
+Result<std::string> read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) return fail(ErrorCode::IoError, fmt::format("cannot read '{}'", path.string()));
+  return bytes;
+}
+
+// Writes the seal over the user block of the closed file at `temporary`.
+Result<void> seal(const fs::path& temporary, const fs::path& path) {
+  auto bytes = read_bytes(temporary);
+  if (!bytes) return std::unexpected(bytes.error());
+  if (bytes->size() < kSealBytes || bytes->substr(kSealBytes, kHdf5Signature.size()) != kHdf5Signature)
+    return fail(ErrorCode::IoError, fmt::format("writing '{}': HDF5 did not leave the user block", path.string()));
+  const std::string header = seal_header(std::string_view(*bytes).substr(kSealBytes));
+  std::fstream out(temporary, std::ios::binary | std::ios::in | std::ios::out);
+  out.write(header.data(), static_cast<std::streamsize>(header.size()));
+  out.close();
+  if (!out) return fail(ErrorCode::IoError, fmt::format("writing '{}' failed at its seal", path.string()));
+  return {};
+}
+
+// Checks a file's seal before libhdf5 reads it. A file that starts with HDF5's own signature has
+// no seal (written before the seal, or by another program) and is let through unchecked; one
+// whose seal does not match its bytes is refused.
+Result<void> check_seal(const fs::path& path) {
+  auto bytes = read_bytes(path);
+  if (!bytes) return std::unexpected(bytes.error());
+  const std::string_view all(*bytes);
+  if (all.starts_with(kHdf5Signature)) return {};
+  const bool hdf5_after_block = all.size() > kSealBytes && all.substr(kSealBytes).starts_with(kHdf5Signature);
+  if (!all.starts_with(kSealMagic) && !hdf5_after_block) return {};  // not ours: HDF5 itself says what it is
+  if (all.size() <= kSealBytes || seal_header(all.substr(kSealBytes)) != all.substr(0, kSealBytes)) {
+    return fail(ErrorCode::ParseError,
+                fmt::format("'{}' is damaged: its bytes do not match the SHA-256 and length clumpforge sealed it "
+                            "with (it changed after it was written, by damage or by another program; write it "
+                            "again, or remove the seal with 'h5unjam -i FILE -o COPY' to read it unchecked)",
+                            path.string()));
+  }
+  return {};
+}
+
+// Writes the file's header attributes, then `body(file)`, then the seal, atomically.
 template <class Body>
 Result<void> write_library_file(const fs::path& path, Body&& body) {
   return write_path_atomically(path, [&](const fs::path& temporary) -> Result<void> {
     QuietHdf5 quiet;
     try {
-      Handle file(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+      Handle creation(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
+      check(H5Pset_userblock(creation.get(), kSealBytes), "the user block");
+      Handle file(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, creation.get(), H5P_DEFAULT), H5Fclose);
       if (!file.ok()) return fail(ErrorCode::IoError, fmt::format("cannot create HDF5 file '{}'", path.string()));
       write_string_attribute(file.get(), "format", kClumpLibraryFormat);
       write_int_attribute(file.get(), "schema_version", kClumpSchemaVersion);
@@ -351,7 +415,7 @@ Result<void> write_library_file(const fs::path& path, Body&& body) {
     } catch (const Hdf5Failure& failure) {
       return fail(ErrorCode::IoError, fmt::format("writing '{}' failed at '{}'", path.string(), failure.what));
     }
-    return {};
+    return seal(temporary, path);
   });
 }
 }  // namespace
@@ -386,6 +450,7 @@ Result<std::vector<Clump>> read_clump_library(const fs::path& path) {
   if (!fs::exists(path, ec)) return fail(ErrorCode::NotFound, fmt::format("'{}': no such file", path.string()));
   if (fs::is_directory(path, ec))
     return fail(ErrorCode::InvalidArgument, fmt::format("'{}' is a directory", path.string()));
+  if (auto sealed = check_seal(path); !sealed) return std::unexpected(sealed.error());
   QuietHdf5 quiet;
   if (H5Fis_hdf5(path.c_str()) <= 0) {
     return fail(
