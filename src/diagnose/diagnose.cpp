@@ -6,6 +6,35 @@
 
 namespace clumpforge {
 
+namespace {
+// The baseline's and the improved model's whole tracks (beyond the horizons), for the
+// summaries, the plots and the report's before and after; each phase's improved misfit.
+Result<std::pair<std::vector<TrialScore>, std::vector<TrialScore>>> whole_tracks(
+    diagnosis::Context& c, DiagnoseResult& result, const Model& baseline, const diagnosis::Improvement& improved) {
+  using namespace diagnosis;
+  const Groups improved_groups = phase_groups(c, c.all, improved.scores);
+  c.ev.full_duration = true;
+  auto full_base = score(c, baseline, c.all, true);
+  auto full_improved = full_base;
+  if (full_base && improved.changed) {
+    const ClumpSwap swap(c, improved.clump);
+    full_improved = score(c, improved.model, c.all, true);
+  }
+  c.ev.full_duration = false;
+  if (!full_base) return std::unexpected(full_base.error());
+  if (!full_improved) return std::unexpected(full_improved.error());
+  result.before = quality(c, *full_base);
+  result.after = quality(c, *full_improved);
+  for (auto& p : result.phases) {
+    for (const auto& [key, g] : improved_groups) {
+      if (c.names[key.recording] == p.recording && key.phase == p.phase && g.values > 0)
+        p.improved_chi2_per_value = g.chi2 / g.values;
+    }
+  }
+  return std::pair{std::move(*full_base), std::move(*full_improved)};
+}
+}  // namespace
+
 Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
                                 const std::vector<Recording>& recordings, const std::vector<std::string>& names,
                                 const DiagnoseOptions& options, const RunContext& run) {
@@ -115,26 +144,9 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   const bool named = decision.named() && !*particle;
   if (second.fit()) result.refitted_on_all = second.fit()->model.base;
   result.improved = improved.model.base;
-  const Groups improved_groups = phase_groups(c, c.all, improved.scores);
-  // Whole tracks (beyond the horizons) for the summaries and the plots.
-  c.ev.full_duration = true;
-  auto full_base = score(c, baseline, c.all, true);
-  if (!full_base) return std::unexpected(full_base.error());
-  auto full_improved = full_base;
-  if (improved.changed) {
-    const ClumpSwap swap(c, improved.clump);
-    full_improved = score(c, improved.model, c.all, true);
-  }
-  if (!full_improved) return std::unexpected(full_improved.error());
-  c.ev.full_duration = false;
-  result.before = quality(c, *full_base);
-  result.after = quality(c, *full_improved);
-  for (auto& p : result.phases) {
-    for (const auto& [key, g] : improved_groups) {
-      if (c.names[key.recording] == p.recording && key.phase == p.phase && g.values > 0)
-        p.improved_chi2_per_value = g.chi2 / g.values;
-    }
-  }
+  auto whole = whole_tracks(c, result, baseline, improved);
+  if (!whole) return std::unexpected(whole.error());
+  const auto& [full_base, full_improved] = *whole;
   took(Stage::WholeTracks);
   const bool open = !named && !*particle && result.verdict != Verdict::Ambiguous;
   if (open && !result.unexplained.empty()) {
@@ -153,13 +165,13 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   }
   if (open && !by_flights && options.ensemble_replays > 0) {
     run.report("ensembles", 0.9);
-    if (auto ok = ensemble_stage(c, result, baseline, *full_base, effects, options); !ok)
+    if (auto ok = ensemble_stage(c, result, baseline, full_base, effects, options); !ok)
       return std::unexpected(ok.error());
   }
   withdraw_limits(result);
   ask_for_deciding_experiments(result);
   say_which_were_asked(result, options);
-  track_plots(c, result, *full_base, *full_improved);
+  track_plots(c, result, full_base, full_improved);
   took(Stage::Ensemble);
   result.evaluations = c.evaluations;
   result.replays_reused = c.memo.reused();
