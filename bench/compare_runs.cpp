@@ -45,9 +45,10 @@ std::map<std::string, double> limits_of(const nlohmann::json& report) {
   return out;
 }
 
-/// The candidates whose claimed limit differs between two reports, as "name there -> here".
-std::vector<std::string> limits_changed(const std::map<std::string, double>& there,
-                                        const std::map<std::string, double>& here) {
+/// The candidates whose claimed limit differs between two reports, as "name there -> here", and
+/// how many candidates claimed one in either.
+std::pair<std::vector<std::string>, int> limits_changed(const std::map<std::string, double>& there,
+                                                        const std::map<std::string, double>& here) {
   std::map<std::string, std::pair<double, double>> both;
   for (const auto& [name, v] : there) both[name] = {v, NAN};
   for (const auto& [name, v] : here) both.try_emplace(name, NAN, NAN).first->second.second = v;
@@ -56,13 +57,7 @@ std::vector<std::string> limits_changed(const std::map<std::string, double>& the
   for (const auto& [name, v] : both)
     if (!(std::abs(v.first - v.second) <= 1e-9 * std::abs(v.first)))
       out.push_back(fmt::format("{} {} -> {}", name, shown(v.first), shown(v.second)));
-  return out;
-}
-
-std::size_t claimed_in_either(const std::map<std::string, double>& there, const std::map<std::string, double>& here) {
-  std::size_t n = there.size();
-  for (const auto& [name, v] : here) n += there.contains(name) ? 0 : 1;
-  return n;
+  return {out, static_cast<int>(both.size())};
 }
 
 int resolution_of(const nlohmann::json& report) {
@@ -156,10 +151,10 @@ Result<RunComparison> compare_runs(const fs::path& here, const fs::path& there) 
       out.only_here.push_back(id);
       continue;
     }
+    auto [limits, claimed] = limits_changed(other->second.limits, r.limits);
     out.cases.push_back({id, other->second.verdict, r.verdict, other->second.basis, r.basis, other->second.seconds,
                          r.seconds, other->second.spheres, r.spheres, other->second.replays, r.replays,
-                         limits_changed(other->second.limits, r.limits),
-                         static_cast<int>(claimed_in_either(other->second.limits, r.limits))});
+                         std::move(limits), claimed});
   }
   for (const auto& [id, r] : *theirs)
     if (!mine->contains(id)) out.only_there.push_back(id);

@@ -5,11 +5,11 @@
 
 #include <fstream>
 #include <functional>
-#include <iterator>
 #include <set>
 
 #include "core/atomic_file.hpp"
 #include "core/sha256.hpp"
+#include "core/text.hpp"
 #include "core/version.hpp"
 
 namespace clumpforge {
@@ -358,10 +358,9 @@ std::string seal_header(std::string_view sealed) {
 }
 
 Result<std::string> read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.good() && !in.eof()) return fail(ErrorCode::IoError, fmt::format("cannot read '{}'", path.string()));
-  return bytes;
+  auto bytes = read_file_bytes(path);
+  if (!bytes) return fail(ErrorCode::IoError, fmt::format("cannot read '{}'", path.string()));
+  return std::move(*bytes);
 }
 
 // Writes the seal over the user block of the closed file at `temporary`.
