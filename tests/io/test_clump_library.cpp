@@ -141,6 +141,22 @@ TEST(ClumpLibrary, EveryDamagedByteIsRefusedBeforeLibhdf5ReadsIt) {
   EXPECT_FALSE(read_clump_library(dir / "shorter.h5"));
 }
 
+TEST(ClumpLibrary, ALibraryEditedInPlaceByAnotherProgramIsRefused) {
+  // h5py, not clumpforge, changes one attribute in place: HDF5 keeps the user block as it was, so
+  // the seal no longer matches, and the message says how to read the file anyway.
+  test::ScratchDir dir("h5");
+  ASSERT_TRUE(write_clump_library(dir / "lib.h5", std::vector<Clump>{sample_clump("a", 4)}));
+  const auto py = test::run_command(
+      fmt::format("/usr/bin/python3 -c \"import h5py; f = h5py.File('{}', 'a'); f['clumps/a'].attrs['mass_kg'] = 1.0; "
+                  "f.close()\"",
+                  (dir / "lib.h5").string()));
+  ASSERT_EQ(py.exit_code, 0) << py.err;
+  const auto read = read_clump_library(dir / "lib.h5");
+  ASSERT_FALSE(read);
+  EXPECT_NE(read.error().message.find("lib.h5' is damaged"), std::string::npos) << read.error().message;
+  EXPECT_NE(read.error().message.find("h5unjam"), std::string::npos) << read.error().message;
+}
+
 TEST(ClumpLibrary, AnUnsealedLibraryIsStillRead) {
   // HDF5's addresses count from the superblock, so the file less its user block is the library
   // as written before the seal (h5unjam does the same): read, unchecked, as it was.
