@@ -380,10 +380,7 @@ Result<void> seal(const fs::path& temporary, const fs::path& path) {
 // Checks a file's seal before libhdf5 reads it. A file that starts with HDF5's own signature has
 // no seal (written before the seal, or by another program) and is let through unchecked; one
 // whose seal does not match its bytes is refused.
-Result<void> check_seal(const fs::path& path) {
-  auto bytes = read_bytes(path);
-  if (!bytes) return std::unexpected(bytes.error());
-  const std::string_view all(*bytes);
+Result<void> check_seal(std::string_view all, const fs::path& path) {
   if (all.starts_with(kHdf5Signature)) return {};
   const bool hdf5_after_block = all.size() > kSealBytes && all.substr(kSealBytes).starts_with(kHdf5Signature);
   if (!all.starts_with(kSealMagic) && !hdf5_after_block) return {};  // not ours: HDF5 itself says what it is
@@ -395,6 +392,25 @@ Result<void> check_seal(const fs::path& path) {
                             path.string()));
   }
   return {};
+}
+
+// Where HDF5 looks for its superblock: at 0, then at 512, 1024, 2048, ... (after a user block).
+bool has_hdf5_signature(std::string_view all) {
+  for (std::size_t at = 0; at + kHdf5Signature.size() <= all.size(); at = at == 0 ? kSealBytes : 2 * at) {
+    if (all.substr(at, kHdf5Signature.size()) == kHdf5Signature) return true;
+  }
+  return false;
+}
+
+// Opens the bytes already read and checked as a read-only HDF5 file in memory (the core driver
+// with a file image), so that libhdf5 reads exactly the bytes the seal was checked on and the
+// file is read from disk once.
+Handle open_image(std::string_view all) {
+  Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!access.ok() || H5Pset_fapl_core(access.get(), 1 << 16, 0) < 0 ||
+      H5Pset_file_image(access.get(), const_cast<char*>(all.data()), all.size()) < 0)
+    return Handle(-1, H5Fclose);
+  return Handle(H5Fopen("clumpforge-library-image", H5F_ACC_RDONLY, access.get()), H5Fclose);
 }
 
 // Writes the file's header attributes, then `body(file)`, then the seal, atomically.
@@ -449,15 +465,17 @@ Result<std::vector<Clump>> read_clump_library(const fs::path& path) {
   if (!fs::exists(path, ec)) return fail(ErrorCode::NotFound, fmt::format("'{}': no such file", path.string()));
   if (fs::is_directory(path, ec))
     return fail(ErrorCode::InvalidArgument, fmt::format("'{}' is a directory", path.string()));
-  if (auto sealed = check_seal(path); !sealed) return std::unexpected(sealed.error());
+  auto bytes = read_bytes(path);
+  if (!bytes) return std::unexpected(bytes.error());
+  if (auto sealed = check_seal(*bytes, path); !sealed) return std::unexpected(sealed.error());
   QuietHdf5 quiet;
-  if (H5Fis_hdf5(path.c_str()) <= 0) {
+  if (!has_hdf5_signature(*bytes)) {
     return fail(
         ErrorCode::ParseError,
         fmt::format("'{}' is not an HDF5 file (expected a clump library from 'clumpforge fill')", path.string()));
   }
   try {
-    Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    Handle file = open_image(*bytes);
     if (!file.ok()) return fail(ErrorCode::ParseError, fmt::format("'{}' is a damaged HDF5 file", path.string()));
     const Reader reader{path.string()};
     if (!reader.has_attribute(file.get(), "format") ||
