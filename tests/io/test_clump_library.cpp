@@ -1,7 +1,15 @@
 // The HDF5 clump library: bit-exact round trip, readable by plain tools, clear errors.
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <future>
+#include <thread>
 
 #include "io/clump_library.hpp"
 #include "support/test_support.hpp"
@@ -165,6 +173,36 @@ TEST(ClumpLibrary, AnUnsealedLibraryIsStillRead) {
   ASSERT_TRUE(write_clump_library(dir / "sealed.h5", clumps));
   test::write_text(dir / "unsealed.h5", test::read_text(dir / "sealed.h5").substr(512));
   const auto read = read_clump_library(dir / "unsealed.h5");
+  ASSERT_TRUE(read) << read.error().message;
+  ASSERT_EQ(read->size(), 2u);
+  for (std::size_t i = 0; i < clumps.size(); ++i) expect_identical(clumps[i], (*read)[i]);
+}
+
+TEST(ClumpLibrary, IsReadFromDiskOnceSoAPipeServes) {
+  // The seal is checked on the bytes read, and libhdf5 opens those same bytes from memory: a
+  // library that can be read only once (a named pipe; `clumpforge export <(ssh host cat L.h5)`)
+  // is read whole. A reader that opened the path again would wait for a second writer.
+  test::ScratchDir dir("h5");
+  const std::vector<Clump> clumps{sample_clump("a", 5), sample_clump("b", 6)};
+  ASSERT_TRUE(write_clump_library(dir / "lib.h5", clumps));
+  const std::string bytes = test::read_text(dir / "lib.h5");
+  const std::filesystem::path fifo = dir / "pipe.h5";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] {
+    std::ofstream out(fifo, std::ios::binary);  // waits for the reader to open the pipe
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  });
+  auto reading = std::async(std::launch::async, [&] { return read_clump_library(fifo); });
+  const bool done = reading.wait_for(std::chrono::seconds(20)) == std::future_status::ready;
+  writer.join();
+  // A reader that opened the pipe again waits there for a writer: give it writers with nothing
+  // to say (O_NONBLOCK: none is opened while no reader waits), until it ends.
+  while (reading.wait_for(std::chrono::milliseconds(100)) != std::future_status::ready) {
+    const int w = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (w >= 0) ::close(w);
+  }
+  ASSERT_TRUE(done) << "the reader opened the pipe a second time";
+  const auto read = reading.get();
   ASSERT_TRUE(read) << read.error().message;
   ASSERT_EQ(read->size(), 2u);
   for (std::size_t i = 0; i < clumps.size(); ++i) expect_identical(clumps[i], (*read)[i]);
