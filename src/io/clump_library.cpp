@@ -404,7 +404,7 @@ bool has_hdf5_signature(std::string_view all) {
 
 // Opens the bytes already read and checked as a read-only HDF5 file in memory (the core driver
 // with a file image), so that libhdf5 reads exactly the bytes the seal was checked on and the
-// file is read from disk once.
+// file is read from disk once. HDF5 copies the image: `all` may be freed once this returns.
 Handle open_image(std::string_view all) {
   Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
   if (!access.ok() || H5Pset_fapl_core(access.get(), 1 << 16, 0) < 0 ||
@@ -476,6 +476,7 @@ Result<std::vector<Clump>> read_clump_library(const fs::path& path) {
   }
   try {
     Handle file = open_image(*bytes);
+    std::string().swap(*bytes);  // libhdf5 holds its own copy of the image now
     if (!file.ok()) return fail(ErrorCode::ParseError, fmt::format("'{}' is a damaged HDF5 file", path.string()));
     const Reader reader{path.string()};
     if (!reader.has_attribute(file.get(), "format") ||
