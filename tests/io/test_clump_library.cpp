@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -188,13 +190,33 @@ TEST(ClumpLibrary, IsReadFromDiskOnceSoAPipeServes) {
   const std::string bytes = test::read_text(dir / "lib.h5");
   const std::filesystem::path fifo = dir / "pipe.h5";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  // The writer waits for the reader to open the pipe, for 20 s at most (O_NONBLOCK: the open
+  // fails while no reader has it open), so a reader that failed before opening it cannot leave
+  // the test waiting.
+  bool writer_opened = false;
   std::thread writer([&] {
-    std::ofstream out(fifo, std::ios::binary);  // waits for the reader to open the pipe
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    int w = -1;
+    while ((w = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK)) < 0 && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (w < 0) return;
+    writer_opened = true;
+    sigset_t pipe_signal;  // a reader that closes early makes write() fail (EPIPE), not end the test
+    sigemptyset(&pipe_signal);
+    sigaddset(&pipe_signal, SIGPIPE);
+    pthread_sigmask(SIG_BLOCK, &pipe_signal, nullptr);
+    ::fcntl(w, F_SETFL, ::fcntl(w, F_GETFL) & ~O_NONBLOCK);
+    for (std::size_t at = 0; at < bytes.size();) {
+      const ssize_t n = ::write(w, bytes.data() + at, bytes.size() - at);
+      if (n <= 0) break;
+      at += static_cast<std::size_t>(n);
+    }
+    ::close(w);
   });
   auto reading = std::async(std::launch::async, [&] { return read_clump_library(fifo); });
   const bool done = reading.wait_for(std::chrono::seconds(20)) == std::future_status::ready;
   writer.join();
+  EXPECT_TRUE(writer_opened) << "the reader never opened the pipe";
   // A reader that opened the pipe again waits there for a writer: give it writers with nothing
   // to say (O_NONBLOCK: none is opened while no reader waits), until it ends.
   while (reading.wait_for(std::chrono::milliseconds(100)) != std::future_status::ready) {
