@@ -52,14 +52,19 @@ nlohmann::json outcome_shift_json(const std::optional<OutcomeShift>& shift, cons
                      {"to", finite_or_null(m.to)},
                      {"noise", finite_or_null(m.noise)},
                      {"recorded_se", finite_or_null(m.se)}});
-  return {{"means", shift->means},
+  // The move that matters most (null fields when no mean was compared).
+  const MeanMove* most = shift->largest_move();
+  const auto of_most = [&](auto field) { return most != nullptr ? field(*most) : nlohmann::json(); };
+  return {{"means", shift->means()},
           {"chi2", finite_or_null(shift->chi2)},
           {"p", finite_or_null(shift->p)},
-          {"largest_se", finite_or_null(shift->largest)},
-          {"recording", shift->recording < names.size() ? nlohmann::json(names[shift->recording]) : nlohmann::json()},
-          {"outcome", std::string(outcome_name(shift->outcome))},
-          {"from", finite_or_null(shift->from)},
-          {"to", finite_or_null(shift->to)},
+          {"largest_se", finite_or_null(shift->largest())},
+          {"recording", of_most([&](const MeanMove& m) {
+             return m.recording < names.size() ? nlohmann::json(names[m.recording]) : nlohmann::json();
+           })},
+          {"outcome", of_most([](const MeanMove& m) { return nlohmann::json(std::string(outcome_name(m.outcome))); })},
+          {"from", of_most([](const MeanMove& m) { return finite_or_null(m.from); })},
+          {"to", of_most([](const MeanMove& m) { return finite_or_null(m.to); })},
           {"replays", shift->replays},
           {"judged", shift->judged},
           {"converged", shift->judged ? nlohmann::json(shift->converged()) : nlohmann::json()},

@@ -180,14 +180,17 @@ void bind_parts(py::module_& m) {
   py::class_<OutcomeShift>(m, "OutcomeShift",
                            "How a finer clump's replayed outcomes moved from the previous clump's at the same "
                            "coefficients and orientations.")
-      .def_readonly("means", &OutcomeShift::means)
+      .def_property_readonly("means", &OutcomeShift::means, "recorded means both clumps were compared on")
       .def_readonly("chi2", &OutcomeShift::chi2)
       .def_readonly("p", &OutcomeShift::p)
-      .def_readonly("largest", &OutcomeShift::largest, "the largest move in recorded standard errors")
-      .def_readonly("recording", &OutcomeShift::recording)
-      .def_readonly("outcome", &OutcomeShift::outcome)
-      .def_readonly("from_value", &OutcomeShift::from)
-      .def_readonly("to_value", &OutcomeShift::to)
+      .def_property_readonly("largest", &OutcomeShift::largest, "the largest move in recorded standard errors")
+      .def_property_readonly(
+          "largest_move",
+          [](const OutcomeShift& s) -> std::optional<MeanMove> {
+            if (const MeanMove* m = s.largest_move()) return *m;
+            return std::nullopt;
+          },
+          "the mean that moved most in recorded standard errors (None: no mean compared)")
       .def_readonly("replays", &OutcomeShift::replays)
       .def_readonly("judged", &OutcomeShift::judged,
                     "whether a verdict reads it (false: reported only, on its comparison's own replays)")

@@ -433,8 +433,8 @@ std::string agreement_unconverged(const ParticleModelRung& agreed, const Particl
       "with {} ({} spheres) the recorded outcomes are consistent with the replays (largest z^2 {:.1f}), but from {} "
       "to {} spheres, at that clump's coefficients, the replayed outcomes still moved (chi^2 {:.1f} over {} means, p "
       "= {:.2g}, up to {:.1f} recorded standard errors): its agreement is not converged, and it explains nothing",
-      agreed.name, agreed.spheres, agreed.worst_phase_chi2_per_value, agreed.spheres, next.spheres, s.chi2, s.means,
-      s.p, s.largest);
+      agreed.name, agreed.spheres, agreed.worst_phase_chi2_per_value, agreed.spheres, next.spheres, s.chi2, s.means(),
+      s.p, s.largest());
 }
 
 /// While the particle model is not converged (its finest clump `spheres`) every candidate asked
@@ -479,7 +479,7 @@ void undecided_by_resolution(DiagnoseResult& result, const ParticleModelRung& be
       "coefficients and release orientations, the replayed outcomes still moved (chi^2 {:.1f} over {} means, p = "
       "{:.2g}, up to {:.1f} recorded standard errors). Whether {} is missing physics or the coarser clump's share "
       "hangs on a particle model that has not converged.",
-      names, finest.name, finest.spheres, before.spheres, finest.spheres, s.chi2, s.means, s.p, s.largest, names);
+      names, finest.name, finest.spheres, before.spheres, finest.spheres, s.chi2, s.means(), s.p, s.largest(), names);
 }
 
 namespace {
@@ -527,7 +527,7 @@ bool let_through_on_unconverged_finest(DiagnoseResult& result, const EnsembleRes
       "errors). Whether {} is missing physics or the coarse clump's share hangs on a particle model that has not "
       "converged.",
       check.diagnosed, check.spheres, name, let_through.delta_bic, last.name, last.spheres, there, min_delta_bic,
-      before.spheres, last.spheres, s.chi2, s.means, s.p, s.largest, name);
+      before.spheres, last.spheres, s.chi2, s.means(), s.p, s.largest(), name);
   return true;
 }
 
@@ -752,11 +752,12 @@ bool particle_model_unconverged(const Context& c, DiagnoseResult& result) {
   const ParticleModelRung& before = *std::next(last);
   const OutcomeShift& shift = *last->outcome_shift;
   const EnsembleReport& e = *result.ensemble;
-  const Shown as = shown(shift.outcome);
+  const MeanMove& most = *shift.largest_move();  // not converged: at least one mean was compared
+  const Shown as = shown(most.outcome);
   const std::string where = fmt::format(
-      ", most the mean {} of {} ({:.3g} -> {:.3g} {}, {:.1f} recorded standard errors)", outcome_name(shift.outcome),
-      recording_label((*c.ev.recordings)[shift.recording], c.names[shift.recording]), shift.from * as.scale,
-      shift.to * as.scale, as.unit, shift.largest);
+      ", most the mean {} of {} ({:.3g} -> {:.3g} {}, {:.1f} recorded standard errors)", outcome_name(most.outcome),
+      recording_label((*c.ev.recordings)[most.recording], c.names[most.recording]), most.from * as.scale,
+      most.to * as.scale, as.unit, most.matters());
   undecidable_unconverged(result, last->spheres);
   result.statement = fmt::format(
       "Not decidable with these clumps: the recorded outcomes differ from replays over the unknown release "
@@ -767,7 +768,7 @@ bool particle_model_unconverged(const Context& c, DiagnoseResult& result) {
       "Until a finer clump's outcomes agree with the last one's, the mismatch may be the particle model's, not "
       "missing physics.",
       e.null_chi2, e.outcomes, result.particle_model->diagnosed, last->chi2_per_value * e.outcomes, last->name,
-      before.spheres, last->spheres, shift.chi2, shift.means, shift.p, where);
+      before.spheres, last->spheres, shift.chi2, shift.means(), shift.p, where);
   return true;
 }
 

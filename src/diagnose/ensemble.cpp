@@ -295,18 +295,17 @@ OutcomeShift outcome_shift(const std::vector<OutcomeComparison>& coarse, const s
     if (!(noise > 0.0)) continue;
     const MeanMove m{b.recording, b.outcome, a->ensemble_mean, b.ensemble_mean, noise, comparison_se(b)};
     shift.moves.push_back(m);
-    ++shift.means;
     shift.chi2 += m.chi2();
-    if (m.matters() >= shift.largest) {
-      shift.largest = m.matters();
-      shift.recording = m.recording;
-      shift.outcome = m.outcome;
-      shift.from = m.from;
-      shift.to = m.to;
-    }
   }
-  shift.p = shift.means > 0 ? chi2_upper_tail(shift.chi2, shift.means) : 1.0;
+  shift.p = shift.means() > 0 ? chi2_upper_tail(shift.chi2, shift.means()) : 1.0;
   return shift;
+}
+
+const MeanMove* OutcomeShift::largest_move() const {
+  const MeanMove* largest = nullptr;
+  for (const MeanMove& m : moves)
+    if (largest == nullptr || m.matters() >= largest->matters()) largest = &m;
+  return largest;
 }
 
 namespace {

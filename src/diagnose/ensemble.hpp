@@ -131,23 +131,25 @@ struct MeanMove {
 /// error or more (comparison_se): a clump whose outcomes still move by that much with resolution cannot say whether a
 /// mismatch beyond the release horizon is missing physics or its own coarseness.
 struct OutcomeShift {
-  static constexpr double kReal = 0.01;      ///< upper-tail probability below which the move is real
-  static constexpr double kMatters = 1.0;    ///< [recorded standard errors] a move that matters
-  int means = 0;                             ///< recorded means both clumps were compared on
-  double chi2 = 0.0;                         ///< of the shifts against the replays' sampling noise
-  double p = 1.0;                            ///< its upper tail with `means` degrees of freedom
-  double largest = 0.0;                      ///< the largest |shift| in recorded standard errors
-  std::size_t recording = 0;                 ///< that mean's recording
-  Outcome outcome = Outcome::ReboundHeight;  ///< and outcome
-  double from = 0.0, to = 0.0;               ///< its replayed value with each clump
-  int replays = 0;                           ///< replays per recording it was measured with
+  static constexpr double kReal = 0.01;    ///< upper-tail probability below which the move is real
+  static constexpr double kMatters = 1.0;  ///< [recorded standard errors] a move that matters
+  double chi2 = 0.0;                       ///< of the shifts against the replays' sampling noise
+  double p = 1.0;                          ///< its upper tail with means() degrees of freedom
+  int replays = 0;                         ///< replays per recording it was measured with
   /// Whether a verdict may read it: false for a rung that neither explains the outcomes nor is
   /// the last, whose move is only reported, on its comparison's own replays (12 in a first
   /// comparison: too few to call a move converged; the strong elastic-plastic case's 64-sphere
   /// rung, p = 0.30 on 12 replays and 0.00066 on 48 at 11c5051).
   bool judged = true;
   std::vector<MeanMove> moves;  ///< each mean compared, in the fine comparisons' order
-  bool converged() const { return !(means > 0 && p < kReal && largest >= kMatters); }
+  /// Recorded means both clumps were compared on.
+  int means() const { return static_cast<int>(moves.size()); }
+  /// The move that matters most in recorded standard errors (the last of equals); null when no
+  /// mean was compared.
+  const MeanMove* largest_move() const;
+  /// The largest |shift| in recorded standard errors (0 when no mean was compared).
+  double largest() const { return moves.empty() ? 0.0 : largest_move()->matters(); }
+  bool converged() const { return !(means() > 0 && p < kReal && largest() >= kMatters); }
 };
 /// The shift from `coarse` to `fine` (comparisons of the same recordings, compare_model); only
 /// the means are compared (a spread's sampling noise is not the mean's).

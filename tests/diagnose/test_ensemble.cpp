@@ -615,9 +615,15 @@ TEST(EnsembleConvergence, AnOutcomeShiftCountsWhenItIsRealAndMatters) {
   const auto coarse = comparisons(0.10, 0.01);
   // The same outcomes: nothing moved.
   const OutcomeShift none = outcome_shift(coarse, coarse);
-  EXPECT_EQ(none.means, 2);
+  EXPECT_EQ(none.means(), 2);
   EXPECT_NEAR(none.chi2, 0.0, 1e-12);
   EXPECT_TRUE(none.converged());
+  // No coarse comparison to move from: no mean compared, no largest move.
+  const OutcomeShift nothing = outcome_shift({}, coarse);
+  EXPECT_EQ(nothing.means(), 0);
+  EXPECT_EQ(nothing.largest_move(), nullptr);
+  EXPECT_EQ(nothing.largest(), 0.0);
+  EXPECT_TRUE(nothing.converged());
   // The first recording's mean moved by 0.02: the replays' noise is sqrt(2 / 12) * 0.0104 =
   // 0.0043, so chi^2 = (0.02 / 0.0043)^2 = 22 over 2 means (p ~ 2e-5); the recorded se is
   // 0.0062, so 3.2 se.
@@ -625,26 +631,27 @@ TEST(EnsembleConvergence, AnOutcomeShiftCountsWhenItIsRealAndMatters) {
   moved[2] = coarse[2];  // only the first recording's mean moves
   moved[2].recording = 1;
   const OutcomeShift shift = outcome_shift(coarse, moved);
-  EXPECT_EQ(shift.means, 2);
+  EXPECT_EQ(shift.means(), 2);
   EXPECT_NEAR(shift.chi2, 21.5, 1.5);
   EXPECT_LT(shift.p, OutcomeShift::kReal);
-  EXPECT_NEAR(shift.largest, 0.02 / comparison_se(moved[0]), 1e-9);
-  EXPECT_GT(shift.largest, 2.0);
-  EXPECT_EQ(shift.recording, 0U);
-  EXPECT_NEAR(shift.from, 0.10, 1e-12);
-  EXPECT_NEAR(shift.to, 0.12, 1e-12);
+  EXPECT_NEAR(shift.largest(), 0.02 / comparison_se(moved[0]), 1e-9);
+  EXPECT_GT(shift.largest(), 2.0);
+  ASSERT_NE(shift.largest_move(), nullptr);
+  EXPECT_EQ(shift.largest_move()->recording, 0U);
+  EXPECT_NEAR(shift.largest_move()->from, 0.10, 1e-12);
+  EXPECT_NEAR(shift.largest_move()->to, 0.12, 1e-12);
   EXPECT_FALSE(shift.converged());
   // Each mean's move, in the fine comparisons' order; they add up to the chi^2.
   ASSERT_EQ(shift.moves.size(), 2U);
   EXPECT_EQ(shift.moves[0].recording, 0U);
   EXPECT_NEAR(shift.moves[0].to - shift.moves[0].from, 0.02, 1e-12);
-  EXPECT_NEAR(shift.moves[0].matters(), shift.largest, 1e-12);
+  EXPECT_NEAR(shift.moves[0].matters(), shift.largest(), 1e-12);
   EXPECT_NEAR(shift.moves[1].chi2(), 0.0, 1e-12);
   EXPECT_NEAR(shift.moves[0].chi2() + shift.moves[1].chi2(), shift.chi2, 1e-9);
   // The same move against recordings ten times as scattered: real, but under a recorded se.
   const OutcomeShift small = outcome_shift(comparisons(0.10, 0.1), comparisons(0.12, 0.1));
   EXPECT_LT(small.p, OutcomeShift::kReal);
-  EXPECT_LT(small.largest, OutcomeShift::kMatters);
+  EXPECT_LT(small.largest(), OutcomeShift::kMatters);
   EXPECT_TRUE(small.converged());
   // A move within the replays' noise (0.004 against 0.0043 per mean): not real.
   const OutcomeShift noise = outcome_shift(coarse, comparisons(0.104, 0.01));
@@ -868,6 +875,20 @@ TEST(EnsembleDecided, TheReportedAdviceAgreesWithTheFinalVerdict) {
 
 namespace {
 
+// A finer clump's move over `means` recorded means (each recorded standard error 1): the first
+// mean moved by `largest`, the others not at all; `chi2` and `p` as given.
+OutcomeShift shift_of(int means, double chi2, double p, double largest, int replays = 0) {
+  OutcomeShift shift{.chi2 = chi2, .p = p, .replays = replays};
+  for (int k = 0; k < means; ++k)
+    shift.moves.push_back({.recording = static_cast<std::size_t>(k),
+                           .outcome = Outcome::ReboundHeight,
+                           .from = 0.0,
+                           .to = k == 0 ? largest : 0.0,
+                           .noise = 1.0,
+                           .se = 1.0});
+  return shift;
+}
+
 // A particle-model check of `rungs` adaptive clumps doubling from `spheres` (the first diagnosed,
 // the others refitted), the last one's move from the one before over `means` recorded means with
 // upper tail `p`, its largest `largest` recorded standard errors.
@@ -881,11 +902,7 @@ ParticleModelCheck ladder(int spheres, int rungs, int means, double p, double la
     check.rungs[r].spheres = spheres << r;
     check.rungs[r].refitted = r > 0;
   }
-  OutcomeShift shift;
-  shift.means = means;
-  shift.p = p;
-  shift.largest = largest;
-  check.rungs.back().outcome_shift = shift;
+  check.rungs.back().outcome_shift = shift_of(means, 0.0, p, largest);
   return check;
 }
 
@@ -1310,7 +1327,7 @@ TEST(EnsembleGate, AComparisonIsAtAGateOnlyWithinTheDrawsReach) {
     DiagnoseResult result = report_with(12.0, 16.1);
     ParticleModelCheck check;
     ParticleModelRung rung;
-    rung.outcome_shift = OutcomeShift{.means = 16, .chi2 = 30.0, .p = 0.0021, .largest = 1.8, .replays = 48};
+    rung.outcome_shift = shift_of(16, 30.0, 0.0021, 1.8, 48);
     check.rungs = {ParticleModelRung{}, rung};
     result.particle_model = check;
     EXPECT_FALSE(at_a_gate(result, 10.0));

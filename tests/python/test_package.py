@@ -191,7 +191,7 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
     assert cf.Basis.particle_model != cf.Basis.unexplained_outcomes
     # Beyond the release horizon a mismatch on a clump not converged there is undecidable.
     assert cf.Basis.unconverged_particle_model != cf.Basis.unexplained_outcomes
-    assert {"means", "chi2", "p", "largest", "outcome", "replays", "judged", "converged", "moves"} <= set(
+    assert {"means", "chi2", "p", "largest", "largest_move", "replays", "judged", "converged", "moves"} <= set(
         dir(cf.OutcomeShift)
     )
     assert {"recording", "outcome", "from_value", "to_value", "noise", "recorded_se", "chi2", "matters"} <= set(
