@@ -164,6 +164,10 @@ void bind_parts(py::module_& m) {
       .def_readonly("phase", &PhaseOf::phase)
       .def_readonly("chi2_per_value", &PhaseOf::chi2_per_value)
       .def_readonly("where", &PhaseOf::where);
+}
+
+// The particle-model check: the outcomes compared, each finer clump tried and how far it moved them.
+void bind_particle_model(py::module_& m) {
   py::enum_<Outcome> outcome(m, "Outcome");
   for (Outcome o : {Outcome::ReboundHeight, Outcome::Drift, Outcome::RollDistance, Outcome::RollTime,
                     Outcome::SlipAngle, Outcome::SlideTime})
@@ -357,6 +361,7 @@ void bind_outcomes(py::module_& m) {
 void bind_diagnose(py::module_& m) {
   bind_enums(m);
   bind_parts(m);
+  bind_particle_model(m);
   bind_result(m);
   bind_outcomes(m);
   m.def("diagnose", &run_diagnosis, py::arg("clump"), py::arg("recordings"),
