@@ -44,31 +44,35 @@ nlohmann::json preferred_json(const std::vector<SetUpShare>& shares) {
 // How a rung's replayed outcomes moved from the previous clump's (null when not compared).
 nlohmann::json outcome_shift_json(const std::optional<OutcomeShift>& shift, const std::vector<std::string>& names) {
   if (!shift) return nlohmann::json();
+  const auto move_json = [&](const MeanMove& m) {
+    return nlohmann::json{
+        {"recording", m.recording < names.size() ? nlohmann::json(names[m.recording]) : nlohmann::json()},
+        {"outcome", std::string(outcome_name(m.outcome))},
+        {"from", finite_or_null(m.from)},
+        {"to", finite_or_null(m.to)},
+        {"noise", finite_or_null(m.noise)},
+        {"recorded_se", finite_or_null(m.se)}};
+  };
   nlohmann::json moves = nlohmann::json::array();
-  for (const MeanMove& m : shift->moves)
-    moves.push_back({{"recording", m.recording < names.size() ? nlohmann::json(names[m.recording]) : nlohmann::json()},
-                     {"outcome", std::string(outcome_name(m.outcome))},
-                     {"from", finite_or_null(m.from)},
-                     {"to", finite_or_null(m.to)},
-                     {"noise", finite_or_null(m.noise)},
-                     {"recorded_se", finite_or_null(m.se)}});
-  // The move that matters most (null fields when no mean was compared).
-  const MeanMove* most = shift->largest_move();
-  const auto of_most = [&](auto field) { return most != nullptr ? field(*most) : nlohmann::json(); };
-  return {{"means", shift->means()},
-          {"chi2", finite_or_null(shift->chi2)},
-          {"p", finite_or_null(shift->p)},
-          {"largest_se", finite_or_null(shift->largest())},
-          {"recording", of_most([&](const MeanMove& m) {
-             return m.recording < names.size() ? nlohmann::json(names[m.recording]) : nlohmann::json();
-           })},
-          {"outcome", of_most([](const MeanMove& m) { return nlohmann::json(std::string(outcome_name(m.outcome))); })},
-          {"from", of_most([](const MeanMove& m) { return finite_or_null(m.from); })},
-          {"to", of_most([](const MeanMove& m) { return finite_or_null(m.to); })},
-          {"replays", shift->replays},
-          {"judged", shift->judged},
-          {"converged", shift->judged ? nlohmann::json(shift->converged()) : nlohmann::json()},
-          {"moves", moves}};
+  for (const MeanMove& m : shift->moves) moves.push_back(move_json(m));
+  nlohmann::json out{{"means", shift->means()},
+                     {"chi2", finite_or_null(shift->chi2)},
+                     {"p", finite_or_null(shift->p)},
+                     {"largest_se", finite_or_null(shift->largest())},
+                     {"recording", nullptr},
+                     {"outcome", nullptr},
+                     {"from", nullptr},
+                     {"to", nullptr},
+                     {"replays", shift->replays},
+                     {"judged", shift->judged},
+                     {"converged", shift->judged ? nlohmann::json(shift->converged()) : nlohmann::json()},
+                     {"moves", moves}};
+  // The move that matters most, as its entry in `moves` (null when no mean was compared).
+  if (const MeanMove* most = shift->largest_move()) {
+    const nlohmann::json j = move_json(*most);
+    for (const char* key : {"recording", "outcome", "from", "to"}) out[key] = j[key];
+  }
+  return out;
 }
 
 nlohmann::json coefficients_json(const std::vector<SurfaceParameters>& base) {
