@@ -85,11 +85,13 @@ void write_text(std::ostream& out, const DiagnoseResult& r) {
                        r.before.summary_error[k].second, r.after.summary_error[k].second);
   }
   if (const auto& h = r.heldout_outcomes) {
+    const bool finer = h->rung != 0 && r.particle_model && h->rung < r.particle_model->rungs.size();
     out << fmt::format(
-        "held-out outcomes (calibrated on {} training trials, compared on {} held-out): RMS z {:.2f} -> {:.2f} over "
-        "{} means and spreads ({:.1f} % better)\n",
-        h->training_trials, h->heldout_trials, h->rms_z_null(), h->rms_z_named(), h->statistics,
-        100.0 * h->improvement());
+        "held-out outcomes (calibrated on {} training trials, compared on {} held-out{}): RMS z {:.2f} -> {:.2f} "
+        "over {} means and spreads ({:.1f} % better)\n",
+        h->training_trials, h->heldout_trials,
+        finer ? fmt::format(", with {} as named", r.particle_model->rungs[h->rung].name) : std::string(),
+        h->rms_z_null(), h->rms_z_named(), h->statistics, 100.0 * h->improvement());
   }
   if (const auto& h = r.heldout_flights) {
     out << fmt::format(

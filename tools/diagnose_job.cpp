@@ -388,6 +388,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
                                     {"rms_z_named", h->rms_z_named()},
                                     {"improvement", h->improvement()},
                                     {"values", h->values},
+                                    {"rung", h->rung},
                                     {"replays", h->replays},
                                     {"seconds", h->seconds}};
   }

@@ -133,6 +133,8 @@ void bind_parts(py::module_& m) {
       .def_readonly("chi2_null", &OutcomeHoldout::chi2_null)
       .def_readonly("chi2_named", &OutcomeHoldout::chi2_named)
       .def_readonly("values", &OutcomeHoldout::values, "the effect's parameters from the training trials")
+      .def_readonly("rung", &OutcomeHoldout::rung,
+                    "the particle-model rung it was made and checked on (0: the diagnosed clump)")
       .def_readonly("seconds", &OutcomeHoldout::seconds, "[s] its wall clock")
       .def_property_readonly("rms_z_null", &OutcomeHoldout::rms_z_null)
       .def_property_readonly("rms_z_named", &OutcomeHoldout::rms_z_named)

@@ -259,6 +259,7 @@ struct OutcomeHoldout {
   double chi2_null = 0.0;      ///< the training trials' null against the held-out outcomes
   double chi2_named = 0.0;     ///< the training trials' named effect against them
   std::vector<double> values;  ///< the effect's parameters as the training trials calibrate them
+  std::size_t rung = 0;        ///< the particle-model rung it was made and checked on (0: the diagnosed clump)
   int replays = 0;             ///< DEM replays of its two held-out comparisons (the training trials' calibration's
                                ///< are in the diagnosis's evaluations)
   double seconds = 0.0;        ///< [s] its wall clock

@@ -113,26 +113,26 @@ std::optional<GateFound> inconsistent_candidate_at_gate(const EnsembleReport& e,
 /// Orientations drawn afresh for a gate's check: neither the null's nor a candidate's.
 constexpr std::uint64_t kGateCheckStream = 290000;
 
-/// A rung's clump, its full-duration scores and its model (the refit of a finer clump, kept in
-/// Context::refits) with the coefficients `base`.
-struct RungModel {
-  const Clump* clump = nullptr;
-  const std::vector<TrialScore>* scores = nullptr;
-  Model model;
-};
+}  // namespace
+
 Result<RungModel> rung_model(const Context& c, const Model& baseline, const std::vector<TrialScore>& full_scores,
-                             std::size_t rung, const std::vector<SurfaceParameters>& base) {
-  if (rung == 0) {
-    Model m = baseline;
-    m.base = base;
-    return RungModel{c.ev.clump, &full_scores, std::move(m)};
-  }
-  if (rung > c.finer.size()) return fail(ErrorCode::InvalidArgument, "a gate names a clump the diagnosis has not");
+                             std::size_t rung) {
+  if (rung == 0) return RungModel{c.ev.clump, &full_scores, baseline};
+  if (rung > c.finer.size())
+    return fail(ErrorCode::InvalidArgument, "a name or gate is on a clump the diagnosis has not");
   const auto kept = c.refits.find({c.finer[rung - 1], &baseline});
-  if (kept == c.refits.end()) return fail(ErrorCode::InvalidArgument, "a gate's clump was not refitted");
-  Model m = kept->second.fitted.model;
-  m.base = base;
-  return RungModel{c.finer[rung - 1], &kept->second.scores, std::move(m)};
+  if (kept == c.refits.end()) return fail(ErrorCode::InvalidArgument, "a name or gate is on a clump not refitted");
+  return RungModel{c.finer[rung - 1], &kept->second.scores, kept->second.fitted.model};
+}
+
+namespace {
+
+/// rung_model with the coefficients `base`.
+Result<RungModel> rung_model_at(const Context& c, const Model& baseline, const std::vector<TrialScore>& full_scores,
+                                std::size_t rung, const std::vector<SurfaceParameters>& base) {
+  auto at = rung_model(c, baseline, full_scores, rung);
+  if (at) at->model.base = base;
+  return at;
 }
 
 /// `model` replayed with `at`'s clump from the gate checks' orientations, compared.
@@ -213,7 +213,7 @@ Result<bool> gates_hold(Context& c, const DiagnoseResult& result, const Model& b
   std::optional<std::pair<RungModel, std::vector<OutcomeComparison>>> null;
   auto null_replayed = [&]() -> Result<const std::pair<RungModel, std::vector<OutcomeComparison>>*> {
     if (!null) {
-      auto at = rung_model(c, baseline, full_scores, e.rung, e.calibrated);
+      auto at = rung_model_at(c, baseline, full_scores, e.rung, e.calibrated);
       if (!at) return std::unexpected(at.error());
       auto cmp = replayed(c, *at, at->model, eo);
       if (!cmp) return std::unexpected(cmp.error());

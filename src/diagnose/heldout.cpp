@@ -39,22 +39,22 @@ Result<void> heldout_outcomes(Context& c, DiagnoseResult& result, const Model& b
                               const std::vector<TrialScore>& full_scores, const EnsembleOptions& eo) {
   if (result.verdict != Verdict::Named || result.basis != Basis::Ensemble || !result.effect || !result.ensemble)
     return {};
-  if (result.ensemble->rung != 0) {
-    result.notes.push_back(
-        "held-out trials: not compared on the outcomes, since the name was made with a finer clump than the one "
-        "diagnosed");
-    return {};
-  }
+  // A name made with a finer clump (its null consistent there, or the ladder converged on it) is
+  // checked with that clump and its refitted coefficients, as it was made.
+  const std::size_t rung = result.ensemble->rung;
+  auto at = rung_model(c, baseline, full_scores, rung);
+  if (!at) return std::unexpected(at.error());
+  const ClumpSwap swap(c, at->clump);
   const auto started = std::chrono::steady_clock::now();
   const Effect named = *result.effect;
-  const std::vector<FreeCoefficient> free = calibrated_beyond_horizon(c, baseline);
-  auto [train_ev, train_scores] = trials_of(c.ev, full_scores, c.training);
-  auto [held_ev, held_scores] = trials_of(c.ev, full_scores, c.heldout);
+  const std::vector<FreeCoefficient> free = calibrated_beyond_horizon(c, at->model);
+  auto [train_ev, train_scores] = trials_of(c.ev, *at->scores, c.training);
+  auto [held_ev, held_scores] = trials_of(c.ev, *at->scores, c.heldout);
   EnsembleOptions o = eo;
   o.pursue = named;
   o.finer = nullptr;  // how far a finer clump moves it is not asked here
   o.candidates_when_inconsistent = nullptr;
-  auto train = compare_ensembles(train_ev, baseline, train_scores, free, {named}, o);
+  auto train = compare_ensembles(train_ev, at->model, train_scores, free, {named}, o);
   if (!train) return std::unexpected(train.error());
   c.evaluations += train->replays;
   const auto h = std::find_if(train->hypotheses.begin(), train->hypotheses.end(),
@@ -66,12 +66,12 @@ Result<void> heldout_outcomes(Context& c, DiagnoseResult& result, const Model& b
         effect_name(named)));
     return {};
   }
-  Model null = baseline;
+  Model null = at->model;
   null.base = train->calibrated;
   OutcomeHoldout out;
   auto before = compare_model(held_ev, null, held_scores, o, out.replays, kHeldOutStream);
   if (!before) return std::unexpected(before.error());
-  auto after = compare_model(held_ev, with_hypothesis(baseline, *h), held_scores, o, out.replays, kHeldOutStream);
+  auto after = compare_model(held_ev, with_hypothesis(at->model, *h), held_scores, o, out.replays, kHeldOutStream);
   if (!after) return std::unexpected(after.error());
   c.evaluations += out.replays;
   out.training_trials = static_cast<int>(c.training.size());
@@ -80,6 +80,7 @@ Result<void> heldout_outcomes(Context& c, DiagnoseResult& result, const Model& b
   out.chi2_null = chi2_of(*before);
   out.chi2_named = chi2_of(*after);
   out.values = h->values;
+  out.rung = rung;
   out.seconds = seconds_since(started);
   result.heldout_outcomes = std::move(out);
   return {};

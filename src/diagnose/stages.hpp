@@ -442,6 +442,17 @@ struct GateFound {
   Effect best = Effect::AirDrag;  ///< margin: the best plausible candidate; candidate_inconsistent: that one
   std::optional<Effect> rival;    ///< margin: the rival whose gap to it is at the gate
 };
+/// A particle-model rung's clump, its full-duration scores and its model: the diagnosed clump's
+/// (rung 0) with `baseline`, or the finer clump's refit (Context::refits, kept until the ensemble
+/// stage ends) with its own coefficients.
+struct RungModel {
+  const Clump* clump = nullptr;
+  const std::vector<TrialScore>* scores = nullptr;
+  Model model;
+};
+Result<RungModel> rung_model(const Context& c, const Model& baseline, const std::vector<TrialScore>& full_scores,
+                             std::size_t rung);
+
 /// Every gate the comparison decided at, in the order consistency, margin, an inconsistent
 /// candidate past the margin. (A finer clump's move is no gate: it is measured with
 /// EnsembleOptions::move_replays, the replays a check would take.)
@@ -478,11 +489,12 @@ std::vector<FreeCoefficient> calibrated_beyond_horizon(const Context& c, const M
 
 // ---- heldout.cpp -----------------------------------------------------------------------------
 
-/// With a name made on the outcomes at the diagnosed clump (basis Ensemble, rung 0): the null and
-/// the named effect calibrated again on the training trials' outcomes (compare_ensembles on them,
-/// the effect pursued) and both compared, from the same fresh release orientations, with the
-/// held-out trials' outcomes (result.heldout_outcomes). `eo` are the options of the comparison
-/// the verdict rests on. Anything else: nothing done.
+/// With a name made on the outcomes (basis Ensemble), on the rung it was made on (its clump and,
+/// on a finer rung, its refitted model: rung_model, so before Context::refits is cleared): the
+/// null and the named effect calibrated again on the training trials' outcomes
+/// (compare_ensembles on them, the effect pursued) and both compared, from the same fresh release
+/// orientations, with the held-out trials' outcomes (result.heldout_outcomes). `eo` are the
+/// options of the comparison the verdict rests on. Anything else: nothing done.
 Result<void> heldout_outcomes(Context& c, DiagnoseResult& result, const Model& baseline,
                               const std::vector<TrialScore>& full_scores, const EnsembleOptions& eo);
 

@@ -907,6 +907,49 @@ TEST(DiagnoseEnsemble, AKineticFrictionBelowTheStaticOneIsNamedFromFourSquareTil
   }
 }
 
+TEST(DiagnoseEnsemble, ANameMadeWithAFinerClumpIsCheckedOnTheHeldOutTrialsWithThatClump) {
+  // The same strong friction drop in six four-square tilts of the finer adaptive-340, diagnosed
+  // with the coarse adaptive-55 and the ladder's 128 and 256 spheres as finer clumps. No clump
+  // leaves the outcomes consistent, the ladder converges from 128 to 256 spheres, and the drop is
+  // named on adaptive-256's comparison (judge_on_converged_clump). The held-out check is made as
+  // the name was, with adaptive-256 and its refitted coefficients: before, a name on a finer rung
+  // had none.
+  auto library = read_clump_library(test::source_dir() / "clumps" / "tuber-default.h5");
+  ASSERT_TRUE(library) << library.error().message;
+  auto coarse = select_clump(*library, "adaptive-55", "tuber-default.h5");
+  ASSERT_TRUE(coarse) << coarse.error().message;
+  auto ladder = read_clump_library(test::source_dir() / "clumps" / "tuber-default-ladder.h5");
+  ASSERT_TRUE(ladder) << ladder.error().message;
+  DiagnoseOptions options;
+  options.effects = {Effect::StaticKineticFriction, Effect::Adhesion};
+  for (const char* name : {"adaptive-128", "adaptive-256"}) {
+    auto finer = select_clump(*ladder, name, "tuber-default-ladder.h5");
+    ASSERT_TRUE(finer) << finer.error().message;
+    options.finer_clumps.push_back(*finer);
+  }
+  auto made = four_square_tilts_from_the_finer_body(6, 0.25, 2613);
+  ASSERT_TRUE(made) << made.error().message;
+  auto result = diagnose(*coarse, default_material_table(), made->recordings, made->names, options);
+  ASSERT_TRUE(result) << result.error().message;
+  ASSERT_EQ(result->verdict, Verdict::Named) << result->statement;
+  EXPECT_EQ(result->effect, Effect::StaticKineticFriction) << result->statement;
+  EXPECT_EQ(result->basis, Basis::Ensemble) << result->statement;
+  ASSERT_TRUE(result->particle_model.has_value());
+  ASSERT_TRUE(result->heldout_outcomes.has_value()) << result->statement;
+  const OutcomeHoldout& held = *result->heldout_outcomes;
+  ASSERT_GT(held.rung, 0u) << "named with the diagnosed clump: this test no longer reaches a finer rung";
+  ASSERT_LT(held.rung, result->particle_model->rungs.size());
+  EXPECT_EQ(result->particle_model->rungs[held.rung].name, "adaptive-256");
+  EXPECT_EQ(held.training_trials, 3);
+  EXPECT_EQ(held.heldout_trials, 3);
+  EXPECT_GT(held.statistics, 0);
+  // Measured 98.0 % (RMS z 15.11 -> 0.30 over 4 means and spreads), the drop 0.215 from the three
+  // training trials.
+  EXPECT_GT(held.improvement(), 0.3) << held.rms_z_null() << " -> " << held.rms_z_named();
+  ASSERT_EQ(held.values.size(), 1u);
+  EXPECT_NEAR(held.values[0], 0.25, 0.1);
+}
+
 TEST(DiagnoseEnsemble, ARecordingWithMoreTrialsThanReplaysIsReplayedOncePerTrial) {
   // Fourteen tuber drops from 0.2 m on soil, made from the finer adaptive-340, no release
   // orientation, diagnosed with the default 12 replays per recording. The recorded sample's mean

@@ -205,7 +205,7 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
     assert cf.Basis.free_flights != cf.Basis.ensemble
     # A name made beyond the release horizon, checked on the held-out trials where it was made.
     assert {"heldout_outcomes", "heldout_flights"} <= set(dir(cf.DiagnoseResult))
-    assert {"training_trials", "heldout_trials", "rms_z_null", "rms_z_named", "improvement", "values"} <= set(
+    assert {"training_trials", "heldout_trials", "rms_z_null", "rms_z_named", "improvement", "values", "rung"} <= set(
         dir(cf.OutcomeHoldout)
     )
     assert {"training_flights", "heldout_flights", "offset_m", "wobble_m", "without_m", "with_m"} <= set(
