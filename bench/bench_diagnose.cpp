@@ -883,6 +883,7 @@ struct BenchOptions {
     options.lab.contact.wall_mass = contact_wall_mass();
     options.drift_at = drift_at();
     options.held_starts = !one_start;
+    options.seed = seed;
   }
   std::string recordings_set, orientation = "none",
                               generator_file = std::string(CLUMPFORGE_SOURCE_DIR) + "/clumps/tuber-default.h5",
@@ -912,7 +913,9 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("-o,--output,--out", o.out, "Working directory (recordings, answers, reports, summary)");
   app.add_option("--controls", o.controls, "Effect-free controls");
   app.add_option("--trials", o.trials, "Trials per recording");
-  app.add_option("--seed", o.seed, "Seed of the whole benchmark");
+  app.add_option("--seed", o.seed,
+                 "Seed of the whole benchmark: the generated recordings and each diagnosis's release orientations "
+                 "(with --recordings-set, the latter alone; as diagnose --seed)");
   app.add_option("--effects", o.only, "Only these effects, by name (space- or comma-separated; default: the library)")
       ->delimiter(',');
   app.add_flag("--full-set", o.full_set,

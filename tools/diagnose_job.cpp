@@ -491,6 +491,7 @@ Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& c
   run.report["wall_mass"] = std::string(wall_mass_name(job.options.lab.contact.wall_mass));
   run.report["drop_drift"] = std::string(drift_at_name(job.options.drift_at));
   run.report["held_starts"] = job.options.held_starts;
+  run.report["seed"] = job.options.seed;  // the release orientations drawn: the same seed, the same report
   return run;
 }
 

@@ -114,16 +114,18 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   EXPECT_FALSE(std::filesystem::exists(dir / "mass"));
   // A track too short to decide anything: that verdict, not a guess; the report says which
   // wall-contact mass its coefficients are under and whether a fit ending on the null was
-  // started again (--one-start).
+  // started again (--one-start), and the seed of its release orientations (1 unless given).
   for (const std::string mass : {"whole", "shared"}) {
     const bool one_start = mass == "shared";
     run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --wall-mass {}{} --json",
-                                           (dir / "rec").string(), clump(), mass, one_start ? " --one-start" : ""));
+                                           (dir / "rec").string(), clump(), mass,
+                                           one_start ? " --one-start --seed 5" : ""));
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const auto j = nlohmann::json::parse(run.out);
     EXPECT_EQ(j["verdict"], "undecidable");
     EXPECT_EQ(j["wall_mass"], mass);
     EXPECT_EQ(j["held_starts"], !one_start);
+    EXPECT_EQ(j["seed"], one_start ? 5 : 1);
   }
   // A trial id is the recording's free text: an escape sequence in it (JSON "\u001b") is written
   // out as \x1B in the text report's note on the too-short trial, never sent to the terminal.
