@@ -453,9 +453,9 @@ struct RungModel {
 Result<RungModel> rung_model(const Context& c, const Model& baseline, const std::vector<TrialScore>& full_scores,
                              std::size_t rung);
 
-/// Every gate the comparison decided at, in the order consistency, margin, an inconsistent
-/// candidate past the margin. (A finer clump's move is no gate: it is measured with
-/// EnsembleOptions::move_replays, the replays a check would take.)
+/// Every gate the comparison decided at, in the order consistency, margin (the best candidate's
+/// over the null, then its closest rival's gap below it), an inconsistent candidate past the margin. (A finer clump's
+/// move is no gate: it is measured with EnsembleOptions::move_replays, the replays a check would take.)
 std::vector<GateFound> gates_at(const DiagnoseResult& result, double min_delta_bic);
 /// Each gate's decision judged again on `eo.replays` replays per recording from release
 /// orientations drawn afresh, at the first draw's calibrated coefficients: the null's

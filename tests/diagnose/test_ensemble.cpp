@@ -1381,7 +1381,7 @@ TEST(EnsembleGate, EveryGateIsFoundWithWhatDecidedThere) {
   EnsembleHypothesis offset;  // past the margin, its outcomes inconsistent
   offset.effect = Effect::ComOffset;
   offset.plausible = true;
-  offset.first_delta_bic = offset.fresh_delta_bic = 25.0;
+  offset.first_delta_bic = offset.fresh_delta_bic = 15.0;
   offset.values = {0.001};
   for (int o = 0; o < 36; ++o)
     offset.comparisons.push_back({.statistic = o < 18 ? Statistic::Mean : Statistic::Spread, .z = 2.0});
@@ -1394,11 +1394,53 @@ TEST(EnsembleGate, EveryGateIsFoundWithWhatDecidedThere) {
   EXPECT_EQ(gates[1].retry.gate, Gate::CandidateMargin);
   EXPECT_EQ(gates[1].best, Effect::ViscoelasticRestitution);
   ASSERT_TRUE(gates[1].rival.has_value());
-  EXPECT_EQ(*gates[1].rival, Effect::ElasticPlasticRestitution);
+  EXPECT_EQ(*gates[1].rival, Effect::ElasticPlasticRestitution);  // the closest rival (the offset is 15 below)
   EXPECT_NEAR(gates[1].retry.value, 10.0, 1e-12);
   EXPECT_EQ(gates[2].retry.gate, Gate::CandidateInconsistent);
   EXPECT_EQ(gates[2].best, Effect::ComOffset);
   EXPECT_LT(gates[2].retry.value, gates[2].retry.threshold);  // its means at 72 over 17 degrees of freedom
+}
+
+// A best candidate at its own gate does not hide its rival's: lab-like case-08 at seed 2, the
+// elastic-plastic law at delta-BIC 19.2 and 19.5 on its two draws (within twice the margin of 10)
+// and the viscoelastic one at 12.4 and 12.6, 6.6 below it (ambiguous). Both decisions are judged
+// again: the best's margin first, then the gap. Before, only the best's margin was, it held
+// (30.5 on 48 replays), and the gap was never judged again.
+TEST(EnsembleGate, ABestAtItsOwnGateDoesNotHideItsRivals) {
+  DiagnoseResult result;
+  EnsembleReport e;
+  e.outcomes = 32;
+  e.calibrated_here = {"Q235:restitution", "soil:restitution"};
+  for (int o = 0; o < 32; ++o) e.null_comparisons.push_back({.statistic = Statistic::Mean, .z = 0.6});
+  EnsembleHypothesis best, rival, far;
+  best.effect = Effect::ElasticPlasticRestitution;
+  best.first_delta_bic = 19.18;
+  best.fresh_delta_bic = 19.50;
+  rival.effect = Effect::ViscoelasticRestitution;
+  rival.first_delta_bic = 12.40;
+  rival.fresh_delta_bic = 12.60;
+  far.effect = Effect::Adhesion;  // 17.2 below: within reach too, but not the closest
+  far.first_delta_bic = far.fresh_delta_bic = 2.0;
+  best.plausible = rival.plausible = far.plausible = true;
+  e.hypotheses = {best, far, rival};
+  result.ensemble = e;
+  const auto gates = diagnosis::gates_at(result, 10.0);
+  ASSERT_EQ(gates.size(), 2u);
+  EXPECT_EQ(gates[0].retry.gate, Gate::CandidateMargin);
+  EXPECT_EQ(gates[0].best, Effect::ElasticPlasticRestitution);
+  EXPECT_FALSE(gates[0].rival.has_value());
+  EXPECT_NEAR(gates[0].retry.value, 19.18, 1e-12);
+  EXPECT_EQ(gates[1].retry.gate, Gate::CandidateMargin);
+  EXPECT_EQ(gates[1].best, Effect::ElasticPlasticRestitution);
+  ASSERT_TRUE(gates[1].rival.has_value());
+  EXPECT_EQ(*gates[1].rival, Effect::ViscoelasticRestitution);  // the closest rival
+  EXPECT_NEAR(gates[1].retry.value, 19.18 - 12.60, 1e-12);
+  // Below the margin the best names nothing, so no rival is asked about.
+  result.ensemble->hypotheses[0].first_delta_bic = 9.0;
+  result.ensemble->hypotheses[2].first_delta_bic = result.ensemble->hypotheses[2].fresh_delta_bic = 8.0;
+  const auto below = diagnosis::gates_at(result, 10.0);
+  ASSERT_EQ(below.size(), 1u);
+  EXPECT_FALSE(below[0].rival.has_value());
 }
 
 // A restitution candidate's tilt replays start from a level plate, as the generator's do; other
