@@ -74,14 +74,15 @@ std::vector<GateFound> margins_at_gate(const EnsembleReport& e, double margin) {
                      .best = best->effect});
   if (d < margin) return found;
   const EnsembleHypothesis* rival = nullptr;  // the closest: it decides whether the verdict is ambiguous
+  double gap = 2.0 * margin;                  // its gap; within reach below twice the margin
   for (const EnsembleHypothesis& h : e.hypotheses) {
-    const double gap = d - h.best_delta_bic();
-    if (&h != best && h.plausible && gap > 0.0 && gap < 2.0 * margin &&
-        (!rival || h.best_delta_bic() > rival->best_delta_bic()))
+    const double below = d - h.best_delta_bic();
+    if (&h != best && h.plausible && below > 0.0 && below < gap) {
       rival = &h;
+      gap = below;
+    }
   }
   if (rival) {
-    const double gap = d - rival->best_delta_bic();
     found.push_back(
         {.retry = {.gate = Gate::CandidateMargin,
                    .value = gap,

@@ -948,7 +948,10 @@ TEST(DiagnoseEnsemble, ANameMadeWithAFinerClumpIsCheckedOnTheHeldOutTrialsWithTh
   ASSERT_LT(held.rung, result->particle_model->rungs.size());
   EXPECT_EQ(result->particle_model->rungs[held.rung].name, "adaptive-256");
   // Measured 98.0 % (RMS z 15.11 -> 0.30 over 4 means and spreads), the drop 0.215 from the three
-  // training trials.
+  // training trials: in the test's properties (--gtest_output=json:FILE).
+  RecordProperty("heldout_rms_z_null", std::to_string(held.rms_z_null()));
+  RecordProperty("heldout_rms_z_named", std::to_string(held.rms_z_named()));
+  RecordProperty("heldout_drop", held.values.empty() ? "none" : std::to_string(held.values[0]));
   expect_the_drop_predicts_the_heldout_tilts(held);
 }
 
