@@ -336,19 +336,15 @@ std::string misnamed_line(const std::vector<std::pair<std::string, std::string>>
                      shown.empty() ? std::string() : fmt::format(" ({})", fmt::join(shown, ", ")));
 }
 
-/// The particle a case's recordings name: the first manifest's mesh (relative to it) and density.
-std::optional<std::pair<fs::path, double>> case_particle(const fs::path& case_dir) {
-  std::vector<fs::path> manifests;
-  for (const auto& entry : fs::directory_iterator(case_dir)) {
-    if (fs::is_regular_file(entry.path() / "recording.json")) manifests.push_back(entry.path() / "recording.json");
-  }
-  std::sort(manifests.begin(), manifests.end());
-  if (manifests.empty()) return std::nullopt;
-  std::ifstream in(manifests.front());
-  const auto j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.contains("particle") || !j["particle"].contains("mesh")) return std::nullopt;
-  return std::pair{manifests.front().parent_path() / j["particle"]["mesh"].get<std::string>(),
-                   j["particle"].value("density_kg_m3", 1085.0)};
+/// The mesh a case's recordings name (relative to the manifest naming it). The bench opens it where
+/// diagnose would not (outside the recording's folder: the lab-like set keeps its meshes beside
+/// its cases); the density is the recordings' own, as diagnose reads it.
+std::optional<fs::path> case_mesh(const fs::path& case_dir) {
+  auto set = read_recordings(case_dir);
+  if (!set) return std::nullopt;
+  auto stated = stated_particle(*set);
+  if (!stated || !stated->mesh) return std::nullopt;
+  return stated->mesh_in.parent_path() / *stated->mesh;
 }
 
 /// Runs one diagnosis in process and stores its report as `report` (atomically); a failure is
@@ -467,15 +463,14 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
       existing_only || run_missing(
                            team, ids, [&](std::size_t i) { return !fs::exists(out / ids[i] / "report.json"); },
                            [&](std::size_t i) {
-                             const auto particle = case_particle(set / ids[i]);
-                             if (!particle) {
+                             const auto mesh = case_mesh(set / ids[i]);
+                             if (!mesh) {
                                std::cerr << ids[i] << ": no particle mesh named in its manifests\n";
                                return false;
                              }
                              cli::DiagnoseJob job = base;
                              job.recordings = {(set / ids[i]).string()};
-                             job.mesh = particle->first.string();
-                             job.density = particle->second;
+                             job.mesh = mesh->string();
                              return diagnose_case(ids[i], job, out / ids[i] / "report.json");
                            });
   if (!team.leader()) return ran ? 0 : 1;

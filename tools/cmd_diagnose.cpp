@@ -1,4 +1,4 @@
-// clumpforge diagnose --recordings DIR... (--mesh MESH | --library CLUMP.h5 [--clump NAME]) [--output DIR] [--json]
+// clumpforge diagnose --recordings DIR... [--mesh MESH | --library CLUMP.h5 [--clump NAME]] [--output DIR] [--json]
 // Where the DEM and the recordings disagree, which physics is missing, and the fit once it is added.
 #include <fmt/format.h>
 
@@ -33,6 +33,8 @@ struct DiagnoseArgs {
   int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
   std::uint64_t seed = 1;
   bool json = false, no_replay_reuse = false, one_start = false;
+  const CLI::Option* units_option = nullptr;    ///< given: --units overrides nothing the recordings state
+  const CLI::Option* density_option = nullptr;  ///< given: --density must agree with the recordings'
 };
 
 /// The text report. Trial ids, track names and folder names are the recording's free text and can
@@ -119,8 +121,8 @@ int run_diagnose(const DiagnoseArgs& args) {
                   .mesh = args.mesh,
                   .library = args.clump,
                   .clump_name = args.clump_name,
-                  .units = args.units,
-                  .density = args.density,
+                  .units = args.units_option->count() > 0 ? std::optional(args.units) : std::nullopt,
+                  .density = args.density_option->count() > 0 ? std::optional(args.density) : std::nullopt,
                   .spheres = args.spheres,
                   .finer_clumps = args.finer_clumps,
                   .materials = args.materials,
@@ -181,7 +183,9 @@ Command add_diagnose_command(CLI::App& app) {
   sub->add_option("--recordings", args->recordings, "Recording directories, or directories of them")
       ->required()
       ->expected(1, -1);
-  sub->add_option("--mesh", args->mesh, "The particle's closed mesh (filled adaptively with --spheres spheres)");
+  sub->add_option("--mesh", args->mesh,
+                  "The particle's closed mesh (filled adaptively with --spheres spheres); without --mesh and "
+                  "--library, the mesh the recordings name (particle.mesh) when it lies inside a recording's folder");
   add_library_option(*sub, args->clump, "The particle as a clump library (.h5)");
   add_clump_option(*sub, args->clump_name, "Which clump of the library (needed when it holds several)");
   sub->add_option("--spheres", args->spheres,
@@ -192,8 +196,14 @@ Command add_diagnose_command(CLI::App& app) {
                   "tracks still change with the next one, and a mismatch is refitted with the rest before it is "
                   "blamed on missing physics (with --mesh: 2x, 4x ... the spheres; with --library: its clumps with "
                   "more spheres)");
-  add_units_option(*sub, args->units, "With --mesh: its length unit (mm, cm, m)");
-  add_density_option(*sub, args->density, "With --mesh: bulk density [kg/m^3]");
+  args->units_option = add_units_option(
+      *sub, args->units,
+      "With --mesh: its length unit (mm, cm, m; default: the recordings' mesh_units when --mesh is the mesh they "
+      "name, else mm)");
+  args->density_option =
+      add_density_option(*sub, args->density,
+                         "Bulk density [kg/m^3] (default: the recordings' density_kg_m3, else 1085, the Corydalis "
+                         "tuber's); given and stated, they must agree within 1 %, and a library's clump with both");
   sub->add_option("--effects", args->effects,
                   "Candidate effects to test, space- or comma-separated (default: the whole library)")
       ->delimiter(',');

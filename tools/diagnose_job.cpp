@@ -17,15 +17,99 @@
 namespace clumpforge::cli {
 namespace {
 
-// A recording directory, or a directory of recording directories (sorted by name).
-Result<void> collect(const std::string& path, std::vector<Recording>& recordings, std::vector<std::string>& names) {
-  auto set = read_recordings(path);
-  if (!set) return std::unexpected(set.error());
-  for (std::size_t i = 0; i < set->recordings.size(); ++i) {
-    recordings.push_back(std::move(set->recordings[i]));
-    names.push_back(std::move(set->names[i]));
+namespace fs = std::filesystem;
+
+// Each recording directory, or directory of recording directories (sorted by name), in one set.
+Result<RecordingSet> collect(const std::vector<std::string>& paths) {
+  RecordingSet all;
+  for (const auto& path : paths) {
+    auto set = read_recordings(path);
+    if (!set) return std::unexpected(set.error());
+    std::ranges::move(set->recordings, std::back_inserter(all.recordings));
+    std::ranges::move(set->names, std::back_inserter(all.names));
+    std::ranges::move(set->manifests, std::back_inserter(all.manifests));
   }
-  return {};
+  return all;
+}
+
+// Where the particle's density came from.
+enum class DensityFrom { CommandLine, Recordings, Library, Default };
+
+std::string_view density_from_name(DensityFrom from) {
+  switch (from) {
+    case DensityFrom::CommandLine:
+      return "command_line";
+    case DensityFrom::Recordings:
+      return "recordings";
+    case DensityFrom::Library:
+      return "library";
+    case DensityFrom::Default:
+      return "default";
+  }
+  return "default";
+}
+
+// The particle diagnosed: a mesh with its unit and density, or a library's clump (mesh empty).
+struct ParticleChoice {
+  std::string mesh;
+  bool mesh_from_recordings = false;
+  std::string units = "mm";
+  double density = kDefaultDensity;
+  DensityFrom density_from = DensityFrom::Default;
+};
+
+// The mesh: the one given, or the one the recordings name inside a recording's folder (nothing
+// outside it is opened because a recording names it: the refusal says to give it as --mesh).
+Result<ParticleChoice> mesh_choice(const DiagnoseJob& job, const StatedParticle& stated) {
+  ParticleChoice c;
+  if (!job.mesh.empty()) {
+    c.mesh = job.mesh;
+  } else if (stated.mesh) {
+    auto inside = stated.mesh_inside();
+    if (!inside)
+      return fail(inside.error().code,
+                  fmt::format("{}; clumpforge opens nothing outside a recording's folder because the recording names "
+                              "it: give the mesh as --mesh '{}'{}",
+                              inside.error().message, stated.mesh_as_named()->string(),
+                              stated.mesh_units ? fmt::format(" --units {}", *stated.mesh_units) : std::string()));
+    c.mesh = inside->string();
+    c.mesh_from_recordings = true;
+  } else {
+    return fail(ErrorCode::InvalidArgument,
+                "give exactly one of --mesh and --library: the recordings name no particle mesh (particle.mesh)");
+  }
+  std::error_code ec;
+  const bool stated_mesh = c.mesh_from_recordings ||
+                           (stated.mesh && fs::absolute(job.mesh, ec).lexically_normal() == stated.mesh_as_named());
+  if (job.units && stated_mesh && stated.mesh_units && *job.units != *stated.mesh_units)
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("{} states the particle mesh's units as {}, --units gives {}: leave --units out to use "
+                            "the recording's",
+                            stated.mesh_in.string(), *stated.mesh_units, *job.units));
+  c.units = job.units ? *job.units : (stated_mesh && stated.mesh_units ? *stated.mesh_units : "mm");
+  return c;
+}
+
+// The particle: its mesh (mesh_choice) or a library, and its density, from the command line, the
+// recordings or the default; a density given and stated must agree (a library's clump: in
+// library_models).
+Result<ParticleChoice> particle_choice(const DiagnoseJob& job, const StatedParticle& stated) {
+  if (job.density && stated.density && !same_density(*job.density, *stated.density))
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("{} states the particle's density {:g} kg/m^3, --density gives {:g}: one particle, one "
+                            "density (leave --density out to use the recording's)",
+                            stated.density_in.string(), *stated.density, *job.density));
+  ParticleChoice c;
+  if (job.library.empty()) {
+    auto mesh = mesh_choice(job, stated);
+    if (!mesh) return std::unexpected(mesh.error());
+    c = std::move(*mesh);
+  }
+  c.density = job.density ? *job.density : stated.density.value_or(kDefaultDensity);
+  c.density_from = job.density      ? DensityFrom::CommandLine
+                   : stated.density ? DensityFrom::Recordings
+                                    : DensityFrom::Default;
+  return c;
 }
 
 // A number, or null when it is not finite (JSON has no infinity or NaN).
@@ -104,12 +188,27 @@ struct ParticleModels {
 };
 
 // From a library: the clump named, and the library's clumps with more spheres (fewest first).
-Result<ParticleModels> library_models(const DiagnoseJob& job) {
+// Its clump's density must agree with the one the recordings state or --density gives.
+Result<ParticleModels> library_models(const DiagnoseJob& job, ParticleChoice& choice, const StatedParticle& stated) {
   auto clumps = read_clump_library(job.library);
   if (!clumps) return std::unexpected(clumps.error());
   std::vector<Clump> others = *clumps;
   auto chosen = select_clump(std::move(*clumps), job.clump_name, job.library);
   if (!chosen) return std::unexpected(chosen.error());
+  const auto differs = [&](double d) { return chosen->density > 0.0 && !same_density(chosen->density, d); };
+  if (choice.density_from != DensityFrom::Default && differs(choice.density))
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("'{}': clump '{}' was made at the density {:g} kg/m^3, and {} {:g} kg/m^3: fill the "
+                            "mesh at that density, or diagnose it with --mesh",
+                            job.library, chosen->name, chosen->density,
+                            choice.density_from == DensityFrom::CommandLine
+                                ? std::string("--density gives")
+                                : fmt::format("{} states", stated.density_in.string()),
+                            choice.density));
+  if (chosen->density > 0.0) {
+    choice.density = chosen->density;
+    choice.density_from = DensityFrom::Library;
+  }
   ParticleModels out{.clump = std::move(*chosen), .ladder = {}, .finer = {}};
   std::erase_if(others, [&](const Clump& c) { return c.spheres.size() <= out.clump.spheres.size(); });
   std::ranges::sort(others, {}, [](const Clump& c) { return c.spheres.size(); });
@@ -122,12 +221,13 @@ Result<ParticleModels> library_models(const DiagnoseJob& job) {
 // The mesh filled adaptively (with --spheres, or to the surface accuracy by convergence, the
 // resolutions tried in `ladder`); finer fills with twice, four times ... as many spheres, kept
 // when they lie closer to the mesh.
-Result<ParticleModels> particle_models(const DiagnoseJob& job, const RunContext& context) {
-  if (!job.library.empty()) return library_models(job);
+Result<ParticleModels> particle_models(const DiagnoseJob& job, ParticleChoice& choice, const StatedParticle& stated,
+                                       const RunContext& context) {
+  if (!job.library.empty()) return library_models(job, choice, stated);
   ParticleModels out;
   SdfOptions sdf;
   sdf.feature_size = 1e-3;
-  auto body = load_closed_body(job.mesh, job.units, job.density, sdf, context);
+  auto body = load_closed_body(choice.mesh, choice.units, choice.density, sdf, context);
   if (!body) return std::unexpected(body.error());
   FillOptions fill;
   fill.method = FillMethod::Adaptive;
@@ -135,14 +235,14 @@ Result<ParticleModels> particle_models(const DiagnoseJob& job, const RunContext&
   auto filled = job.spheres > 0 ? fill_body(body->body, fill, context)
                                 : fill_to_surface_accuracy(body->body, fill, job.options.model_accuracy_m / 3.0,
                                                            kMaxAutoSpheres, &out.ladder, context);
-  if (!filled) return fail(filled.error().code, fmt::format("'{}': {}", job.mesh, filled.error().message));
+  if (!filled) return fail(filled.error().code, fmt::format("'{}': {}", choice.mesh, filled.error().message));
   out.clump = std::move(filled->clump);
   double surface = out.clump.error.surface_rms;
   int spheres = static_cast<int>(out.clump.spheres.size());
   for (int k = 0; k < job.finer_clumps && 2 * spheres <= kMaxFinerSpheres; ++k) {
     fill.max_spheres = 2 * spheres;
     auto finer = fill_body(body->body, fill, context);
-    if (!finer) return fail(finer.error().code, fmt::format("'{}': {}", job.mesh, finer.error().message));
+    if (!finer) return fail(finer.error().code, fmt::format("'{}': {}", choice.mesh, finer.error().message));
     spheres = fill.max_spheres;
     // A fill no closer to the mesh (a sphere's mesh is one sphere; more add corners) is no finer.
     if (!(finer->clump.error.surface_rms < surface)) break;
@@ -449,19 +549,22 @@ std::string diagnosis_tracks_json(const DiagnoseResult& r) {
 }
 
 Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& context) {
-  if (job.mesh.empty() == job.library.empty())
-    return fail(ErrorCode::InvalidArgument, "give exactly one of --mesh and --library");
-  std::vector<Recording> recordings;
-  std::vector<std::string> names;
-  for (const auto& path : job.recordings) {
-    if (auto ok = collect(path, recordings, names); !ok) return std::unexpected(ok.error());
-  }
+  if (!job.mesh.empty() && !job.library.empty())
+    return fail(ErrorCode::InvalidArgument, "give exactly one of --mesh and --library, not both");
+  auto set = collect(job.recordings);
+  if (!set) return std::unexpected(set.error());
+  const std::vector<Recording>& recordings = set->recordings;
+  const std::vector<std::string>& names = set->names;
+  auto stated = stated_particle(*set);
+  if (!stated) return std::unexpected(stated.error());
+  auto choice = particle_choice(job, *stated);
+  if (!choice) return std::unexpected(choice.error());
   auto table = job.materials.empty() ? Result<MaterialTable>(default_material_table()) : read_materials(job.materials);
   if (!table) return std::unexpected(table.error());
   for (const auto& r : recordings) {
     if (auto s = table->find(r.surface); !s) return std::unexpected(s.error());
   }
-  auto model = particle_models(job, context);
+  auto model = particle_models(job, *choice, *stated, context);
   if (!model) return std::unexpected(model.error());
   DiagnoseOptions options = job.options;
   options.finer_clumps = std::move(model->finer);
@@ -492,6 +595,15 @@ Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& c
   run.report["drop_drift"] = std::string(drift_at_name(job.options.drift_at));
   run.report["held_starts"] = job.options.held_starts;
   run.report["seed"] = job.options.seed;  // the release orientations drawn: the same seed, the same report
+  run.report["particle"] = {
+      {"mesh", choice->mesh.empty() ? nlohmann::json() : nlohmann::json(choice->mesh)},
+      {"mesh_from", choice->mesh.empty()
+                        ? nlohmann::json()
+                        : nlohmann::json(choice->mesh_from_recordings ? "recordings" : "command_line")},
+      {"mesh_units", choice->mesh.empty() ? nlohmann::json() : nlohmann::json(choice->units)},
+      {"library", job.library.empty() ? nlohmann::json() : nlohmann::json(job.library)},
+      {"density_kg_m3", choice->density},
+      {"density_from", std::string(density_from_name(choice->density_from))}};
   return run;
 }
 

@@ -3,6 +3,7 @@
 /// in process for every case): the recordings read, the particle model made (a library's clump,
 /// or the mesh filled to the surface accuracy), diagnose() run, and its report as JSON.
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,9 @@
 
 namespace clumpforge::cli {
 
+/// The density a mesh is filled at when neither the command line nor the recordings give one: the
+/// Corydalis tuber's [kg/m^3].
+inline constexpr double kDefaultDensity = 1085.0;
 /// The largest adaptive clump the convergence ladder tries.
 inline constexpr int kMaxAutoSpheres = 256;
 /// The largest finer clump made to check the particle model against.
@@ -20,11 +24,16 @@ inline constexpr int kMaxFinerSpheres = 1024;
 
 struct DiagnoseJob {
   std::vector<std::string> recordings;  ///< recording folders, or folders of them
-  std::string mesh;                     ///< the particle's closed mesh, or
-  std::string library, clump_name;      ///< a clump library and the clump's name
-  std::string units = "mm";             ///< of the mesh
-  double density = 1085.0;              ///< of the mesh [kg/m^3]
-  int spheres = 0;                      ///< adaptive budget for the mesh; 0: by convergence to the scan
+  /// The particle's closed mesh, or a clump library and the clump's name; neither: the mesh the
+  /// recordings name (`particle.mesh`), when it lies inside the folder of the recording naming it.
+  std::string mesh;
+  std::string library, clump_name;
+  /// Of the mesh; unset: the recordings' `mesh_units` when the mesh is the one they name, else mm.
+  std::optional<std::string> units;
+  /// [kg/m^3] unset: the recordings' `density_kg_m3`, else kDefaultDensity. Given and stated, the
+  /// two must agree within kStatedDensityTolerance; a library's clump must agree with both.
+  std::optional<double> density;
+  int spheres = 0;  ///< adaptive budget for the mesh; 0: by convergence to the scan
   /// Finer clumps of the same body for the particle-model check (DiagnoseOptions::finer_clumps):
   /// from a mesh, fills with 2, 4, ... times the spheres (kept while closer to the mesh); from a
   /// library, its clumps with more spheres. 0: none.

@@ -43,6 +43,15 @@ struct Trial {
   std::string extra_json = "{}";  ///< other keys of the trial, kept when rewriting
 };
 
+/// How far apart (relative) two densities of one particle may be: a recording's stated one, the
+/// command line's and a clump's (1 %: a lab's 1084.6 is the library's 1085).
+inline constexpr double kStatedDensityTolerance = 0.01;
+
+/// Whether two densities [kg/m^3] are one particle's, within kStatedDensityTolerance.
+inline bool same_density(double a, double b) {
+  return std::abs(a - b) <= kStatedDensityTolerance * std::max(a, b);
+}
+
 /// Limits no experiment exceeds: a value beyond them is refused as a broken recording.
 struct RecordingLimits {
   static constexpr double max_coordinate = 100.0;      ///< [m] |x|, |z| of a track

@@ -98,31 +98,29 @@ std::string_view column_unit(const std::string& column) {
   return "rad";
 }
 
-/// The track file a trial names, resolved inside the recording's folder: an absolute path, a
-/// `..` component or a link that leads out of the folder is refused, and nothing is opened.
-Result<fs::path> track_path(const fs::path& dir, const std::string& name) {
+/// A file a recording names (`what`: "the track path", "the particle's mesh"), resolved inside
+/// the recording's folder: an absolute path, a `..` component or a link that leads out of the
+/// folder is refused, and nothing is opened.
+Result<fs::path> inside_folder(const fs::path& dir, const std::string& name, std::string_view what) {
   const fs::path relative(name);
-  if (name.empty()) return fail(ErrorCode::InvalidArgument, "the track path is empty");
+  if (name.empty()) return fail(ErrorCode::InvalidArgument, fmt::format("{} is empty", what));
   if (relative.is_absolute() || relative.has_root_name() || relative.has_root_directory()) {
-    return fail(
-        ErrorCode::InvalidArgument,
-        fmt::format("the track path '{}' is absolute; it must name a file inside the recording's folder", name));
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("{} '{}' is absolute; it must name a file inside the recording's folder", what, name));
   }
   for (const auto& part : relative) {
     if (part == "..")
-      return fail(ErrorCode::InvalidArgument,
-                  fmt::format("the track path '{}' leaves the recording's folder ('..')", name));
+      return fail(ErrorCode::InvalidArgument, fmt::format("{} '{}' leaves the recording's folder ('..')", what, name));
   }
   std::error_code ec;
   const fs::path folder = fs::weakly_canonical(fs::absolute(dir, ec), ec);
   const fs::path resolved = fs::weakly_canonical(fs::absolute(dir / relative, ec), ec);
   if (ec)
-    return fail(ErrorCode::InvalidArgument,
-                fmt::format("the track path '{}' cannot be resolved: {}", name, ec.message()));
+    return fail(ErrorCode::InvalidArgument, fmt::format("{} '{}' cannot be resolved: {}", what, name, ec.message()));
   auto [end, at] = std::mismatch(folder.begin(), folder.end(), resolved.begin(), resolved.end());
   if (end != folder.end()) {
     return fail(ErrorCode::InvalidArgument,
-                fmt::format("the track path '{}' leads out of the recording's folder (through a link)", name));
+                fmt::format("{} '{}' leads out of the recording's folder (through a link)", what, name));
   }
   return dir / relative;
 }
@@ -354,7 +352,7 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
       if (!entry["track"].is_string())
         reader.error("track", fmt::format("trial '{}': 'track' must be a file name", trial.id), search_from);
       trial.track_file = entry["track"].get<std::string>();
-      auto path = track_path(dir, trial.track_file);
+      auto path = inside_folder(dir, trial.track_file, "the track path");
       if (!path) reader.error("track", fmt::format("trial '{}': {}", trial.id, path.error().message), search_from);
       auto track = read_track(*path);
       if (!track) throw ManifestError{track.error().message};
@@ -520,6 +518,7 @@ Result<RecordingSet> read_recordings(const fs::path& path) {
     auto r = read_recording(path);
     if (!r) return std::unexpected(r.error());
     set.recordings.push_back(std::move(*r));
+    set.manifests.push_back(fs::is_directory(path, ec) ? path / "recording.json" : path);
     std::string name = fs::is_directory(path, ec) ? path.filename().string() : path.parent_path().filename().string();
     if (name.empty()) name = fs::absolute(path).lexically_normal().parent_path().filename().string();
     set.names.push_back(name);
@@ -540,8 +539,73 @@ Result<RecordingSet> read_recordings(const fs::path& path) {
     if (!r) return std::unexpected(r.error());
     set.recordings.push_back(std::move(*r));
     set.names.push_back(child.filename().string());
+    set.manifests.push_back(child / "recording.json");
   }
   return set;
+}
+
+Result<fs::path> StatedParticle::mesh_inside() const {
+  if (!mesh) return fail(ErrorCode::NotFound, "the recordings name no particle mesh");
+  auto path = inside_folder(mesh_in.parent_path(), *mesh, "the particle's mesh");
+  if (!path) return fail(path.error().code, fmt::format("{}: {}", mesh_in.string(), path.error().message));
+  return path;
+}
+
+std::optional<fs::path> StatedParticle::mesh_as_named() const {
+  if (!mesh) return std::nullopt;
+  std::error_code ec;
+  return fs::absolute(mesh_in.parent_path() / *mesh, ec).lexically_normal();
+}
+
+namespace {
+/// "'A' states X and 'B' states Y": the refusal of two manifests that disagree on the particle.
+Error disagree(const fs::path& first, const fs::path& second, std::string_view what, const std::string& a,
+               const std::string& b) {
+  return {ErrorCode::InvalidArgument,
+          fmt::format("{} states the particle's {} {} and {} states {}: the recordings of one diagnosis are of one "
+                      "particle",
+                      first.string(), what, a, second.string(), b)};
+}
+}  // namespace
+
+Result<StatedParticle> stated_particle(const RecordingSet& set) {
+  StatedParticle out;
+  fs::path units_in;
+  for (std::size_t i = 0; i < set.recordings.size() && i < set.manifests.size(); ++i) {
+    const Recording& r = set.recordings[i];
+    const fs::path& at = set.manifests[i];
+    if (const auto& d = r.particle_density) {
+      if (!out.density) {
+        out.density = *d;
+        out.density_in = at;
+      } else if (!same_density(*d, *out.density)) {
+        return std::unexpected(disagree(out.density_in, at, "density", fmt::format("{:g} kg/m^3", *out.density),
+                                        fmt::format("{:g} kg/m^3", *d)));
+      }
+    }
+    if (const auto& m = r.particle_mesh) {
+      if (!out.mesh) {
+        out.mesh = *m;
+        out.mesh_in = at;
+      } else {
+        StatedParticle other;
+        other.mesh = *m;
+        other.mesh_in = at;
+        if (other.mesh_as_named() != out.mesh_as_named())
+          return std::unexpected(
+              disagree(out.mesh_in, at, "mesh", fmt::format("'{}'", *out.mesh), fmt::format("'{}'", *m)));
+      }
+    }
+    if (const auto& u = r.particle_mesh_units) {
+      if (!out.mesh_units) {
+        out.mesh_units = *u;
+        units_in = at;
+      } else if (*u != *out.mesh_units) {
+        return std::unexpected(disagree(units_in, at, "mesh units", *out.mesh_units, *u));
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace clumpforge

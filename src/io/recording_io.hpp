@@ -20,12 +20,35 @@ Result<void> write_recording(const std::filesystem::path& dir, const Recording& 
 /// Recordings with the names reports give them.
 struct RecordingSet {
   std::vector<Recording> recordings;
-  std::vector<std::string> names;  ///< parallel to `recordings`: each one's folder name
+  std::vector<std::string> names;                ///< parallel to `recordings`: each one's folder name
+  std::vector<std::filesystem::path> manifests;  ///< parallel to `recordings`: each one's recording.json
 };
 
 /// A recording directory (or its recording.json), or a directory of recording directories
 /// (read in name order). Fails naming the path when it is neither, or naming the file of the
 /// first recording that breaks the spec.
 Result<RecordingSet> read_recordings(const std::filesystem::path& path);
+
+/// The particle the recordings of one set state (each manifest's optional `particle`), where
+/// they state it. Two manifests that state different densities (by more than
+/// kStatedDensityTolerance), mesh units or meshes are refused, naming both files: one
+/// diagnosis, one particle.
+struct StatedParticle {
+  std::optional<double> density;          ///< [kg/m^3]
+  std::filesystem::path density_in;       ///< the first manifest that states it
+  std::optional<std::string> mesh;        ///< as the first manifest that names it writes it
+  std::filesystem::path mesh_in;          ///< that manifest
+  std::optional<std::string> mesh_units;  ///< as written ("mm", "cm", "m")
+
+  /// The stated mesh, resolved inside the folder of the manifest that names it; refused (nothing
+  /// opened) when it is absolute, has a `..` or leads out through a link: nothing outside a
+  /// recording's folder is opened because the recording names it.
+  Result<std::filesystem::path> mesh_inside() const;
+  /// The stated mesh's path as written, from the manifest's folder, without touching the disk
+  /// (for comparing with a mesh given on the command line, and for messages).
+  std::optional<std::filesystem::path> mesh_as_named() const;
+};
+
+Result<StatedParticle> stated_particle(const RecordingSet& set);
 
 }  // namespace clumpforge

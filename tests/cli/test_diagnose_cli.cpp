@@ -187,6 +187,93 @@ TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
   }
 }
 
+namespace {
+/// A lab-like sphere control's 0.5 m steel drop copied into `dir`, the sphere's mesh beside its
+/// manifest, which states `particle` (JSON text).
+void sphere_drop_stating(const std::filesystem::path& dir, const std::string& particle) {
+  const auto lab_like = test::shared_dir() / "data" / "lab-like";
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy(lab_like / "case-13" / "drop-Q235-0.5", dir, std::filesystem::copy_options::recursive);
+  std::filesystem::copy(lab_like / "meshes" / "sphere.stl", dir / "sphere.stl");
+  std::filesystem::permissions(dir / "recording.json", std::filesystem::perms::owner_write,
+                               std::filesystem::perm_options::add);
+  auto manifest = nlohmann::json::parse(std::ifstream(dir / "recording.json"));
+  manifest["particle"] = nlohmann::json::parse(particle);
+  std::ofstream(dir / "recording.json") << manifest.dump(1);
+}
+}  // namespace
+
+TEST(DiagnoseCli, TheParticleTheRecordingsStateIsTheOneDiagnosed) {
+  test::ScratchDir dir("diagnose-stated-particle");
+  // The recording names the mesh beside it and a density of 1300 kg/m^3: neither --mesh nor
+  // --density is needed, and the density is the recording's, not the default tuber's 1085.
+  sphere_drop_stating(dir / "stated", R"({"mesh": "sphere.stl", "mesh_units": "mm", "density_kg_m3": 1300})");
+  sphere_drop_stating(dir / "unstated", R"({})");
+  sphere_drop_stating(dir / "tuber-density", R"({"mesh": "sphere.stl", "density_kg_m3": 1085})");
+  auto diagnosed = [&](const std::string& recording, const std::string& more) {
+    const auto run = test::run_clumpforge(
+        fmt::format("diagnose --recordings '{}' {} --effects air_drag --json", (dir / recording).string(), more));
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return run.exit_code == 0 ? nlohmann::json::parse(run.out) : nlohmann::json::object();
+  };
+  const auto stated = diagnosed("stated", "");
+  EXPECT_EQ(stated["particle"]["mesh"], (dir / "stated" / "sphere.stl").string());
+  EXPECT_EQ(stated["particle"]["mesh_from"], "recordings");
+  EXPECT_EQ(stated["particle"]["mesh_units"], "mm");
+  EXPECT_EQ(stated["particle"]["density_kg_m3"], 1300.0);
+  EXPECT_EQ(stated["particle"]["density_from"], "recordings");
+  // The same particle given on the command line: the same diagnosis to the bit.
+  const auto given =
+      diagnosed("unstated", fmt::format("--mesh '{}' --density 1300", (dir / "unstated" / "sphere.stl").string()));
+  EXPECT_EQ(given["particle"]["mesh_from"], "command_line");
+  EXPECT_EQ(given["particle"]["density_from"], "command_line");
+  EXPECT_EQ(given["baseline"], stated["baseline"]);
+  EXPECT_EQ(given["hypotheses"], stated["hypotheses"]);
+  // At the tuber's density the same sphere is another body: its air drag's rejection moves.
+  const auto tuber = diagnosed("tuber-density", "");
+  EXPECT_EQ(tuber["particle"]["density_kg_m3"], 1085.0);
+  ASSERT_FALSE(tuber["hypotheses"].empty());
+  ASSERT_FALSE(stated["hypotheses"].empty());
+  EXPECT_NE(tuber["hypotheses"][0]["strong_delta_chi2"], stated["hypotheses"][0]["strong_delta_chi2"]);
+}
+
+TEST(DiagnoseCli, AParticleTheCommandLineOrTheRecordingsContradictIsRefusedAndNothingIsWritten) {
+  test::ScratchDir dir("diagnose-particle-refused");
+  const auto lab_like = test::shared_dir() / "data" / "lab-like";
+  const std::string outside = (lab_like / "case-13" / "drop-Q235-0.5").string();
+  const std::string sphere = (lab_like / "meshes" / "sphere.stl").string();
+  sphere_drop_stating(dir / "a", R"({"mesh": "sphere.stl", "density_kg_m3": 1085})");
+  sphere_drop_stating(dir / "b", R"({"mesh": "sphere.stl", "density_kg_m3": 1300})");
+  sphere_drop_stating(dir / "absolute", fmt::format(R"({{"mesh": "{}"}})", sphere));
+  sphere_drop_stating(dir / "heavy", R"({"density_kg_m3": 1300})");
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases{
+      // The lab-like layout names its mesh outside each recording's folder: said, with the --mesh to give.
+      {fmt::format("'{}'", outside), "leaves the recording's folder",
+       fmt::format("--mesh '{}' --units mm", (lab_like / "meshes" / "sphere.stl").lexically_normal().string())},
+      {fmt::format("'{}'", (dir / "absolute").string()), "is absolute", "give the mesh as --mesh"},
+      {fmt::format("'{}' --mesh '{}' --density 1300", outside, sphere), "states the particle's density 1085 kg/m^3",
+       "--density gives 1300"},
+      {fmt::format("'{}' --mesh '{}' --units m", outside, sphere), "mesh's units as mm", "--units gives m"},
+      {fmt::format("'{}' '{}'", (dir / "a").string(), (dir / "b").string()), "density 1085 kg/m^3",
+       (dir / "b" / "recording.json").string()},
+      {fmt::format("'{}' --library '{}'", (dir / "heavy").string(), clump()), "was made at the density 1085 kg/m^3",
+       (dir / "heavy" / "recording.json").string() + " states 1300"},
+      {fmt::format("'{}' --library '{}' --density 900", (dir / "a").string(), clump()), "states the particle's density",
+       "--density gives 900"},
+      {fmt::format("'{}' --library '{}' --mesh '{}'", (dir / "a").string(), clump(), sphere),
+       "exactly one of --mesh and --library", "not both"}};
+  for (const auto& [arguments, said, also] : cases) {
+    SCOPED_TRACE(arguments);
+    const auto run =
+        test::run_clumpforge(fmt::format("diagnose --recordings {} --output '{}'", arguments, (dir / "out").string()));
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_NE(run.err.find(said), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find(also), std::string::npos) << run.err;
+    EXPECT_TRUE(run.out.empty()) << run.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  }
+}
+
 TEST(ConcealCli, BadOptionsAreRefusedAndNothingIsWritten) {
   test::ScratchDir dir("conceal-bad");
   const auto out = dir / "recordings";

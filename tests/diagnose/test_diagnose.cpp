@@ -69,6 +69,32 @@ const HypothesisReport* hypothesis_named(const DiagnoseResult& result, std::stri
 
 }  // namespace
 
+TEST(DiagnoseInputs, ARecordingOfAnotherDensityThanTheClumpIsRefusedBeforeAnyReplay) {
+  // A lab-like drop stating 1300 kg/m^3 against the 1085 kg/m^3 tuber clump (as the Python
+  // module's diagnose(clump, recordings) would be called): refused, not diagnosed at 1085.
+  auto drop = read_recording(test::shared_dir() / "data" / "lab-like" / "case-13" / "drop-Q235-0.5");
+  ASSERT_TRUE(drop) << drop.error().message;
+  ASSERT_EQ(drop->particle_density, 1085.0);
+  const Clump clump = diagnosis_clump();
+  DiagnoseOptions options;
+  options.effects = {Effect::AirDrag};
+  drop->particle_density = 1300.0;
+  auto refused = diagnose(clump, default_material_table(), {*drop}, {"drop-Q235-0.5"}, options);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, ErrorCode::InvalidArgument);
+  EXPECT_NE(refused.error().message.find("'drop-Q235-0.5' states the particle's density 1300 kg/m^3"),
+            std::string::npos)
+      << refused.error().message;
+  EXPECT_NE(refused.error().message.find("'adaptive-32' is of 1085 kg/m^3"), std::string::npos)
+      << refused.error().message;
+  // Within 1 %: one particle, diagnosed (its summaries only, to be quick).
+  drop->particle_density = 1090.0;
+  for (auto& trial : drop->trials) trial.track.reset();
+  auto within = diagnose(clump, default_material_table(), {*drop}, {"drop-Q235-0.5"}, options);
+  ASSERT_TRUE(within) << within.error().message;
+  EXPECT_TRUE(within->summaries_only);
+}
+
 TEST(DiagnoseMeasurement, NoiseLevelFromThirdDifferences) {
   // The median absolute third difference recovers sigma within 5 % (600 differences).
   for (double sigma : {2e-5, 1e-4, 5e-4}) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <fstream>
 #include <random>
 
 #include "io/recording_io.hpp"
@@ -432,6 +433,66 @@ TEST(RecordingLimits, DamagedCopiesOfARealRecordingAreReadOrRefusedNeverThrown) 
     }
   }
   EXPECT_GT(refused, copies / 3) << refused << " of " << copies << " refused";
+}
+
+namespace {
+/// A drop recording without tracks whose manifest states `particle` (JSON text, or nothing).
+void summary_drop(const fs::path& dir, const std::string& particle) {
+  fs::create_directories(dir);
+  std::ofstream(dir / "recording.json") << fmt::format(
+      R"({{"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {{"release_height_m": 0.2}},{}
+  "trials": [{{"id": "01", "summary": {{"rebound_height_m": 0.03}}}}]}})",
+      particle.empty() ? std::string() : fmt::format(R"( "particle": {},)", particle));
+}
+}  // namespace
+
+TEST(StatedParticle, TheRecordingsAgreeOnOneParticleOrAreRefusedNamingBoth) {
+  test::ScratchDir dir("stated-particle");
+  const std::string tuber = R"({"mesh": "../meshes/tuber.stl", "mesh_units": "mm", "density_kg_m3": 1085})";
+  summary_drop(dir / "set" / "a", tuber);
+  // Within 1 %: one particle; the same mesh named from another folder; a manifest stating nothing.
+  summary_drop(dir / "set" / "b", R"({"mesh": "../b/../meshes/tuber.stl", "density_kg_m3": 1090})");
+  summary_drop(dir / "set" / "c", "");
+  auto set = read_recordings(dir / "set");
+  ASSERT_TRUE(set) << set.error().message;
+  ASSERT_EQ(set->manifests.size(), 3u);
+  EXPECT_EQ(set->manifests[1], dir / "set" / "b" / "recording.json");
+  auto stated = stated_particle(*set);
+  ASSERT_TRUE(stated) << stated.error().message;
+  EXPECT_EQ(stated->density, 1085.0);
+  EXPECT_EQ(stated->density_in, dir / "set" / "a" / "recording.json");
+  EXPECT_EQ(stated->mesh_units, "mm");
+  EXPECT_EQ(stated->mesh_as_named(), fs::absolute(dir / "set" / "meshes" / "tuber.stl").lexically_normal());
+  // Outside the folder of the recording naming it: refused, nothing opened.
+  auto inside = stated->mesh_inside();
+  ASSERT_FALSE(inside);
+  EXPECT_NE(inside.error().message.find("leaves the recording's folder"), std::string::npos) << inside.error().message;
+  EXPECT_NE(inside.error().message.find((dir / "set" / "a" / "recording.json").string()), std::string::npos);
+
+  const std::vector<std::pair<std::string, std::string>> disagreeing{
+      {R"({"density_kg_m3": 1300})", "density 1085 kg/m^3"},
+      {R"({"mesh": "../meshes/sphere.stl"})", "mesh '../meshes/tuber.stl'"},
+      {R"({"mesh": "../meshes/tuber.stl", "mesh_units": "m"})", "mesh units mm"}};
+  for (const auto& [particle, said] : disagreeing) {
+    SCOPED_TRACE(particle);
+    fs::remove_all(dir / "set" / "c");
+    summary_drop(dir / "set" / "c", particle);
+    set = read_recordings(dir / "set");
+    ASSERT_TRUE(set) << set.error().message;
+    stated = stated_particle(*set);
+    ASSERT_FALSE(stated);
+    EXPECT_NE(stated.error().message.find(said), std::string::npos) << stated.error().message;
+    EXPECT_NE(stated.error().message.find((dir / "set" / "c" / "recording.json").string()), std::string::npos);
+    EXPECT_NE(stated.error().message.find("one particle"), std::string::npos);
+  }
+  // Inside the folder: resolved there.
+  summary_drop(dir / "own", R"({"mesh": "tuber.stl"})");
+  set = read_recordings(dir / "own");
+  ASSERT_TRUE(set) << set.error().message;
+  stated = stated_particle(*set);
+  ASSERT_TRUE(stated && stated->mesh_inside()) << "the mesh beside the manifest is inside its folder";
+  EXPECT_EQ(*stated->mesh_inside(), dir / "own" / "tuber.stl");
+  EXPECT_FALSE(stated->density);
 }
 
 }  // namespace clumpforge
