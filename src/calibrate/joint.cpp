@@ -72,6 +72,8 @@ Result<std::vector<JointSurfaceResult>> calibrate_joint(const Clump& clump, cons
     return fail(ErrorCode::InvalidArgument,
                 "joint calibration needs >= 2 trials, >= 1 tilt trial, >= 1 iteration, >= 10 resamples");
   }
+  if (auto ok = check_stated_density(recordings, clump.density, fmt::format("the clump '{}'", clump.name)); !ok)
+    return std::unexpected(ok.error());
   std::vector<std::string> surfaces;
   for (const auto& r : recordings) {
     if (std::find(surfaces.begin(), surfaces.end(), r.surface) == surfaces.end()) surfaces.push_back(r.surface);

@@ -132,6 +132,8 @@ Result<PaperCalibration> calibrate_paper(const Clump& clump, const MaterialTable
                                          const std::vector<Recording>& recordings, const PaperOptions& options,
                                          const RunContext& context, const Team& team) {
   if (options.trials_per_level < 1) return fail(ErrorCode::InvalidArgument, "trials per level must be at least 1");
+  if (auto ok = check_stated_density(recordings, clump.density, fmt::format("the clump '{}'", clump.name)); !ok)
+    return std::unexpected(ok.error());
   std::vector<std::string> surfaces;
   for (const auto& r : recordings) {
     if (std::find(surfaces.begin(), surfaces.end(), r.surface) == surfaces.end()) surfaces.push_back(r.surface);

@@ -570,4 +570,21 @@ Result<LabResult> run_lab_test(const Clump& clump, const MaterialTable& table, c
   return result;
 }
 
+Result<void> check_stated_density(const std::vector<Recording>& recordings, double density, std::string_view model,
+                                  const std::vector<std::string>& names) {
+  if (!(density > 0.0)) return {};  // a model that does not say its density
+  for (std::size_t i = 0; i < recordings.size(); ++i) {
+    const auto& stated = recordings[i].particle_density;
+    if (!stated || same_density(*stated, density)) continue;
+    const std::string which =
+        i < names.size() ? fmt::format("recording '{}'", names[i])
+                         : fmt::format("the {} recording on {}", to_string(recordings[i].test), recordings[i].surface);
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("{} states the particle's density {:g} kg/m^3, and {} is of {:g} kg/m^3: a model of "
+                            "another particle than the recordings are of",
+                            which, *stated, model, density));
+  }
+  return {};
+}
+
 }  // namespace clumpforge

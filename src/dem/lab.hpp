@@ -104,6 +104,12 @@ std::vector<ReplaySample> replay_trial(const LabWorld& lab, const Recording& set
 /// (0, 10) m, incline in (0, 90) deg, roll start in (0, 0.45) m along the slope, tilt rate > 0.
 Result<void> check_lab_setup(const Recording& setup);
 
+/// Refuses recordings that state their particle's density (`particle.density_kg_m3`) other than
+/// `density` [kg/m^3], the particle model's (`model` names it in the message): one particle.
+/// `names` (parallel to `recordings`, or empty) name the recordings.
+Result<void> check_stated_density(const std::vector<Recording>& recordings, double density, std::string_view model,
+                                  const std::vector<std::string>& names = {});
+
 /// Runs `options.trials` trials of `setup`'s test (its test, surface and set-up fields)
 /// with `clump` as the particle. Fails for an unknown surface or particle material, bad
 /// coefficients, or a time step above the stable limit.

@@ -475,14 +475,8 @@ Result<void> check_inputs(const Clump& clump, const std::vector<Recording>& reco
   if (recordings.empty()) return fail(ErrorCode::InvalidArgument, "no recordings to diagnose");
   if (names.size() != recordings.size()) return fail(ErrorCode::InvalidArgument, "one name per recording is needed");
   if (auto ok = check_options(options); !ok) return std::unexpected(ok.error());
-  for (std::size_t i = 0; i < recordings.size(); ++i) {
-    const auto& stated = recordings[i].particle_density;
-    if (stated && clump.density > 0.0 && !same_density(*stated, clump.density))
-      return fail(ErrorCode::InvalidArgument,
-                  fmt::format("recording '{}' states the particle's density {:g} kg/m^3, and the clump '{}' is of "
-                              "{:g} kg/m^3: diagnose a model of the particle the recordings are of",
-                              names[i], *stated, clump.name, clump.density));
-  }
+  if (auto ok = check_stated_density(recordings, clump.density, fmt::format("the clump '{}'", clump.name), names); !ok)
+    return ok;
   for (const Clump& finer : options.finer_clumps) {
     if (finer.spheres.empty() || !(std::abs(finer.mass - clump.mass) <= 0.05 * clump.mass)) {
       return fail(ErrorCode::InvalidArgument,

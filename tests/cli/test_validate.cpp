@@ -75,7 +75,21 @@ namespace clumpforge {
 TEST(CalibrateCli, BadInputIsAClearError) {
   const std::string lib = (test::source_dir() / "clumps" / "tuber-default.h5").string();
   const std::string drop = (test::shared_dir() / "data" / "paper" / "drop-Q235").string();
+  // The study's drops as a lab with a denser particle would record them: not the 1085 kg/m^3 tuber clump's.
+  test::ScratchDir dir("calibrate-bad");
+  std::string manifest = test::read_text(std::filesystem::path(drop) / "recording.json");
+  ASSERT_NE(manifest.find("1085"), std::string::npos);
+  manifest.replace(manifest.find("1085"), 4, "1300");
+  std::filesystem::create_directories(dir / "heavy");
+  test::write_text(dir / "heavy" / "recording.json", manifest);
+  const std::string heavy = (dir / "heavy").string();
   const std::vector<std::pair<std::string, std::string>> cases{
+      {fmt::format("calibrate --recordings '{}' --library '{}' --clump lattice-4mm", heavy, lib),
+       "states the particle's density 1300 kg/m^3, and the clump 'lattice-4mm' is of 1085 kg/m^3"},
+      {fmt::format("calibrate --recordings '{}' '{}' '{}' '{}' --library '{}' --clump lattice-4mm --method joint",
+                   heavy, (test::shared_dir() / "data" / "paper" / "tilt-Q235").string(),
+                   (test::shared_dir() / "data" / "paper" / "roll-Q235").string(), drop, lib),
+       "states the particle's density 1300 kg/m^3"},
       {fmt::format("calibrate --recordings '{}' --library '{}' --clump lattice-4mm --method bayes", drop, lib),
        "unknown method 'bayes'"},
       {fmt::format("calibrate --recordings /nonexistent/rec --library '{}' --clump lattice-4mm", lib),
