@@ -96,6 +96,12 @@ void bind_recordings(py::module_& m) {
       .def_readonly("tilt_rate_deg_per_s", &Recording::tilt_rate_deg_per_s)
       .def_readonly("frame_rate_hz", &Recording::frame_rate_hz)
       .def_readonly("position_noise_m", &Recording::position_noise_m)
+      .def_readonly("particle_density", &Recording::particle_density,
+                    "[kg/m^3] the particle's, as the manifest states it (None: not stated); diagnose and the "
+                    "calibrations refuse a clump more than 1 % from it")
+      .def_readonly("particle_mesh", &Recording::particle_mesh,
+                    "The particle's mesh as the manifest names it, relative to the manifest (None: not named)")
+      .def_readonly("particle_mesh_units", &Recording::particle_mesh_units)
       .def_readonly("trials", &Recording::trials)
       .def_property_readonly("summaries", [](const Recording& r) { return column(r.summaries()); });
   m.def(

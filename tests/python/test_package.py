@@ -4,6 +4,7 @@ analytic answers and the files the library writes. Run by ctest (label python)."
 import json
 import math
 import pathlib
+import shutil
 import threading
 import time
 
@@ -159,6 +160,23 @@ def test_recordings_read_and_absurd_ones_are_refused(tmp_path):
                                         '"release_height_m": 1e9, "trials": []}')
     with pytest.raises(cf.Error, match="recording.json"):
         cf.read_recording(str(bad))
+
+
+def test_diagnose_refuses_a_clump_of_another_density_than_the_recordings_state(tmp_path):
+    """A lab-like drop states the particle's density; the same drop stating 1300 kg/m^3 is not a
+    recording of the 1085 kg/m^3 tuber clump, and diagnose says so before anything runs."""
+    source = SHARED / "data/lab-like/case-13/drop-Q235-0.5"
+    stated = cf.read_recording(str(source))
+    assert stated.particle_density == pytest.approx(1085.0)
+    assert stated.particle_mesh == "../../meshes/sphere.stl" and stated.particle_mesh_units == "mm"
+    heavy = tmp_path / "heavy"
+    shutil.copytree(source, heavy, copy_function=shutil.copyfile)  # the shared set is read-only
+    manifest = json.loads((heavy / "recording.json").read_text())
+    manifest["particle"]["density_kg_m3"] = 1300
+    (heavy / "recording.json").write_text(json.dumps(manifest))
+    clump = cf.read_clump(str(ROOT / "clumps/tuber-default-diagnosis.h5"))
+    with pytest.raises(cf.InvalidArgumentError, match="density 1300 kg/m\\^3, and the clump 'adaptive-32' is of 1085"):
+        cf.diagnose(clump, {"heavy": cf.read_recording(str(heavy))}, effects=["air_drag"])
 
 
 def test_a_damaged_byte_in_a_track_is_a_parse_error_not_a_unicode_error(tmp_path):
