@@ -107,6 +107,20 @@ void write_text(std::ostream& out, const DiagnoseResult& r) {
                      r.training_trials, r.evaluations, r.seconds);
 }
 
+/// The particle diagnosed (report.json's `particle`): which model, its density and where each came from.
+void write_particle(std::ostream& out, const nlohmann::json& particle) {
+  const auto from = [](const nlohmann::json& where) {
+    return where == "command_line" ? std::string("as given") : fmt::format("from the {}", where.get<std::string>());
+  };
+  const std::string model = particle["mesh"].is_null()
+                                ? fmt::format("library {}", particle["library"].get<std::string>())
+                                : fmt::format("mesh {} ({}, {})", particle["mesh"].get<std::string>(),
+                                              particle["mesh_units"].get<std::string>(), from(particle["mesh_from"]));
+  out << fmt::format("particle: {}; density {:g} kg/m^3 ({})\n", model, particle["density_kg_m3"].get<double>(),
+                     particle["density_from"] == "default" ? std::string("not stated or given: the Corydalis tuber's")
+                                                           : from(particle["density_from"]));
+}
+
 int run_diagnose(const DiagnoseArgs& args) {
   constexpr std::string_view kCommand = "diagnose";
   if (args.spheres != 0 && (args.spheres < 1 || args.spheres > 5000)) {
@@ -169,6 +183,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   else {
     std::ostringstream text;
     write_text(text, *result);
+    write_particle(text, report["particle"]);
     print_report_text(text.str());
   }
   return kExitOk;

@@ -230,7 +230,16 @@ TEST(DiagnoseCli, TheParticleTheRecordingsStateIsTheOneDiagnosed) {
   EXPECT_EQ(given["baseline"], stated["baseline"]);
   EXPECT_EQ(given["hypotheses"], stated["hypotheses"]);
   // At the tuber's density the same sphere is another body: its air drag's rejection moves.
-  const auto tuber = diagnosed("tuber-density", "");
+  // Printed as text, the report ends by saying which particle it diagnosed.
+  const auto text = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --effects air_drag --output '{}'",
+                                                     (dir / "tuber-density").string(), (dir / "out").string()));
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find(fmt::format("particle: mesh {} (mm, from the recordings); density 1085 kg/m^3 (from the "
+                                      "recordings)",
+                                      (dir / "tuber-density" / "sphere.stl").string())),
+            std::string::npos)
+      << text.out;
+  const auto tuber = nlohmann::json::parse(std::ifstream(dir / "out" / "report.json"));
   EXPECT_EQ(tuber["particle"]["density_kg_m3"], 1085.0);
   ASSERT_FALSE(tuber["hypotheses"].empty());
   ASSERT_FALSE(stated["hypotheses"].empty());
