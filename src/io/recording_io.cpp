@@ -551,10 +551,17 @@ Result<fs::path> StatedParticle::mesh_inside() const {
   return path;
 }
 
+namespace {
+/// A mesh path as a manifest names it, from the manifest's folder, without touching the disk.
+fs::path named_from(const fs::path& manifest, const std::string& mesh) {
+  std::error_code ec;
+  return fs::absolute(manifest.parent_path() / mesh, ec).lexically_normal();
+}
+}  // namespace
+
 std::optional<fs::path> StatedParticle::mesh_as_named() const {
   if (!mesh) return std::nullopt;
-  std::error_code ec;
-  return fs::absolute(mesh_in.parent_path() / *mesh, ec).lexically_normal();
+  return named_from(mesh_in, *mesh);
 }
 
 namespace {
@@ -587,13 +594,9 @@ Result<StatedParticle> stated_particle(const RecordingSet& set) {
       if (!out.mesh) {
         out.mesh = *m;
         out.mesh_in = at;
-      } else {
-        StatedParticle other;
-        other.mesh = *m;
-        other.mesh_in = at;
-        if (other.mesh_as_named() != out.mesh_as_named())
-          return std::unexpected(
-              disagree(out.mesh_in, at, "mesh", fmt::format("'{}'", *out.mesh), fmt::format("'{}'", *m)));
+      } else if (named_from(at, *m) != named_from(out.mesh_in, *out.mesh)) {
+        return std::unexpected(
+            disagree(out.mesh_in, at, "mesh", fmt::format("'{}'", *out.mesh), fmt::format("'{}'", *m)));
       }
     }
     if (const auto& u = r.particle_mesh_units) {
