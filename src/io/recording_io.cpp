@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/atomic_file.hpp"
+#include "core/sha256.hpp"
 #include "core/text.hpp"
 #include "numerics/statistics.hpp"
 
@@ -567,13 +568,37 @@ std::optional<fs::path> StatedParticle::mesh_as_named() const {
 namespace {
 /// "'A' states X and 'B' states Y": the refusal of two manifests that disagree on the particle.
 Error disagree(const fs::path& first, const fs::path& second, std::string_view what, const std::string& a,
-               const std::string& b) {
+               const std::string& b, const std::string& why = {}) {
   return {ErrorCode::InvalidArgument,
-          fmt::format("{} states the particle's {} {} and {} states {}: the recordings of one diagnosis are of one "
+          fmt::format("{} states the particle's {} {} and {} states {}{}: the recordings of one diagnosis are of one "
                       "particle",
-                      first.string(), what, a, second.string(), b)};
+                      first.string(), what, a, second.string(), b, why.empty() ? why : fmt::format(" ({})", why))};
 }
 }  // namespace
+
+/// Two manifests that name their mesh at different paths (`first` as stated so far, `mesh` named
+/// by `second`) state one particle when both files lie inside their recordings' folders and hold
+/// the same bytes: a lab that keeps a copy of the mesh beside each recording (the one layout
+/// whose mesh clumpforge opens, see StatedParticle::mesh_inside). Otherwise refused, naming both
+/// files as written from their manifests' folders and why they are not one particle.
+Result<void> same_mesh_copies(const StatedParticle& first, const fs::path& second, const std::string& mesh) {
+  const auto shown = [](const fs::path& manifest, const std::string& m) {
+    return fmt::format("'{}'", (manifest.parent_path() / m).lexically_normal().string());
+  };
+  const auto refuse = [&](const std::string& why) {
+    return std::unexpected(
+        disagree(first.mesh_in, second, "mesh", shown(first.mesh_in, *first.mesh), shown(second, mesh), why));
+  };
+  auto a = first.mesh_inside();
+  auto b = inside_folder(second.parent_path(), mesh, "the particle's mesh");
+  if (!a || !b) return refuse("two files, not compared: clumpforge opens no file outside a recording's folder");
+  auto hash_a = sha256_file(*a);
+  auto hash_b = sha256_file(*b);
+  if (!hash_a) return refuse(hash_a.error().message);
+  if (!hash_b) return refuse(hash_b.error().message);
+  if (*hash_a != *hash_b) return refuse("two files whose bytes differ");
+  return {};
+}
 
 Result<StatedParticle> stated_particle(const RecordingSet& set) {
   StatedParticle out;
@@ -595,8 +620,7 @@ Result<StatedParticle> stated_particle(const RecordingSet& set) {
         out.mesh = *m;
         out.mesh_in = at;
       } else if (named_from(at, *m) != named_from(out.mesh_in, *out.mesh)) {
-        return std::unexpected(
-            disagree(out.mesh_in, at, "mesh", fmt::format("'{}'", *out.mesh), fmt::format("'{}'", *m)));
+        if (auto same = same_mesh_copies(out, at, *m); !same) return std::unexpected(same.error());
       }
     }
     if (const auto& u = r.particle_mesh_units) {

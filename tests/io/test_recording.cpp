@@ -471,7 +471,11 @@ TEST(StatedParticle, TheRecordingsAgreeOnOneParticleOrAreRefusedNamingBoth) {
 
   const std::vector<std::pair<std::string, std::string>> disagreeing{
       {R"({"density_kg_m3": 1300})", "density 1085 kg/m^3"},
-      {R"({"mesh": "../meshes/sphere.stl"})", "mesh '../meshes/tuber.stl'"},
+      {R"({"mesh": "../meshes/sphere.stl"})",
+       fmt::format("mesh '{}' and {} states '{}' (two files, not compared: clumpforge opens no file outside a "
+                   "recording's folder)",
+                   (dir / "set" / "meshes" / "tuber.stl").string(), (dir / "set" / "c" / "recording.json").string(),
+                   (dir / "set" / "meshes" / "sphere.stl").string())},
       {R"({"mesh": "../meshes/tuber.stl", "mesh_units": "m"})", "mesh units mm"}};
   for (const auto& [particle, said] : disagreeing) {
     SCOPED_TRACE(particle);
@@ -493,6 +497,40 @@ TEST(StatedParticle, TheRecordingsAgreeOnOneParticleOrAreRefusedNamingBoth) {
   ASSERT_TRUE(stated && stated->mesh_inside()) << "the mesh beside the manifest is inside its folder";
   EXPECT_EQ(*stated->mesh_inside(), dir / "own" / "tuber.stl");
   EXPECT_FALSE(stated->density);
+}
+
+TEST(StatedParticle, CopiesOfOneMeshBesideEachRecordingAreOneParticle) {
+  // The one layout whose stated mesh clumpforge opens keeps a copy beside each recording: the
+  // same bytes at different paths are one particle (refused as two until the commit after
+  // 3c9dd52); copies whose bytes differ are two, refused naming both files.
+  test::ScratchDir dir("stated-particle-copies");
+  for (const char* rec : {"a", "b"}) {
+    summary_drop(dir / "set" / rec, R"({"mesh": "body.stl", "mesh_units": "mm"})");
+    std::ofstream(dir / "set" / rec / "body.stl") << "solid body\nendsolid body\n";
+  }
+  auto set = read_recordings(dir / "set");
+  ASSERT_TRUE(set) << set.error().message;
+  auto stated = stated_particle(*set);
+  ASSERT_TRUE(stated) << stated.error().message;
+  ASSERT_TRUE(stated->mesh_inside());
+  EXPECT_EQ(*stated->mesh_inside(), dir / "set" / "a" / "body.stl");
+
+  std::ofstream(dir / "set" / "b" / "body.stl") << "solid other\nendsolid other\n";
+  stated = stated_particle(*set);
+  ASSERT_FALSE(stated);
+  const std::string said = stated.error().message;
+  EXPECT_NE(said.find(fmt::format(
+                "{} states the particle's mesh '{}' and {} states '{}'",
+                (dir / "set" / "a" / "recording.json").string(), (dir / "set" / "a" / "body.stl").string(),
+                (dir / "set" / "b" / "recording.json").string(), (dir / "set" / "b" / "body.stl").string())),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("whose bytes differ"), std::string::npos) << said;
+  // A copy that is missing is refused too, saying so.
+  fs::remove(dir / "set" / "b" / "body.stl");
+  stated = stated_particle(*set);
+  ASSERT_FALSE(stated);
+  EXPECT_NE(stated.error().message.find("body.stl"), std::string::npos) << stated.error().message;
 }
 
 }  // namespace clumpforge
