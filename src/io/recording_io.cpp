@@ -149,17 +149,36 @@ std::vector<double> tracked(const std::vector<double>& column) {
   return out;
 }
 
-/// What is wrong with a drop's track that does not fall, or nothing. The particle is released
-/// from rest with its lowest point `height` above the plate, so its tracked point falls about
-/// `height` (the spec's z_m is up positive): a track that falls less than a quarter of it is
-/// not this drop's (a still frame, the wrong file, z down or in other units). Judged only on
-/// tracks of 10 or more heights (shorter ones are the diagnosis's to refuse as unusable).
-std::optional<std::string> drop_that_does_not_fall(const Track& track, double height) {
+/// How far a track's tracked point falls or rises beyond what a test allows, as a factor
+/// between units, in words: "(x100: centimetres?)". A track written in centimetres or millimetres
+/// under a metre header moves 100 or 1000 times as far; one within the coordinates' limit (100 m)
+/// passes every other check and ran to a verdict on a body 100 times the size.
+std::string units_hint(double ratio) {
+  for (const auto& [factor, unit] : {std::pair{1000.0, "millimetres"}, {100.0, "centimetres"}, {39.37, "inches"}}) {
+    if (ratio > 0.5 * factor && ratio < 2.0 * factor) return fmt::format(" (about {:g} times: {}?)", factor, unit);
+  }
+  return {};
+}
+
+/// What is wrong with a drop's track that does not fall as the drop does, or nothing. The
+/// particle is released from rest with its lowest point `height` above the plate, so its
+/// tracked point falls about `height` (the spec's z_m is up positive; a body's centroid lies at
+/// most a few centimetres above its lowest point): a track that falls less than a quarter of it
+/// is not this drop's (a still frame, the wrong file, z down or in other units), and one that
+/// falls more than twice it and 5 cm is in other units. Judged only on tracks of 10 or more
+/// heights (shorter ones are the diagnosis's to refuse as unusable).
+std::optional<std::string> wrong_drop_track(const Track& track, double height) {
   const std::vector<double> z = tracked(track.z);
   if (z.size() < 10) return std::nullopt;
   const double start = median({z.begin(), z.begin() + 5});
   const auto [low, high] = std::ranges::minmax(z);
   const double fall = start - low, rise = high - start;
+  if (fall > 2.0 * height + 0.05) {
+    return fmt::format(
+        "its tracked point falls {:.4g} m, where a drop from {:g} m falls about that far: x_m and z_m must be in "
+        "metres{}",
+        fall, height, units_hint(fall / height));
+  }
   if (fall >= 0.25 * height) return std::nullopt;
   if (rise >= 0.25 * height) {
     return fmt::format(
@@ -173,16 +192,25 @@ std::optional<std::string> drop_that_does_not_fall(const Track& track, double he
       fall * 1e3, height);
 }
 
-/// What is wrong with a roll's track that ends uphill of its start, or nothing. x_m is
-/// positive in the direction of travel (the spec), and a particle released from rest on the
-/// incline cannot come to rest above where it started: a track whose tracked point ends more
-/// than a quarter of the incline's horizontal run (at least 5 mm) on the negative side ran the
-/// other way (x pointing uphill). A particle that stays where it was set is a result, not an
-/// error. Judged on tracks of 10 or more positions.
-std::optional<std::string> roll_that_runs_uphill(const Track& track, double start_distance, double incline_deg) {
-  const std::vector<double> x = tracked(track.x);
-  if (x.size() < 10) return std::nullopt;
-  const double run = start_distance * std::cos(incline_deg * std::numbers::pi / 180.0);
+/// What is wrong with a roll's track, or nothing. x_m is positive in the direction of travel
+/// (the spec), and a particle released from rest on the incline cannot come to rest above where
+/// it started: a track whose tracked point ends more than a quarter of the incline's horizontal
+/// run (at least 5 mm) on the negative side ran the other way (x pointing uphill). A particle
+/// that stays where it was set is a result, not an error. Its tracked point comes down the
+/// incline's rise, start_distance sin(incline), to the flat: one that comes down more than twice
+/// that and 5 cm is in other units. Judged on tracks of 10 or more positions.
+std::optional<std::string> wrong_roll_track(const Track& track, double start_distance, double incline_deg) {
+  const std::vector<double> x = tracked(track.x), z = tracked(track.z);
+  if (x.size() < 10 || z.size() < 10) return std::nullopt;
+  const double angle = incline_deg * std::numbers::pi / 180.0;
+  const double run = start_distance * std::cos(angle), rise = start_distance * std::sin(angle);
+  const double descent = median({z.begin(), z.begin() + 5}) - std::ranges::min(z);
+  if (descent > 2.0 * rise + 0.05) {
+    return fmt::format(
+        "its tracked point comes down {:.4g} m, where a roll from {:g} m along a {:g} deg incline comes down about "
+        "{:.3g} m: x_m and z_m must be in metres{}",
+        descent, start_distance, incline_deg, rise, units_hint(descent / std::max(rise, 1e-3)));
+  }
   const double moved = median({x.end() - 5, x.end()}) - median({x.begin(), x.begin() + 5});
   if (moved >= -std::max(0.25 * run, 5e-3)) return std::nullopt;
   return fmt::format(
@@ -357,8 +385,8 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
       if (!path) reader.error("track", fmt::format("trial '{}': {}", trial.id, path.error().message), search_from);
       auto track = read_track(*path);
       if (!track) throw ManifestError{track.error().message};
-      const auto wrong = r.test == LabTest::Drop   ? drop_that_does_not_fall(*track, r.release_height)
-                         : r.test == LabTest::Roll ? roll_that_runs_uphill(*track, r.start_distance, r.incline_deg)
+      const auto wrong = r.test == LabTest::Drop   ? wrong_drop_track(*track, r.release_height)
+                         : r.test == LabTest::Roll ? wrong_roll_track(*track, r.start_distance, r.incline_deg)
                                                    : std::nullopt;
       if (wrong) throw ManifestError{fmt::format("{}: {}", path->string(), *wrong)};
       trial.track = std::move(*track);

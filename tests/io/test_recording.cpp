@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <numbers>
 #include <random>
 
 #include "io/recording_io.hpp"
@@ -325,6 +326,50 @@ TEST(RecordingLimits, ARollWhoseTrackEndsUphillIsRefused) {
   EXPECT_NE(refusal(dir / "a", roll, up).find("x_m must be positive in the direction of travel"), std::string::npos);
   EXPECT_EQ(refusal(dir / "b", roll, down), "(accepted)");
   EXPECT_EQ(refusal(dir / "c", roll, still), "(accepted)");
+}
+
+TEST(RecordingLimits, ATrackInOtherUnitsThanMetresIsRefused) {
+  // A drop from 0.2 m and a 35 mm roll down 30 deg written in centimetres (or a 0.05 m drop in
+  // millimetres) under the spec's metre header stay within the coordinates' 100 m limit: before
+  // the commit after bf6afa1 they were read as a body falling 20 m and rolling down 1.75 m. One
+  // that moves as the test does is accepted.
+  test::ScratchDir dir("rec");
+  const std::string roll = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+    "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  const auto drop_from = [](double height, double scale) {
+    std::string out = "t_s,x_m,z_m\n";
+    for (int i = 0; i < 400; ++i) {
+      const double t = 0.001 * i, fall = std::min(height, 0.5 * 9.81 * t * t);
+      out += fmt::format("{:.3f},{:.5f},{:.5f}\n", t, 0.001 * scale, (height + 0.01 - fall) * scale);
+    }
+    return out;
+  };
+  const auto roll_in = [](double scale) {
+    std::string out = "t_s,x_m,z_m\n";
+    for (int i = 0; i < 100; ++i) {
+      const double t = 0.004 * i, s = std::min(0.035, 1.5 * t * t);  // along the slope, then on the flat
+      const double x = -0.035 * std::cos(std::numbers::pi / 6) + s * std::cos(std::numbers::pi / 6);
+      out += fmt::format("{:.3f},{:.5f},{:.5f}\n", t, x * scale, (0.0175 - s / 2 + 0.009) * scale);
+    }
+    return out;
+  };
+  const std::string drop = with_track("t.csv");
+  EXPECT_NE(refusal(dir / "a", drop, drop_from(0.2, 100.0))
+                .find("t.csv: its tracked point falls 20 m, where a drop from 0.2 m falls about that far: x_m and z_m "
+                      "must be in metres (about 100 times: centimetres?)"),
+            std::string::npos)
+      << refusal(dir / "a2", drop, drop_from(0.2, 100.0));
+  const std::string low_drop = R"({"format": "recording/1", "test": "drop", "surface": "Q235",
+    "setup": {"release_height_m": 0.05}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  EXPECT_NE(refusal(dir / "b", low_drop, drop_from(0.05, 1000.0)).find("(about 1000 times: millimetres?)"),
+            std::string::npos);
+  EXPECT_NE(refusal(dir / "c", roll, roll_in(100.0))
+                .find("comes down 1.745 m, where a roll from 0.035 m along a 30 deg incline comes down about 0.0175 "
+                      "m: x_m and z_m must be in metres (about 100 times: centimetres?)"),
+            std::string::npos)
+      << refusal(dir / "c2", roll, roll_in(100.0));
+  EXPECT_EQ(refusal(dir / "d", drop, drop_from(0.2, 1.0)), "(accepted)");
+  EXPECT_EQ(refusal(dir / "e", roll, roll_in(1.0)), "(accepted)");
 }
 
 TEST(RecordingLimits, RecordedOrientationIsATypedPrior) {
