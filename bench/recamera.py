@@ -13,7 +13,12 @@ summaries (rebound_height_m, roll_distance_m) get the same added noise, as a lab
 them from its films would; everything else is copied as it is (ANSWERS.json, meshes, extra
 keys). The output is written to a temporary folder beside it and renamed at the end.
 
+With --scale S the camera's image scale is off by S as well (calibrated off the particle's
+plane): every x_m and z_m, and every length summary, is multiplied by S before the noise is
+added, as such a camera reads them.
+
   bench/recamera.py ../shared/data/lab-like OUT --fps drop=250 --noise 5e-4 --seed 1
+  bench/recamera.py SET OUT --noise 1e-4 --scale 1.01
   build/bench/bench_diagnose --recordings-set OUT -o OUT-diagnosed
 
 A test's frame rate is kept when --fps does not name it; --noise applies to every test.
@@ -69,9 +74,9 @@ def inside(folder, name, where):
     return path
 
 
-def refilm_track(path, shown, step, rate, added, rng):
-    """The track's rows at the new frame rate, x_m and z_m with `added` noise (metres); `shown`
-    is the path messages name (the user's file, not its copy)."""
+def refilm_track(path, shown, step, rate, added, rng, scale=1.0):
+    """The track's rows at the new frame rate, x_m and z_m times `scale` with `added` noise
+    (metres); `shown` is the path messages name (the user's file, not its copy)."""
     try:
         with path.open(newline="") as f:
             rows = list(csv.reader(f))
@@ -95,14 +100,14 @@ def refilm_track(path, shown, step, rate, added, rng):
         for c in noisy:
             if c < len(row) and row[c].strip():
                 try:
-                    row[c] = f"{float(row[c]) + rng.gauss(0.0, added):.6f}"
+                    row[c] = f"{float(row[c]) * scale + rng.gauss(0.0, added):.6f}"
                 except ValueError:
                     raise Refusal(f"{shown}:{line}: {header[c]} '{row[c]}' is not a number") from None
         out.append(row)
     return out
 
 
-def refilm_recording(manifest, shown, fps, noise, rng):
+def refilm_recording(manifest, shown, fps, noise, rng, scale=1.0):
     """Re-films one recording's tracks in place; `shown` maps a copied path to the user's."""
     where = str(shown(manifest))
     try:
@@ -135,12 +140,12 @@ def refilm_recording(manifest, shown, fps, noise, rng):
             if path in done:
                 continue
             done.add(path)
-            rows = refilm_track(path, shown(path), step, float(rate), added, rng)
+            rows = refilm_track(path, shown(path), step, float(rate), added, rng, scale)
             with path.open("w", newline="") as f:
                 csv.writer(f, lineterminator="\n").writerows(rows)
         for key, value in (trial.get("summary") or {}).items():
             if key in LENGTH_SUMMARIES and isinstance(value, (int, float)):
-                trial["summary"][key] = round(max(0.0, value + rng.gauss(0.0, added)), 5)
+                trial["summary"][key] = round(max(0.0, value * scale + rng.gauss(0.0, added)), 5)
     camera["frame_rate_hz"] = int(wanted) if float(wanted).is_integer() else float(wanted)
     camera["position_noise_m"] = noise
     recording["camera"] = camera
@@ -154,11 +159,15 @@ def main(argv):
     parser.add_argument("--fps", default="", help="new frame rates per test, e.g. drop=250,roll=125")
     parser.add_argument("--noise", type=float, required=True, help="total camera noise per axis [m]")
     parser.add_argument("--seed", type=int, default=1, help="seed of the added noise")
+    parser.add_argument("--scale", type=float, default=1.0,
+                        help="the camera's image scale: lengths multiplied by it (default 1)")
     args = parser.parse_args(argv)
     try:
         fps = parse_fps(args.fps)
         if not (0.0 <= args.noise <= 0.01):
             raise Refusal(f"--noise {args.noise:g} m outside [0, 0.01] m")
+        if not (0.5 <= args.scale <= 2.0):
+            raise Refusal(f"--scale {args.scale:g} outside [0.5, 2]")
         source = args.recordings.resolve()
         if not source.is_dir():
             raise Refusal(f"{args.recordings}: not a folder")
@@ -177,9 +186,9 @@ def main(argv):
             if not manifests:
                 raise Refusal(f"{args.recordings}: no recording.json in it")
             for manifest in manifests:
-                refilm_recording(manifest, lambda p: source / p.relative_to(copy), fps, args.noise, rng)
+                refilm_recording(manifest, lambda p: source / p.relative_to(copy), fps, args.noise, rng, args.scale)
             settings = {"source": str(source), "fps": fps, "noise_m": args.noise, "seed": args.seed,
-                        "recordings": len(manifests)}
+                        "scale": args.scale, "recordings": len(manifests)}
             (copy / "RECAMERA.json").write_text(json.dumps(settings, indent=1) + "\n")
             os.rename(copy, target)
         finally:

@@ -27,7 +27,7 @@ namespace {
 struct DiagnoseArgs {
   std::vector<std::string> recordings, effects;
   std::string mesh, clump, clump_name, out, materials, units = "mm";
-  std::string roll_release = "on-edge", wall_mass = "whole", drop_drift = "track-end";
+  std::string roll_release = "on-edge", wall_mass = "whole", drop_drift = "track-end", image_scale = "as-recorded";
   double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3, impact_accuracy_pct = 1.0;
   int ensemble_replays = 12, ensemble_replays_at_gate = 48;
   int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
@@ -147,6 +147,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.orientation_prior_deg = args.orientation_prior_deg;
   options.roll_release = parse_roll_posture(args.roll_release).value_or(RollPosture::OnEdge);  // CLI11 checked it
   options.drift_at = parse_drift_at(args.drop_drift).value_or(DriftAt::TrackEnd);              // CLI11 checked it
+  options.image_scale = parse_image_scale(args.image_scale).value_or(ImageScale::AsRecorded);  // CLI11 checked it
   const auto wall_mass = parse_wall_mass_option(args.wall_mass);
   if (!wall_mass) return report_error(kCommand, wall_mass.error());
   options.lab.contact.wall_mass = *wall_mass;
@@ -233,6 +234,13 @@ Command add_diagnose_command(CLI::App& app) {
                   "and is turned at random about its flat faces' normal, or, when orientation_wxyz is recorded, at "
                   "the turn nearest it; a sphere or equant body anyhow) or any (uniform over all orientations)")
       ->check(CLI::IsMember({"on-edge", "any"}))
+      ->capture_default_str();
+  sub->add_option("--image-scale", args->image_scale,
+                  "A drop recording whose free flights fall off g by more than 0.1 % (the camera's image scale or "
+                  "frame rate off, if the tracked point is the centre of mass): as-recorded, or flights (read "
+                  "through the scale its flights give: x, z and rebound heights divided by it; for a sphere, or a "
+                  "body tracked at its centre of mass); measured either way (report.json image_scale)")
+      ->check(CLI::IsMember({"flights", "as-recorded"}))
       ->capture_default_str();
   sub->add_option("--drop-drift", args->drop_drift,
                   "Where a drop's drift is read beyond the release horizon, recorded and replayed alike: track-end "

@@ -296,6 +296,24 @@ nlohmann::json flights_json(const FlightWobble& f) {
           {"smallest_offset_mm", finite_or_null(f.smallest_offset_m * 1e3)}};
 }
 
+/// report.json's image_scale: each tracked drop recording's flights' fall acceleration as
+/// recorded, the scale it gives, whether it is off and whether the diagnosis read it so.
+nlohmann::json image_scale_json(const DiagnoseResult& r) {
+  nlohmann::json recordings = nlohmann::json::array();
+  for (const auto& [name, g, applied] : r.image_scale) {
+    recordings.push_back({{"recording", name},
+                          {"flights", g.flights},
+                          {"fall_acceleration_m_s2", g.acceleration},
+                          {"standard_error_m_s2", g.standard_error},
+                          {"scale", g.scale()},
+                          {"off", g.off()},
+                          {"applied", applied}});
+  }
+  return {{"mode", std::string(to_string(r.image_scale_mode))},
+          {"tolerance", kScaleTolerance},
+          {"recordings", std::move(recordings)}};
+}
+
 /// report.json's ensemble: the recorded outcomes against replays over the unknown release.
 nlohmann::json ensemble_json(const EnsembleReport& e) {
   auto comparisons_json = [&](const std::vector<OutcomeComparison>& list) {
@@ -461,6 +479,7 @@ nlohmann::json diagnosis_report_json(const DiagnoseResult& r, const std::string&
   j["uncalibrated"] = r.uncalibrated;
   j["particle_model"] = particle_model_json(r);
   j["flights"] = r.flights ? flights_json(*r.flights) : nlohmann::json();
+  j["image_scale"] = image_scale_json(r);
   if (r.ensemble) j["ensemble"] = ensemble_json(*r.ensemble);
   if (r.gate_retry) {
     const GateRetry& g = *r.gate_retry;

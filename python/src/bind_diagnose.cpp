@@ -243,6 +243,18 @@ void bind_result(py::module_& m) {
       .def_readonly("offset_high_m", &FlightWobble::offset_high_m)
       .def_readonly("smallest_offset_m", &FlightWobble::smallest_offset_m,
                     "[m] the smallest offset these flights would have shown");
+  py::class_<RecordingScale>(m, "RecordingScale",
+                             "A drop recording's image scale as its free flights give it: between bounces a body "
+                             "falls at g, so their fall in the camera's metres is g times the scale.")
+      .def_readonly("recording", &RecordingScale::recording)
+      .def_property_readonly("flights", [](const RecordingScale& s) { return s.measured.flights; })
+      .def_property_readonly("fall_acceleration_m_s2", [](const RecordingScale& s) { return s.measured.acceleration; })
+      .def_property_readonly("standard_error_m_s2", [](const RecordingScale& s) { return s.measured.standard_error; })
+      .def_property_readonly("scale", [](const RecordingScale& s) { return s.measured.scale(); })
+      .def_property_readonly(
+          "off", [](const RecordingScale& s) { return s.measured.off(); },
+          "off g by more than the tolerance and four standard errors")
+      .def_readonly("applied", &RecordingScale::applied, "its lengths were divided by the scale");
   py::class_<PartedRecording>(m, "PartedRecording",
                               "A recording whose trials part where the replays agree for every release.")
       .def_readonly("recording", &PartedRecording::recording)
@@ -280,6 +292,8 @@ void bind_result(py::module_& m) {
                     "why the tracks fitted frame by frame left candidates undecided")
       .def_readonly("particle_model", &DiagnoseResult::particle_model)
       .def_readonly("flights", &DiagnoseResult::flights)
+      .def_readonly("image_scale", &DiagnoseResult::image_scale,
+                    "each tracked drop recording's image scale from its free flights (RecordingScale)")
       .def_readonly("heldout_outcomes", &DiagnoseResult::heldout_outcomes)
       .def_readonly("heldout_flights", &DiagnoseResult::heldout_flights)
       .def_readonly("evaluations", &DiagnoseResult::evaluations)
@@ -290,7 +304,7 @@ DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, con
                              std::optional<MaterialTable> materials, double orientation_prior_deg,
                              double model_accuracy, int ensemble_replays, int max_evaluations, std::uint64_t seed,
                              const std::vector<Clump>& finer_clumps, const std::string& roll_release,
-                             const py::object& progress) {
+                             const std::string& image_scale, const py::object& progress) {
   std::vector<Recording> list;
   std::vector<std::string> names;
   for (const auto& [name, recording] : recordings) {
@@ -309,6 +323,10 @@ DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, con
   if (!posture)
     raise({ErrorCode::InvalidArgument, fmt::format("roll_release '{}' is not on-edge or any", roll_release)});
   options.roll_release = *posture;
+  const auto scale = parse_image_scale(image_scale);
+  if (!scale)
+    raise({ErrorCode::InvalidArgument, fmt::format("image_scale '{}' is not flights or as-recorded", image_scale)});
+  options.image_scale = *scale;
   options.model_accuracy_m = model_accuracy;
   options.ensemble_replays = ensemble_replays;
   options.max_evaluations = max_evaluations;
@@ -370,13 +388,14 @@ void bind_diagnose(py::module_& m) {
         py::arg("effects") = std::vector<std::string>{}, py::arg("materials") = py::none(),
         py::arg("orientation_prior_deg") = 15.0, py::arg("model_accuracy") = 3e-4, py::arg("ensemble_replays") = 12,
         py::arg("max_evaluations") = 45, py::arg("seed") = 1, py::arg("finer_clumps") = std::vector<Clump>{},
-        py::arg("roll_release") = "on-edge", py::arg("progress") = py::none(),
+        py::arg("roll_release") = "on-edge", py::arg("image_scale") = "as-recorded", py::arg("progress") = py::none(),
         "Finds which physics the model leaves out (`clumpforge diagnose`): recordings is {name: Recording} (as "
         "read_recordings returns), effects the candidates (default: every effect of the library), model_accuracy [m] "
         "how closely any clump follows the real particle, finer_clumps finer clumps of the same body (the "
         "resolution raised while replayed tracks change; refitted before a mismatch is blamed on missing physics), "
         "roll_release how the lab set the particle on a roll's incline (on-edge: a flattened particle on its rim; "
-        "any).");
+        "any), image_scale how a drop recording whose free flights fall off g is read (as-recorded; flights: through "
+        "the scale they give, for a sphere or a body tracked at its centre of mass).");
 }
 
 }  // namespace clumpforge::python

@@ -1,5 +1,8 @@
 #include "diagnose/diagnose.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <chrono>
 
 #include "diagnose/stages.hpp"
@@ -33,6 +36,49 @@ Result<std::pair<std::vector<TrialScore>, std::vector<TrialScore>>> whole_tracks
   }
   return std::pair{std::move(*full_base), std::move(*full_improved)};
 }
+
+/// Each drop recording's image scale as its flights give it, applied or not.
+std::vector<RecordingScale> recording_scales(const std::vector<FlightGravity>& gravity,
+                                             const std::vector<std::string>& names, ImageScale mode) {
+  std::vector<RecordingScale> out;
+  for (const FlightGravity& g : gravity)
+    out.push_back({names[g.recording], g, g.off() && mode == ImageScale::FromFlights});
+  return out;
+}
+
+/// What a diagnosis notes of the drop recordings whose flights fall off g, and how it read them.
+/// Read as recorded, only for a one-sphere clump (`round`): a tracked point off the centre of
+/// mass circles it as a body turns and bends a flight too (FlightGravity), and a tumbling tuber's
+/// silhouette-tracked flights fell off g by up to 0.5 % at the true scale; said of such a body,
+/// the note would blame a camera that is right.
+std::vector<std::string> image_scale_notes(const std::vector<RecordingScale>& scales,
+                                           const std::vector<Recording>& recordings, bool round) {
+  std::vector<std::string> notes;
+  bool applied = false;
+  for (const auto& [name, g, read_so] : scales) {
+    if (!g.off() || !(read_so || round)) continue;
+    applied = applied || read_so;
+    const std::string fall = fmt::format(
+        "{}: its free flights after the first contact fall at {:.4f} +- {:.4f} m/s^2 ({} flights), {:+.2f} % from "
+        "g = {:g} m/s^2, where a body between bounces falls at g whatever it does on the plate: if the tracked point "
+        "is the centre of mass, the camera's image scale (or its frame rate) is off by that much; calibrate the "
+        "scale in the particle's plane",
+        name, g.acceleration, g.standard_error, g.flights, 100.0 * (g.scale() - 1.0), kStandardGravity);
+    notes.push_back(read_so ? fmt::format("{}. Read through the scale {:.4f} (--image-scale flights): its tracks' x "
+                                          "and z and its rebound heights divided by it",
+                                          fall, g.scale())
+                            : fmt::format("{}. Read as recorded, a verdict on these drops may be the scale's: "
+                                          "--image-scale flights reads them through it",
+                                          fall));
+  }
+  const bool others =
+      std::any_of(recordings.begin(), recordings.end(), [](const Recording& r) { return r.test != LabTest::Drop; });
+  if (applied && others)
+    notes.push_back(
+        "the rolls and tilts have no free flights to show their image scale and are read as recorded; where one "
+        "camera filmed every test, divide their tracks by the same scale");
+  return notes;
+}
 }  // namespace
 
 Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
@@ -54,6 +100,26 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
   }
   if (!any_track) return diagnose_summaries(clump, table, recordings, names, options, run);
+  // The image scale: a drop recording's flights fall at g in true metres. Those off are read
+  // through their scale, the whole diagnosis on the rescaled copy.
+  const std::vector<FlightGravity> gravity = recorded_gravity(recordings, body_reach(clump.spheres));
+  result.image_scale = recording_scales(gravity, names, options.image_scale);
+  result.image_scale_mode = options.image_scale;
+  if (std::any_of(result.image_scale.begin(), result.image_scale.end(),
+                  [](const RecordingScale& s) { return s.applied; })) {
+    DiagnoseOptions as_rescaled = options;
+    as_rescaled.image_scale = ImageScale::AsRecorded;
+    auto rescaled_result = diagnose(clump, table, rescaled(recordings, gravity), names, as_rescaled, run);
+    if (!rescaled_result) return rescaled_result;
+    rescaled_result->image_scale = std::move(result.image_scale);
+    rescaled_result->image_scale_mode = options.image_scale;
+    const auto notes = image_scale_notes(rescaled_result->image_scale, recordings, clump.spheres.size() == 1);
+    rescaled_result->notes.insert(rescaled_result->notes.begin(), notes.begin(), notes.end());
+    rescaled_result->seconds = seconds_since(started);
+    return rescaled_result;
+  }
+  for (auto& note : image_scale_notes(result.image_scale, recordings, clump.spheres.size() == 1))
+    result.notes.push_back(std::move(note));
 
   Context c;
   if (options.reuse_replays) c.ev.memo = &c.memo;

@@ -86,7 +86,20 @@ struct DiagnoseOptions {
   /// diagnose/ensemble.hpp). False: every one is run (slower; a check that reading back
   /// changes nothing).
   bool reuse_replays = true;
+  /// A drop recording whose free flights fall off g by more than kScaleTolerance (the camera's
+  /// image scale, or its frame rate, off, if the tracked point is the centre of mass): read as
+  /// recorded (the default: a tumbling body's tracked point bends its flights too), or through
+  /// the scale its flights give (each length divided by it; FlightGravity). Measured either way
+  /// (DiagnoseResult::image_scale).
+  ImageScale image_scale = ImageScale::AsRecorded;
   std::uint64_t seed = 1;
+};
+
+/// A drop recording's image scale as its free flights give it (DiagnoseResult::image_scale).
+struct RecordingScale {
+  std::string recording;
+  FlightGravity measured;
+  bool applied = false;  ///< its lengths were divided by measured.scale()
 };
 
 /// One finer clump tried by the particle-model check.
@@ -436,8 +449,12 @@ struct DiagnoseResult {
   std::optional<GateRetry> gate_retry;               ///< when the ensemble was compared again at a gate
   std::optional<ParticleModelCheck> particle_model;  ///< when finer clumps were given
   std::optional<FlightWobble> flights;               ///< when drops were tracked
-  std::optional<OutcomeHoldout> heldout_outcomes;    ///< a name on the outcomes, checked on held-out trials
-  std::optional<FlightHoldout> heldout_flights;      ///< a name from the free flights, checked on held-out trials
+  /// Each tracked drop recording's flights' fall acceleration, as recorded (recorded_gravity), and
+  /// whether the diagnosis read it through the scale they give (DiagnoseOptions::image_scale).
+  std::vector<RecordingScale> image_scale;
+  ImageScale image_scale_mode = ImageScale::AsRecorded;
+  std::optional<OutcomeHoldout> heldout_outcomes;  ///< a name on the outcomes, checked on held-out trials
+  std::optional<FlightHoldout> heldout_flights;    ///< a name from the free flights, checked on held-out trials
   int tracked_trials = 0, training_trials = 0, evaluations = 0;
   /// Of `evaluations`, the replays beyond the release horizon read back from an earlier
   /// comparison's (ReplayMemo): the same model, clump and release orientation, not run again.

@@ -7,6 +7,7 @@
 #include "core/rng.hpp"
 #include "diagnose/conceal.hpp"  // silhouette_centroid
 #include "diagnose/release.hpp"  // draw_release_orientations
+#include "diagnose/tracks.hpp"   // estimate_noise
 #include "numerics/statistics.hpp"
 
 namespace clumpforge {
@@ -38,6 +39,7 @@ void close_flight(const Track& track, std::size_t first, std::size_t last, doubl
   f.end = track.t[last];
   f.frames = n;
   f.excess_variance = (quadratic_sse(t, x) + quadratic_sse(t, z)) / (2.0 * n - 6.0) - noise * noise;
+  f.fall_acceleration = -2.0 * fit_quadratic(t, z).a;
   out.push_back(f);
 }
 
@@ -52,6 +54,37 @@ double median_excess(const std::vector<FreeFlight>& flights, const std::vector<s
     w.push_back(flights[k].frames);
   }
   return weighted_median(v, w);
+}
+
+/// Each drop recording's flights' fall acceleration (FlightGravity): their mean weighed by the
+/// precision of a parabola's curvature (frames times duration^4), and its standard error from
+/// their weighed scatter. Only flights on which the tracked point keeps to its parabola within
+/// half the camera noise count: a point off the centre of mass circles it as the body turns,
+/// and at a spin w it accelerates by w^2 d besides g (1 mm at 100 rad/s: 10 m/s^2), which a
+/// flight of less than a few turns does not average out (a generated tuber's silhouette
+/// centroid, 0.1 mm from its centre of mass, gave a flight of 9.70 m/s^2). Recordings with
+/// fewer than kGravityFlights such flights are left out.
+constexpr std::size_t kGravityFlights = 6;
+
+std::vector<FlightGravity> flight_gravity(const std::vector<FreeFlight>& flights, const std::vector<double>& noise) {
+  std::vector<FlightGravity> out;
+  for (std::size_t r = 0; r < noise.size(); ++r) {
+    std::vector<double> g, w;
+    for (const FreeFlight& f : flights) {
+      if (f.recording != r || !(f.excess_variance < 0.25 * noise[r] * noise[r])) continue;
+      g.push_back(f.fall_acceleration);
+      w.push_back(f.frames * std::pow(f.end - f.start, 4));
+    }
+    if (g.size() < kGravityFlights) continue;
+    double sum_w = 0.0, mean = 0.0;
+    for (std::size_t k = 0; k < g.size(); ++k) sum_w += w[k], mean += w[k] * g[k];
+    mean /= sum_w;
+    double scatter = 0.0;
+    for (std::size_t k = 0; k < g.size(); ++k) scatter += w[k] * std::pow(g[k] - mean, 2);
+    const double k = static_cast<double>(g.size());
+    out.push_back({r, static_cast<int>(g.size()), mean, std::sqrt(scatter / sum_w / (k - 1.0))});
+  }
+  return out;
 }
 
 /// [m] The offset a median excess needs: a point at distance d from the centre, turned at random,
@@ -133,6 +166,9 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
       }
     }
   }
+  std::vector<double> each_noise(recordings.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t r = 0; r < recordings.size() && r < noise.size(); ++r) each_noise[r] = noise[r];
+  result.gravity = flight_gravity(result.flights, each_noise);
   const std::size_t n = result.flights.size();
   if (drop_noise.empty() || n < static_cast<std::size_t>(std::max(1, options.min_flights))) return result;
   result.judged = true;
@@ -186,6 +222,51 @@ std::optional<FlightHoldout> flight_holdout(const FlightWobble& wobble,
   out.without_m = wobble.allowance_m;
   out.wobble_m = std::sqrt(std::max(0.0, median_excess(wobble.flights, held)));
   return out;
+}
+
+std::optional<ImageScale> parse_image_scale(std::string_view text) {
+  if (text == "flights") return ImageScale::FromFlights;
+  if (text == "as-recorded") return ImageScale::AsRecorded;
+  return std::nullopt;
+}
+
+std::string_view to_string(ImageScale mode) {
+  return mode == ImageScale::FromFlights ? "flights" : "as-recorded";
+}
+
+std::vector<FlightGravity> recorded_gravity(const std::vector<Recording>& recordings, double reach) {
+  std::vector<double> noise(recordings.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    if (recordings[r].test != LabTest::Drop) continue;
+    std::vector<const Track*> tracks;
+    for (const auto& t : recordings[r].trials) {
+      if (t.track) tracks.push_back(&*t.track);
+    }
+    if (!tracks.empty()) noise[r] = estimate_noise(tracks);
+  }
+  FlightWobbleOptions options;
+  options.reach_m = reach;
+  return flight_wobble(recordings, noise, options).gravity;
+}
+
+std::vector<Recording> rescaled(const std::vector<Recording>& recordings, const std::vector<FlightGravity>& gravity) {
+  std::vector<Recording> out = recordings;
+  for (const FlightGravity& g : gravity) {
+    if (!g.off() || g.recording >= out.size()) continue;
+    const double scale = g.scale();
+    for (auto& trial : out[g.recording].trials) {
+      if (trial.summary) *trial.summary /= scale;
+      if (!trial.track) continue;
+      for (double& v : trial.track->x) v /= scale;
+      for (double& v : trial.track->z) v /= scale;
+    }
+  }
+  return out;
+}
+
+bool FlightGravity::off() const {
+  const double departure = std::abs(acceleration - kStandardGravity);
+  return departure > kScaleTolerance * kStandardGravity && departure > 4.0 * standard_error;
 }
 
 bool would_show_offset(const FlightWobble& wobble, double offset) {

@@ -87,6 +87,26 @@ def test_a_drop_filmed_again_at_250_fps_with_half_a_millimetre(tmp_path):
     assert read_track(other / "case-01" / "drop-Q235-0.2" / "trial-01.csv") != rows
 
 
+def test_an_image_scale_off_multiplies_every_length(tmp_path):
+    source = tmp_path / "set"
+    original = read_track(make_set(source) / "trial-01.csv")
+    out = tmp_path / "out"
+    r = run(source, out, "--noise", "1e-4", "--scale", "1.01")
+    assert r.returncode == 0, r.stderr
+    rec = out / "case-01" / "drop-Q235-0.2"
+    rows = read_track(rec / "trial-01.csv")
+    assert [row[0] for row in rows] == [row[0] for row in original]  # every frame kept, no noise added
+    for new, old in zip(rows[1:], original[1:]):
+        for c in (1, 2):
+            assert (new[c] == "") == (old[c] == "")
+            if old[c]:
+                assert abs(float(new[c]) - 1.01 * float(old[c])) < 1e-6
+    manifest = json.loads((rec / "recording.json").read_text())
+    assert abs(manifest["trials"][0]["summary"]["rebound_height_m"] - 0.0505) < 1e-9
+    assert json.loads((out / "RECAMERA.json").read_text())["scale"] == 1.01
+    refused(tmp_path, source, tmp_path / "bad", "--noise", "1e-4", "--scale", "0", message="--scale 0 outside [0.5, 2]")
+
+
 def test_a_frame_rate_not_named_is_kept(tmp_path):
     source = tmp_path / "set"
     make_set(source)

@@ -1,10 +1,12 @@
 // The drops' free flights after the first contact: a tracked point at the centre of mass flies on
 // a parabola between bounces whatever the release; one away from it circles it as the body turns.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -13,7 +15,9 @@
 #include "diagnose/bodies.hpp"
 #include "diagnose/conceal.hpp"
 #include "diagnose/flights.hpp"
+#include "diagnose/tracks.hpp"
 #include "io/clump_library.hpp"
+#include "io/recording_io.hpp"
 #include "support/test_support.hpp"
 
 namespace clumpforge {
@@ -242,6 +246,63 @@ TEST(FreeFlights, SilhouetteWanderOfASphereIsNoneAndOfTheTuberSmall) {
   EXPECT_GT(wander, 3e-5);
   EXPECT_LT(wander, 0.149e-3);
   EXPECT_NEAR(body_reach(clump.spheres), 0.0115, 0.0025);
+}
+
+/// The fall acceleration of the free flights of a lab-like case's drops on `surface` (the
+/// independent simulator's, ../shared/data/lab-like), their tracks' x and z multiplied by
+/// `scale` (a camera whose image scale is off), judged with a sphere's reach of `reach` [m].
+std::vector<FlightGravity> lab_like_flight_gravity(const std::string& case_id, const std::string& surface, double scale,
+                                                   double reach) {
+  std::vector<Recording> drops;
+  for (const char* height : {"0.2", "0.5", "1.0"}) {
+    const auto dir = test::shared_dir() / "data" / "lab-like" / case_id / fmt::format("drop-{}-{}", surface, height);
+    if (!std::filesystem::exists(dir)) continue;
+    auto r = read_recording(dir);
+    EXPECT_TRUE(r) << r.error().message;
+    if (!r) continue;
+    for (auto& trial : r->trials) {
+      for (double& v : trial.track->x) v *= scale;
+      for (double& v : trial.track->z) v *= scale;
+    }
+    drops.push_back(std::move(*r));
+  }
+  std::vector<double> noise;
+  for (const auto& r : drops) {
+    std::vector<const Track*> tracks;
+    for (const auto& t : r.trials) tracks.push_back(&*t.track);
+    noise.push_back(estimate_noise(tracks));
+  }
+  FlightWobbleOptions options;
+  options.reach_m = reach;
+  return flight_wobble(drops, noise, options).gravity;
+}
+
+TEST(FreeFlights, TheirFallAccelerationIsGravityInTheCamerasMetres) {
+  // The independent simulator's drops (its own contact code and clumps; 1000 fps, 0.1 mm):
+  // between bounces a body falls at g whatever it does on the plate, so each recording's flights
+  // give g within 0.3 % (kScaleTolerance): the controls, a strong air drag (C_d 1.5, whose
+  // imprint a rising and falling flight cancels to first order), the tumbling tuber. The same
+  // tracks read through an image scale 1 % off give it back within 0.2 %, and are said to be off.
+  struct Case {
+    const char* id;
+    const char* surface;
+    double reach;  // [m] the body's reach from its centroid, with the tuber's flat side
+  };
+  for (const Case& c :
+       {Case{"case-02", "Q235", 0.0094}, Case{"case-23", "Q235", 0.0094}, Case{"case-20", "Q235", 0.0125},
+        Case{"case-16", "Q235", 0.0125}, Case{"case-02", "soil", 0.0094}}) {
+    SCOPED_TRACE(fmt::format("{} on {}", c.id, c.surface));
+    for (double scale : {1.0, 1.01, 0.99}) {
+      const auto gravity = lab_like_flight_gravity(c.id, c.surface, scale, c.reach);
+      ASSERT_FALSE(gravity.empty());
+      for (const FlightGravity& g : gravity) {
+        SCOPED_TRACE(fmt::format("scale {}, recording {}: {} flights, {:.4f} +- {:.4f} m/s^2", scale, g.recording,
+                                 g.flights, g.acceleration, g.standard_error));
+        EXPECT_NEAR(g.scale(), scale, scale == 1.0 ? kScaleTolerance : 2e-3);
+        EXPECT_EQ(g.off(), scale != 1.0);
+      }
+    }
+  }
 }
 
 TEST(FreeFlights, GeneratedTuberDropsSeenBySilhouetteShowARealisticOffsetAndNotAControl) {

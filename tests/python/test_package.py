@@ -205,6 +205,12 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
         cf.diagnose(small, recordings, finer_clumps=[big])
     with pytest.raises(cf.InvalidArgumentError, match="roll_release 'flat'"):
         cf.diagnose(small, recordings, roll_release="flat")
+    with pytest.raises(cf.InvalidArgumentError, match="image_scale 'pixels'"):
+        cf.diagnose(small, recordings, image_scale="pixels")
+    assert {"recording", "flights", "fall_acceleration_m_s2", "standard_error_m_s2", "scale", "off", "applied"} <= set(
+        dir(cf.RecordingScale)
+    )
+    assert "image_scale" in dir(cf.DiagnoseResult)
     assert "particle_model" in dir(cf.DiagnoseResult)
     assert cf.Basis.particle_model != cf.Basis.unexplained_outcomes
     # Beyond the release horizon a mismatch on a clump not converged there is undecidable.
