@@ -197,7 +197,8 @@ def main(argv):
         print(f"recamera: {e}", file=sys.stderr)
         return 1
     print(f"{len(manifests)} recordings filmed again into {args.output} "
-          f"({', '.join(f'{t} {r:g} fps' for t, r in fps.items()) or 'frame rates kept'}; noise {args.noise:g} m)")
+          f"({', '.join(f'{t} {r:g} fps' for t, r in fps.items()) or 'frame rates kept'}; noise {args.noise:g} m"
+          f"{f'; image scale {args.scale:g}' if args.scale != 1.0 else ''})")
     return 0
 
 
