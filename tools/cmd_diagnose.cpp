@@ -24,6 +24,12 @@ namespace fs = std::filesystem;
 namespace clumpforge::cli {
 namespace {
 
+/// An option taking one of `choices`, its default shown in --help.
+void add_choice(CLI::App& sub, const std::string& name, std::string& value, std::vector<std::string> choices,
+                const std::string& help) {
+  sub.add_option(name, value, help)->check(CLI::IsMember(std::move(choices)))->capture_default_str();
+}
+
 struct DiagnoseArgs {
   std::vector<std::string> recordings, effects;
   std::string mesh, clump, clump_name, out, materials, units = "mm";
@@ -229,26 +235,20 @@ Command add_diagnose_command(CLI::App& app) {
   add_seed_option(*sub, args->seed, "Seed (the release orientations drawn from each prior)");
   sub->add_option("--orientation-prior", args->orientation_prior_deg,
                   "Uncertainty of a recorded release orientation (orientation_wxyz) [deg]; never taken as exact");
-  sub->add_option("--roll-release", args->roll_release,
-                  "How the lab set the particle on a roll's incline: on-edge (a flattened particle stands on its rim "
-                  "and is turned at random about its flat faces' normal, or, when orientation_wxyz is recorded, at "
-                  "the turn nearest it; a sphere or equant body anyhow) or any (uniform over all orientations)")
-      ->check(CLI::IsMember({"on-edge", "any"}))
-      ->capture_default_str();
-  sub->add_option("--image-scale", args->image_scale,
-                  "A drop recording whose free flights fall off g by more than 0.1 % (the camera's image scale or "
-                  "frame rate off, if the tracked point is the centre of mass): as-recorded, or flights (read "
-                  "through the scale its flights give: x, z and rebound heights divided by it; for a sphere, or a "
-                  "body tracked at its centre of mass); measured either way (report.json image_scale)")
-      ->check(CLI::IsMember({"flights", "as-recorded"}))
-      ->capture_default_str();
-  sub->add_option("--drop-drift", args->drop_drift,
-                  "Where a drop's drift is read beyond the release horizon, recorded and replayed alike: track-end "
-                  "(each track's last ten frames; default: right when the tracks run until the particle rests) or "
-                  "after-impact (the same time after each first impact, the longest every recorded trial reaches: "
-                  "for tracks that stop while the particle still moves)")
-      ->check(CLI::IsMember({"track-end", "after-impact"}))
-      ->capture_default_str();
+  add_choice(*sub, "--roll-release", args->roll_release, {"on-edge", "any"},
+             "How the lab set the particle on a roll's incline: on-edge (a flattened particle stands on its rim "
+             "and is turned at random about its flat faces' normal, or, when orientation_wxyz is recorded, at "
+             "the turn nearest it; a sphere or equant body anyhow) or any (uniform over all orientations)");
+  add_choice(*sub, "--image-scale", args->image_scale, {"flights", "as-recorded"},
+             "A drop recording whose free flights fall off g by more than 0.1 % (the camera's image scale or "
+             "frame rate off, if the tracked point is the centre of mass): as-recorded, or flights (read "
+             "through the scale its flights give: x, z and rebound heights divided by it; for a sphere, or a "
+             "body tracked at its centre of mass); measured either way (report.json image_scale)");
+  add_choice(*sub, "--drop-drift", args->drop_drift, {"track-end", "after-impact"},
+             "Where a drop's drift is read beyond the release horizon, recorded and replayed alike: track-end "
+             "(each track's last ten frames; default: right when the tracks run until the particle rests) or "
+             "after-impact (the same time after each first impact, the longest every recorded trial reaches: "
+             "for tracks that stop while the particle still moves)");
   sub->add_option("--wall-mass", args->wall_mass,
                   "The mass in each clump sphere's wall-contact damping: whole (the clump's, as LIGGGHTS and EDEM; "
                   "default; the calibrated coefficients carry over to those engines) or shared (among the clump's "
