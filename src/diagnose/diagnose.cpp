@@ -79,6 +79,35 @@ std::vector<std::string> image_scale_notes(const std::vector<RecordingScale>& sc
         "camera filmed every test, divide their tracks by the same scale");
   return notes;
 }
+
+/// Measures each tracked drop recording's image scale (result.image_scale) and notes those off.
+/// Where the options read some through their scale, the diagnosis of the rescaled copy, with
+/// the scales measured on the recordings as given; nullopt: diagnose the recordings as they are.
+std::optional<Result<DiagnoseResult>> image_scale_stage(const Clump& clump, const MaterialTable& table,
+                                                        const std::vector<Recording>& recordings,
+                                                        const std::vector<std::string>& names,
+                                                        const DiagnoseOptions& options, const RunContext& run,
+                                                        DiagnoseResult& result) {
+  const std::vector<FlightGravity> gravity = recorded_gravity(recordings, body_reach(clump.spheres));
+  result.image_scale = recording_scales(gravity, names, options.image_scale);
+  result.image_scale_mode = options.image_scale;
+  const bool round = clump.spheres.size() == 1;
+  if (std::none_of(result.image_scale.begin(), result.image_scale.end(),
+                   [](const RecordingScale& s) { return s.applied; })) {
+    for (auto& note : image_scale_notes(result.image_scale, recordings, round)) result.notes.push_back(std::move(note));
+    return std::nullopt;
+  }
+  DiagnoseOptions as_rescaled = options;
+  as_rescaled.image_scale = ImageScale::AsRecorded;
+  auto rescaled_result = diagnose(clump, table, rescaled(recordings, gravity), names, as_rescaled, run);
+  if (rescaled_result) {
+    rescaled_result->image_scale = std::move(result.image_scale);
+    rescaled_result->image_scale_mode = options.image_scale;
+    const auto notes = image_scale_notes(rescaled_result->image_scale, recordings, round);
+    rescaled_result->notes.insert(rescaled_result->notes.begin(), notes.begin(), notes.end());
+  }
+  return rescaled_result;
+}
 }  // namespace
 
 Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
@@ -100,26 +129,12 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
   }
   if (!any_track) return diagnose_summaries(clump, table, recordings, names, options, run);
-  // The image scale: a drop recording's flights fall at g in true metres. Those off are read
-  // through their scale, the whole diagnosis on the rescaled copy.
-  const std::vector<FlightGravity> gravity = recorded_gravity(recordings, body_reach(clump.spheres));
-  result.image_scale = recording_scales(gravity, names, options.image_scale);
-  result.image_scale_mode = options.image_scale;
-  if (std::any_of(result.image_scale.begin(), result.image_scale.end(),
-                  [](const RecordingScale& s) { return s.applied; })) {
-    DiagnoseOptions as_rescaled = options;
-    as_rescaled.image_scale = ImageScale::AsRecorded;
-    auto rescaled_result = diagnose(clump, table, rescaled(recordings, gravity), names, as_rescaled, run);
-    if (!rescaled_result) return rescaled_result;
-    rescaled_result->image_scale = std::move(result.image_scale);
-    rescaled_result->image_scale_mode = options.image_scale;
-    const auto notes = image_scale_notes(rescaled_result->image_scale, recordings, clump.spheres.size() == 1);
-    rescaled_result->notes.insert(rescaled_result->notes.begin(), notes.begin(), notes.end());
-    rescaled_result->seconds = seconds_since(started);
-    return rescaled_result;
+  // The image scale: a drop recording's flights fall at g in true metres. Those read through
+  // their scale: the whole diagnosis on the rescaled copy.
+  if (auto rescaled_result = image_scale_stage(clump, table, recordings, names, options, run, result)) {
+    if (*rescaled_result) (*rescaled_result)->seconds = seconds_since(started);
+    return std::move(*rescaled_result);
   }
-  for (auto& note : image_scale_notes(result.image_scale, recordings, clump.spheres.size() == 1))
-    result.notes.push_back(std::move(note));
 
   Context c;
   if (options.reuse_replays) c.ev.memo = &c.memo;
