@@ -129,13 +129,16 @@ inline ContactSettings contact_settings(ContactConventions conventions) {
   return s;
 }
 
+/// The standard gravity every world falls under [m/s^2].
+inline constexpr double kStandardGravity = 9.81;
+
 struct World {
   std::vector<RigidBody> bodies;
   std::vector<Wall> walls;
   std::vector<Material> materials;
   /// interaction[i][j] for material indices i, j.
   std::vector<std::vector<Interaction>> interactions;
-  Eigen::Vector3d gravity{0.0, 0.0, -9.81};
+  Eigen::Vector3d gravity{0.0, 0.0, -kStandardGravity};
   ContactSettings contact;
   std::vector<PhysicsTerm> terms;  ///< extra physics (air drag, ...)
   double time = 0.0;               ///< [s]

@@ -87,6 +87,28 @@ std::vector<FlightGravity> flight_gravity(const std::vector<FreeFlight>& flights
   return out;
 }
 
+/// The free flights of every tracked drop recording with a camera noise (`noise` per recording),
+/// each marked with its recording and trial: the body's reach, a margin and three noise levels
+/// clear of the plate.
+std::vector<FreeFlight> drop_flights(const std::vector<Recording>& recordings, const std::vector<double>& noise,
+                                     const FlightWobbleOptions& options) {
+  std::vector<FreeFlight> out;
+  for (std::size_t r = 0; r < recordings.size() && r < noise.size(); ++r) {
+    if (recordings[r].test != LabTest::Drop || !std::isfinite(noise[r])) continue;
+    const double clearance = options.reach_m + options.clearance_m + 3.0 * noise[r];
+    for (std::size_t k = 0; k < recordings[r].trials.size(); ++k) {
+      const auto& track = recordings[r].trials[k].track;
+      if (!track) continue;
+      for (FreeFlight f : free_flights(*track, clearance, noise[r], options.min_frames)) {
+        f.recording = r;
+        f.trial = k;
+        out.push_back(f);
+      }
+    }
+  }
+  return out;
+}
+
 /// [m] The offset a median excess needs: a point at distance d from the centre, turned at random,
 /// has a variance d^2 / 3 per coordinate; the silhouette's own wander (`allowance` [m]) is taken
 /// off first.
@@ -152,23 +174,10 @@ FlightWobble flight_wobble(const std::vector<Recording>& recordings, const std::
   FlightWobble result;
   result.allowance_m = options.allowance_m;
   std::vector<double> drop_noise;
-  for (std::size_t r = 0; r < recordings.size(); ++r) {
-    if (recordings[r].test != LabTest::Drop || r >= noise.size() || !std::isfinite(noise[r])) continue;
-    drop_noise.push_back(noise[r]);
-    const double clearance = options.reach_m + options.clearance_m + 3.0 * noise[r];
-    for (std::size_t k = 0; k < recordings[r].trials.size(); ++k) {
-      const auto& track = recordings[r].trials[k].track;
-      if (!track) continue;
-      for (FreeFlight f : free_flights(*track, clearance, noise[r], options.min_frames)) {
-        f.recording = r;
-        f.trial = k;
-        result.flights.push_back(f);
-      }
-    }
+  for (std::size_t r = 0; r < recordings.size() && r < noise.size(); ++r) {
+    if (recordings[r].test == LabTest::Drop && std::isfinite(noise[r])) drop_noise.push_back(noise[r]);
   }
-  std::vector<double> each_noise(recordings.size(), std::numeric_limits<double>::quiet_NaN());
-  for (std::size_t r = 0; r < recordings.size() && r < noise.size(); ++r) each_noise[r] = noise[r];
-  result.gravity = flight_gravity(result.flights, each_noise);
+  result.flights = drop_flights(recordings, noise, options);
   const std::size_t n = result.flights.size();
   if (drop_noise.empty() || n < static_cast<std::size_t>(std::max(1, options.min_flights))) return result;
   result.judged = true;
@@ -246,7 +255,7 @@ std::vector<FlightGravity> recorded_gravity(const std::vector<Recording>& record
   }
   FlightWobbleOptions options;
   options.reach_m = reach;
-  return flight_wobble(recordings, noise, options).gravity;
+  return flight_gravity(drop_flights(recordings, noise, options), noise);
 }
 
 std::vector<Recording> rescaled(const std::vector<Recording>& recordings, const std::vector<FlightGravity>& gravity) {

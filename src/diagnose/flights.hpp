@@ -20,6 +20,7 @@
 
 #include "core/clump.hpp"
 #include "core/recording.hpp"
+#include "dem/world.hpp"  // kStandardGravity
 
 namespace clumpforge {
 
@@ -36,9 +37,6 @@ struct FreeFlight {
   /// [m/s^2] the downward acceleration of z's best parabola: g in the camera's metres.
   double fall_acceleration = 0.0;
 };
-
-/// The standard gravity the replays fall under [m/s^2] (World::gravity).
-inline constexpr double kStandardGravity = 9.81;
 
 /// What one drop recording's free flights after the first contact say of the camera's scale.
 /// Between bounces the body flies on a parabola whose curvature is g, whatever it does on the
@@ -77,7 +75,8 @@ inline constexpr double kScaleTolerance = 1e-3;
 /// `min_frames` frames are dropped. `noise` [m] per coordinate is subtracted from each.
 std::vector<FreeFlight> free_flights(const Track& track, double clearance, double noise, int min_frames);
 
-/// Each drop recording's flights' fall acceleration (FlightWobble::gravity), read on its own tracks (their camera noise
+/// Each drop recording's flights' fall acceleration (recordings with 6 or more flights on which
+/// the tracked point keeps to its parabola within half the camera noise), read on its own tracks (their camera noise
 /// estimated from them), for a body whose reach from its tracked point is `reach` [m].
 std::vector<FlightGravity> recorded_gravity(const std::vector<Recording>& recordings, double reach);
 
@@ -136,9 +135,6 @@ struct FlightWobble {
   /// plus noise) as an offset, over the share of an offset the estimate recovers
   /// (kOffsetRecovered). Infinity when too few flights were found.
   double smallest_offset_m = std::numeric_limits<double>::infinity();
-  /// Each drop recording's flights' fall acceleration (recordings with 6 or more flights on which
-  /// the tracked point keeps to its parabola within half the camera noise).
-  std::vector<FlightGravity> gravity;
 };
 
 /// The share of a centre-of-mass offset that FlightWobble::offset_m recovers on a tumbling

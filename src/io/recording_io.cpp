@@ -604,33 +604,38 @@ Error disagree(const fs::path& first, const fs::path& second, std::string_view w
 }
 }  // namespace
 
+namespace {
 /// Two manifests that name their mesh at different paths (`first` as stated so far, `mesh` named
 /// by `second`) state one particle when both files lie inside their recordings' folders and hold
 /// the same bytes: a lab that keeps a copy of the mesh beside each recording (the one layout
 /// whose mesh clumpforge opens, see StatedParticle::mesh_inside). Otherwise refused, naming both
-/// files as written from their manifests' folders and why they are not one particle.
-Result<void> same_mesh_copies(const StatedParticle& first, const fs::path& second, const std::string& mesh) {
-  const auto shown = [](const fs::path& manifest, const std::string& m) {
-    return fmt::format("'{}'", (manifest.parent_path() / m).lexically_normal().string());
-  };
+/// files as named from their manifests' folders and why they are not one particle. `first_hash`
+/// keeps the first mesh's digest, read once for all the manifests after it.
+Result<void> same_mesh_copies(const StatedParticle& first, const fs::path& second, const std::string& mesh,
+                              std::optional<std::string>& first_hash) {
   const auto refuse = [&](const std::string& why) {
-    return std::unexpected(
-        disagree(first.mesh_in, second, "mesh", shown(first.mesh_in, *first.mesh), shown(second, mesh), why));
+    return std::unexpected(disagree(first.mesh_in, second, "mesh", fmt::format("'{}'", first.mesh_as_named()->string()),
+                                    fmt::format("'{}'", named_from(second, mesh).string()), why));
   };
   auto a = first.mesh_inside();
   auto b = inside_folder(second.parent_path(), mesh, "the particle's mesh");
   if (!a || !b) return refuse("two files, not compared: clumpforge opens no file outside a recording's folder");
-  auto hash_a = sha256_file(*a);
+  if (!first_hash) {
+    auto hash = sha256_file(*a);
+    if (!hash) return refuse(hash.error().message);
+    first_hash = std::move(*hash);
+  }
   auto hash_b = sha256_file(*b);
-  if (!hash_a) return refuse(hash_a.error().message);
   if (!hash_b) return refuse(hash_b.error().message);
-  if (*hash_a != *hash_b) return refuse("two files whose bytes differ");
+  if (*first_hash != *hash_b) return refuse("two files whose bytes differ");
   return {};
 }
+}  // namespace
 
 Result<StatedParticle> stated_particle(const RecordingSet& set) {
   StatedParticle out;
   fs::path units_in;
+  std::optional<std::string> mesh_hash;  // the first mesh's digest, once a copy is compared
   for (std::size_t i = 0; i < set.recordings.size() && i < set.manifests.size(); ++i) {
     const Recording& r = set.recordings[i];
     const fs::path& at = set.manifests[i];
@@ -648,7 +653,7 @@ Result<StatedParticle> stated_particle(const RecordingSet& set) {
         out.mesh = *m;
         out.mesh_in = at;
       } else if (named_from(at, *m) != named_from(out.mesh_in, *out.mesh)) {
-        if (auto same = same_mesh_copies(out, at, *m); !same) return std::unexpected(same.error());
+        if (auto same = same_mesh_copies(out, at, *m, mesh_hash); !same) return std::unexpected(same.error());
       }
     }
     if (const auto& u = r.particle_mesh_units) {

@@ -15,7 +15,6 @@
 #include "diagnose/bodies.hpp"
 #include "diagnose/conceal.hpp"
 #include "diagnose/flights.hpp"
-#include "diagnose/tracks.hpp"
 #include "io/clump_library.hpp"
 #include "io/recording_io.hpp"
 #include "support/test_support.hpp"
@@ -266,15 +265,7 @@ std::vector<FlightGravity> lab_like_flight_gravity(const std::string& case_id, c
     }
     drops.push_back(std::move(*r));
   }
-  std::vector<double> noise;
-  for (const auto& r : drops) {
-    std::vector<const Track*> tracks;
-    for (const auto& t : r.trials) tracks.push_back(&*t.track);
-    noise.push_back(estimate_noise(tracks));
-  }
-  FlightWobbleOptions options;
-  options.reach_m = reach;
-  return flight_wobble(drops, noise, options).gravity;
+  return recorded_gravity(drops, reach);
 }
 
 TEST(FreeFlights, TheirFallAccelerationIsGravityInTheCamerasMetres) {
