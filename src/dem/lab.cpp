@@ -407,9 +407,9 @@ Result<LabWorld> make_lab_world(const Clump& clump, const MaterialTable& table, 
     world.walls = {floor};
   }
   const double impact_speed =
-      setup.test == LabTest::Drop ? std::sqrt(2 * 9.81 * setup.release_height)
+      setup.test == LabTest::Drop ? std::sqrt(2 * kStandardGravity * setup.release_height)
       : setup.test == LabTest::Roll
-          ? std::sqrt(2 * 9.81 * setup.start_distance * std::sin(setup.incline_deg * kPi / 180.0)) + 0.2
+          ? std::sqrt(2 * kStandardGravity * setup.start_distance * std::sin(setup.incline_deg * kPi / 180.0)) + 0.2
           : 0.1;
   // A tilt's contacts rest on the plate: its Hertz duration at the nominal 0.1 m/s is no
   // collision's, so the Hertz rule does not apply there. Without the Rayleigh bound the step of a

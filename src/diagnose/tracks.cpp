@@ -231,8 +231,9 @@ double guess_shift(const Track& track, LabTest test, double tilt_rate_deg_per_s,
     z0 = zs[zs.size() / 2];
   }
   constexpr double kMoved = 2e-3;
-  const double acceleration =
-      test == LabTest::Drop ? 9.81 : 9.81 * std::sin(incline_deg * std::numbers::pi / 180.0) * 5.0 / 7.0;
+  const double acceleration = test == LabTest::Drop
+                                  ? kStandardGravity
+                                  : kStandardGravity * std::sin(incline_deg * std::numbers::pi / 180.0) * 5.0 / 7.0;
   int run = 0;
   double run_start = 0.0;
   for (std::size_t i = 0; i < track.size(); ++i) {
