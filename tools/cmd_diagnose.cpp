@@ -239,11 +239,11 @@ Command add_diagnose_command(CLI::App& app) {
              "How the lab set the particle on a roll's incline: on-edge (a flattened particle stands on its rim "
              "and is turned at random about its flat faces' normal, or, when orientation_wxyz is recorded, at "
              "the turn nearest it; a sphere or equant body anyhow) or any (uniform over all orientations)");
-  add_choice(*sub, "--image-scale", args->image_scale, {"flights", "as-recorded"},
-             "A drop recording whose free flights fall off g by more than 0.1 % (the camera's image scale or "
-             "frame rate off, if the tracked point is the centre of mass): as-recorded, or flights (read "
-             "through the scale its flights give: x, z and rebound heights divided by it; for a sphere, or a "
-             "body tracked at its centre of mass); measured either way (report.json image_scale)");
+  add_choice(*sub, "--image-scale", args->image_scale, {"measured", "flights", "as-recorded"},
+             "A recording whose image scale is off by more than 0.1 % (a drop's free flights fall off g; a "
+             "ball's centre rolls off its resting height): as-recorded, or measured (read through the scale "
+             "its tracks give: x, z and length summaries divided by it; for a sphere, or a body tracked at its "
+             "centre of mass; 'flights' is its older name); measured either way (report.json image_scale)");
   add_choice(*sub, "--drop-drift", args->drop_drift, {"track-end", "after-impact"},
              "Where a drop's drift is read beyond the release horizon, recorded and replayed alike: track-end "
              "(each track's last ten frames; default: right when the tracks run until the particle rests) or "

@@ -296,22 +296,25 @@ nlohmann::json flights_json(const FlightWobble& f) {
           {"smallest_offset_mm", finite_or_null(f.smallest_offset_m * 1e3)}};
 }
 
-/// report.json's image_scale: each tracked drop recording's flights' fall acceleration as
-/// recorded, the scale it gives, whether it is off and whether the diagnosis read it so.
+/// report.json's image_scale: each recording's image scale as its tracks give it (a drop's
+/// flights' fall acceleration, a ball's rolling height), the scale, whether it is off and whether
+/// the diagnosis read it so.
 nlohmann::json image_scale_json(const DiagnoseResult& r) {
   nlohmann::json recordings = nlohmann::json::array();
   for (const auto& [name, g, applied] : r.image_scale) {
+    const bool flights = g.source == ScaleSource::FreeFlights;
     recordings.push_back({{"recording", name},
-                          {"flights", g.flights},
-                          {"fall_acceleration_m_s2", g.acceleration},
-                          {"standard_error_m_s2", g.standard_error},
+                          {"from", std::string(to_string(g.source))},
+                          {"samples", g.samples},
+                          {flights ? "fall_acceleration_m_s2" : "height_m", g.measured},
+                          {flights ? "expected_m_s2" : "expected_m", g.expected},
+                          {flights ? "standard_error_m_s2" : "standard_error_m", g.standard_error},
                           {"scale", g.scale()},
+                          {"tolerance", g.tolerance()},
                           {"off", g.off()},
                           {"applied", applied}});
   }
-  return {{"mode", std::string(to_string(r.image_scale_mode))},
-          {"tolerance", kScaleTolerance},
-          {"recordings", std::move(recordings)}};
+  return {{"mode", std::string(to_string(r.image_scale_mode))}, {"recordings", std::move(recordings)}};
 }
 
 /// report.json's ensemble: the recorded outcomes against replays over the unknown release.

@@ -244,16 +244,25 @@ void bind_result(py::module_& m) {
       .def_readonly("smallest_offset_m", &FlightWobble::smallest_offset_m,
                     "[m] the smallest offset these flights would have shown");
   py::class_<RecordingScale>(m, "RecordingScale",
-                             "A drop recording's image scale as its free flights give it: between bounces a body "
-                             "falls at g, so their fall in the camera's metres is g times the scale.")
+                             "A recording's image scale as its tracks give it: a drop's free flights fall at g "
+                             "between bounces, a ball's centre rolls one radius above the incline, so "
+                             "in the camera's metres each is the true value times the scale.")
       .def_readonly("recording", &RecordingScale::recording)
-      .def_property_readonly("flights", [](const RecordingScale& s) { return s.measured.flights; })
-      .def_property_readonly("fall_acceleration_m_s2", [](const RecordingScale& s) { return s.measured.acceleration; })
-      .def_property_readonly("standard_error_m_s2", [](const RecordingScale& s) { return s.measured.standard_error; })
+      .def_property_readonly(
+          "source", [](const RecordingScale& s) { return std::string(to_string(s.measured.source)); },
+          "free_flights (measured and expected in m/s^2) or rolling_height (in m)")
+      .def_property_readonly(
+          "samples", [](const RecordingScale& s) { return s.measured.samples; }, "flights, or frames")
+      .def_property_readonly(
+          "measured", [](const RecordingScale& s) { return s.measured.measured; }, "as the camera gives it")
+      .def_property_readonly(
+          "expected", [](const RecordingScale& s) { return s.measured.expected; },
+          "in true metres: g, or the ball's radius")
+      .def_property_readonly("standard_error", [](const RecordingScale& s) { return s.measured.standard_error; })
       .def_property_readonly("scale", [](const RecordingScale& s) { return s.measured.scale(); })
       .def_property_readonly(
           "off", [](const RecordingScale& s) { return s.measured.off(); },
-          "off g by more than the tolerance and four standard errors")
+          "off by more than the tolerance and four standard errors")
       .def_readonly("applied", &RecordingScale::applied, "its lengths were divided by the scale");
   py::class_<PartedRecording>(m, "PartedRecording",
                               "A recording whose trials part where the replays agree for every release.")
@@ -293,7 +302,7 @@ void bind_result(py::module_& m) {
       .def_readonly("particle_model", &DiagnoseResult::particle_model)
       .def_readonly("flights", &DiagnoseResult::flights)
       .def_readonly("image_scale", &DiagnoseResult::image_scale,
-                    "each tracked drop recording's image scale from its free flights (RecordingScale)")
+                    "each recording's image scale as its tracks give it (RecordingScale)")
       .def_readonly("heldout_outcomes", &DiagnoseResult::heldout_outcomes)
       .def_readonly("heldout_flights", &DiagnoseResult::heldout_flights)
       .def_readonly("evaluations", &DiagnoseResult::evaluations)
@@ -325,7 +334,8 @@ DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, con
   options.roll_release = *posture;
   const auto scale = parse_image_scale(image_scale);
   if (!scale)
-    raise({ErrorCode::InvalidArgument, fmt::format("image_scale '{}' is not flights or as-recorded", image_scale)});
+    raise({ErrorCode::InvalidArgument,
+           fmt::format("image_scale '{}' is not measured, flights or as-recorded", image_scale)});
   options.image_scale = *scale;
   options.model_accuracy_m = model_accuracy;
   options.ensemble_replays = ensemble_replays;
@@ -394,8 +404,24 @@ void bind_diagnose(py::module_& m) {
         "how closely any clump follows the real particle, finer_clumps finer clumps of the same body (the "
         "resolution raised while replayed tracks change; refitted before a mismatch is blamed on missing physics), "
         "roll_release how the lab set the particle on a roll's incline (on-edge: a flattened particle on its rim; "
-        "any), image_scale how a drop recording whose free flights fall off g is read (as-recorded; flights: through "
-        "the scale they give, for a sphere or a body tracked at its centre of mass).");
+        "any), image_scale how a recording whose image scale is off is read (as-recorded; measured: through the scale "
+        "its tracks give, for a sphere or a body tracked at its centre of mass; flights: measured's older name).");
+  m.def(
+      "measure_image_scale",
+      [](const Clump& clump, const py::dict& recordings) {
+        std::vector<Recording> list;
+        std::vector<std::string> names;
+        for (const auto& [name, recording] : recordings) {
+          names.push_back(py::cast<std::string>(name));
+          list.push_back(py::cast<Recording>(recording));
+        }
+        std::vector<RecordingScale> out;
+        for (const ScaleReading& g : measure_image_scale(clump, list)) out.push_back({names[g.recording], g, false});
+        return out;
+      },
+      py::arg("clump"), py::arg("recordings"),
+      "Each recording's image scale as `clumpforge diagnose` reads it, without the diagnosis: [RecordingScale] "
+      "(a drop's free flights; a ball's rolls, for a one-sphere clump). recordings is {name: Recording}.");
 }
 
 }  // namespace clumpforge::python

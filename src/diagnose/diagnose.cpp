@@ -37,59 +37,71 @@ Result<std::pair<std::vector<TrialScore>, std::vector<TrialScore>>> whole_tracks
   return std::pair{std::move(*full_base), std::move(*full_improved)};
 }
 
-/// Each drop recording's image scale as its flights give it, applied or not.
-std::vector<RecordingScale> recording_scales(const std::vector<FlightGravity>& gravity,
+/// Each recording's image scale as its tracks give it, applied or not.
+std::vector<RecordingScale> recording_scales(const std::vector<ScaleReading>& readings,
                                              const std::vector<std::string>& names, ImageScale mode) {
   std::vector<RecordingScale> out;
-  for (const FlightGravity& g : gravity)
-    out.push_back({names[g.recording], g, g.off() && mode == ImageScale::FromFlights});
+  for (const ScaleReading& g : readings)
+    out.push_back({names[g.recording], g, g.off() && mode == ImageScale::Measured});
   return out;
 }
 
-/// What a diagnosis notes of the drop recordings whose flights fall off g, and how it read them.
+/// What one reading off says it measured, and why that is the scale.
+std::string scale_evidence(const std::string& name, const ScaleReading& g) {
+  if (g.source == ScaleSource::FreeFlights)
+    return fmt::format(
+        "{}: its free flights after the first contact fall at {:.4f} +- {:.4f} m/s^2 ({} flights), {:+.2f} % from "
+        "g = {:g} m/s^2, where a body between bounces falls at g whatever it does on the plate: if the tracked point "
+        "is the centre of mass, the camera's image scale (or its frame rate) is off by that much",
+        name, g.measured, g.standard_error, g.samples, 100.0 * (g.scale() - 1.0), kStandardGravity);
+  return fmt::format(
+      "{}: the ball's centre rolls {:.4f} +- {:.4f} mm above the incline ({} frames), {:+.2f} % from the one-sphere "
+      "clump's radius of {:.4f} mm: the camera's image scale is off by that much, or the ball is not the size of "
+      "its scan",
+      name, 1e3 * g.measured, 1e3 * g.standard_error, g.samples, 100.0 * (g.scale() - 1.0), 1e3 * g.expected);
+}
+
+/// What a diagnosis notes of the recordings whose image scale is off, and how it read them.
 /// Read as recorded, only for a one-sphere clump (`round`): a tracked point off the centre of
-/// mass circles it as a body turns and bends a flight too (FlightGravity), and a tumbling tuber's
+/// mass circles it as a body turns and bends a flight too, and a tumbling tuber's
 /// silhouette-tracked flights fell off g by up to 0.5 % at the true scale; said of such a body,
 /// the note would blame a camera that is right.
 std::vector<std::string> image_scale_notes(const std::vector<RecordingScale>& scales,
                                            const std::vector<Recording>& recordings, bool round) {
   std::vector<std::string> notes;
   bool applied = false;
+  std::vector<bool> measured(recordings.size(), false);
   for (const auto& [name, g, read_so] : scales) {
+    if (g.recording < measured.size()) measured[g.recording] = true;
     if (!g.off() || !(read_so || round)) continue;
     applied = applied || read_so;
-    const std::string fall = fmt::format(
-        "{}: its free flights after the first contact fall at {:.4f} +- {:.4f} m/s^2 ({} flights), {:+.2f} % from "
-        "g = {:g} m/s^2, where a body between bounces falls at g whatever it does on the plate: if the tracked point "
-        "is the centre of mass, the camera's image scale (or its frame rate) is off by that much; calibrate the "
-        "scale in the particle's plane",
-        name, g.acceleration, g.standard_error, g.flights, 100.0 * (g.scale() - 1.0), kStandardGravity);
-    notes.push_back(read_so ? fmt::format("{}. Read through the scale {:.4f} (--image-scale flights): its tracks' x "
-                                          "and z and its rebound heights divided by it",
-                                          fall, g.scale())
-                            : fmt::format("{}. Read as recorded, a verdict on these drops may be the scale's: "
-                                          "--image-scale flights reads them through it",
-                                          fall));
+    const std::string said = scale_evidence(name, g) + "; calibrate the scale in the particle's plane";
+    notes.push_back(read_so ? fmt::format("{}. Read through the scale {:.4f} (--image-scale measured): its tracks' "
+                                          "x and z and its length summaries divided by it",
+                                          said, g.scale())
+                            : fmt::format("{}. Read as recorded, a verdict on this recording may be the scale's: "
+                                          "--image-scale measured reads it through it",
+                                          said));
   }
-  const bool others =
-      std::any_of(recordings.begin(), recordings.end(), [](const Recording& r) { return r.test != LabTest::Drop; });
+  bool others = false;
+  for (std::size_t r = 0; r < recordings.size(); ++r) others = others || !measured[r];
   if (applied && others)
     notes.push_back(
-        "the rolls and tilts have no free flights to show their image scale and are read as recorded; where one "
-        "camera filmed every test, divide their tracks by the same scale");
+        "the other recordings show no image scale (a tilt, a tumbling body's roll, or too few flights or frames) "
+        "and are read as recorded; where one camera filmed every test, divide their tracks by the same scale");
   return notes;
 }
 
-/// Measures each tracked drop recording's image scale (result.image_scale) and notes those off.
+/// Measures each tracked recording's image scale (result.image_scale) and notes those off.
 /// Where the options read some through their scale, the diagnosis of the rescaled copy, with
-/// the scales measured on the recordings as given; nullopt: diagnose the recordings as they are.
+/// those notes first.
 std::optional<Result<DiagnoseResult>> image_scale_stage(const Clump& clump, const MaterialTable& table,
                                                         const std::vector<Recording>& recordings,
                                                         const std::vector<std::string>& names,
                                                         const DiagnoseOptions& options, const RunContext& run,
                                                         DiagnoseResult& result) {
-  const std::vector<FlightGravity> gravity = recorded_gravity(recordings, body_reach(clump.spheres));
-  result.image_scale = recording_scales(gravity, names, options.image_scale);
+  const std::vector<ScaleReading> readings = measure_image_scale(clump, recordings);
+  result.image_scale = recording_scales(readings, names, options.image_scale);
   result.image_scale_mode = options.image_scale;
   const bool round = clump.spheres.size() == 1;
   if (std::none_of(result.image_scale.begin(), result.image_scale.end(),
@@ -99,7 +111,7 @@ std::optional<Result<DiagnoseResult>> image_scale_stage(const Clump& clump, cons
   }
   DiagnoseOptions as_rescaled = options;
   as_rescaled.image_scale = ImageScale::AsRecorded;
-  auto rescaled_result = diagnose(clump, table, rescaled(recordings, gravity), names, as_rescaled, run);
+  auto rescaled_result = diagnose(clump, table, rescaled(recordings, readings), names, as_rescaled, run);
   if (rescaled_result) {
     rescaled_result->image_scale = std::move(result.image_scale);
     rescaled_result->image_scale_mode = options.image_scale;

@@ -28,6 +28,7 @@
 #include "diagnose/effects.hpp"
 #include "diagnose/ensemble.hpp"
 #include "diagnose/flights.hpp"
+#include "diagnose/image_scale.hpp"
 #include "diagnose/phases.hpp"
 #include "diagnose/release.hpp"
 
@@ -86,19 +87,19 @@ struct DiagnoseOptions {
   /// diagnose/ensemble.hpp). False: every one is run (slower; a check that reading back
   /// changes nothing).
   bool reuse_replays = true;
-  /// A drop recording whose free flights fall off g by more than kScaleTolerance (the camera's
-  /// image scale, or its frame rate, off, if the tracked point is the centre of mass): read as
+  /// A recording whose image scale is off by more than kScaleTolerance (measure_image_scale: a
+  /// drop's free flights fall off g, a ball's centre rolls off its resting height): read as
   /// recorded (the default: a tumbling body's tracked point bends its flights too), or through
-  /// the scale its flights give (each length divided by it; FlightGravity). Measured either way
+  /// the scale its tracks give (each length divided by it). Measured either way
   /// (DiagnoseResult::image_scale).
   ImageScale image_scale = ImageScale::AsRecorded;
   std::uint64_t seed = 1;
 };
 
-/// A drop recording's image scale as its free flights give it (DiagnoseResult::image_scale).
+/// A recording's image scale as its tracks give it (DiagnoseResult::image_scale).
 struct RecordingScale {
   std::string recording;
-  FlightGravity measured;
+  ScaleReading measured;
   bool applied = false;  ///< its lengths were divided by measured.scale()
 };
 
@@ -449,8 +450,9 @@ struct DiagnoseResult {
   std::optional<GateRetry> gate_retry;               ///< when the ensemble was compared again at a gate
   std::optional<ParticleModelCheck> particle_model;  ///< when finer clumps were given
   std::optional<FlightWobble> flights;               ///< when drops were tracked
-  /// Each tracked drop recording's flights' fall acceleration, as recorded (recorded_gravity), and
-  /// whether the diagnosis read it through the scale they give (DiagnoseOptions::image_scale).
+  /// Each recording's image scale as its tracks give it (measure_image_scale: a drop's flights,
+  /// a ball's rolls), and whether the diagnosis read it through that scale
+  /// (DiagnoseOptions::image_scale).
   std::vector<RecordingScale> image_scale;
   ImageScale image_scale_mode = ImageScale::AsRecorded;
   std::optional<OutcomeHoldout> heldout_outcomes;  ///< a name on the outcomes, checked on held-out trials

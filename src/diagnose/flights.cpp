@@ -56,7 +56,7 @@ double median_excess(const std::vector<FreeFlight>& flights, const std::vector<s
   return weighted_median(v, w);
 }
 
-/// Each drop recording's flights' fall acceleration (FlightGravity): their mean weighed by the
+/// Each drop recording's flights' fall acceleration (a ScaleReading): their mean weighed by the
 /// precision of a parabola's curvature (frames times duration^4), and its standard error from
 /// their weighed scatter. Only flights on which the tracked point keeps to its parabola within
 /// half the camera noise count: a point off the centre of mass circles it as the body turns,
@@ -66,8 +66,8 @@ double median_excess(const std::vector<FreeFlight>& flights, const std::vector<s
 /// fewer than kGravityFlights such flights are left out.
 constexpr std::size_t kGravityFlights = 6;
 
-std::vector<FlightGravity> flight_gravity(const std::vector<FreeFlight>& flights, const std::vector<double>& noise) {
-  std::vector<FlightGravity> out;
+std::vector<ScaleReading> flight_gravity(const std::vector<FreeFlight>& flights, const std::vector<double>& noise) {
+  std::vector<ScaleReading> out;
   for (std::size_t r = 0; r < noise.size(); ++r) {
     std::vector<double> g, w;
     for (const FreeFlight& f : flights) {
@@ -82,7 +82,12 @@ std::vector<FlightGravity> flight_gravity(const std::vector<FreeFlight>& flights
     double scatter = 0.0;
     for (std::size_t k = 0; k < g.size(); ++k) scatter += w[k] * std::pow(g[k] - mean, 2);
     const double k = static_cast<double>(g.size());
-    out.push_back({r, static_cast<int>(g.size()), mean, std::sqrt(scatter / sum_w / (k - 1.0))});
+    out.push_back({.recording = r,
+                   .source = ScaleSource::FreeFlights,
+                   .samples = static_cast<int>(g.size()),
+                   .measured = mean,
+                   .expected = kStandardGravity,
+                   .standard_error = std::sqrt(scatter / sum_w / (k - 1.0))});
   }
   return out;
 }
@@ -233,17 +238,7 @@ std::optional<FlightHoldout> flight_holdout(const FlightWobble& wobble,
   return out;
 }
 
-std::optional<ImageScale> parse_image_scale(std::string_view text) {
-  if (text == "flights") return ImageScale::FromFlights;
-  if (text == "as-recorded") return ImageScale::AsRecorded;
-  return std::nullopt;
-}
-
-std::string_view to_string(ImageScale mode) {
-  return mode == ImageScale::FromFlights ? "flights" : "as-recorded";
-}
-
-std::vector<FlightGravity> recorded_gravity(const std::vector<Recording>& recordings, double reach) {
+std::vector<ScaleReading> recorded_gravity(const std::vector<Recording>& recordings, double reach) {
   std::vector<double> noise(recordings.size(), std::numeric_limits<double>::quiet_NaN());
   for (std::size_t r = 0; r < recordings.size(); ++r) {
     if (recordings[r].test != LabTest::Drop) continue;
@@ -256,26 +251,6 @@ std::vector<FlightGravity> recorded_gravity(const std::vector<Recording>& record
   FlightWobbleOptions options;
   options.reach_m = reach;
   return flight_gravity(drop_flights(recordings, noise, options), noise);
-}
-
-std::vector<Recording> rescaled(const std::vector<Recording>& recordings, const std::vector<FlightGravity>& gravity) {
-  std::vector<Recording> out = recordings;
-  for (const FlightGravity& g : gravity) {
-    if (!g.off() || g.recording >= out.size()) continue;
-    const double scale = g.scale();
-    for (auto& trial : out[g.recording].trials) {
-      if (trial.summary) *trial.summary /= scale;
-      if (!trial.track) continue;
-      for (double& v : trial.track->x) v /= scale;
-      for (double& v : trial.track->z) v /= scale;
-    }
-  }
-  return out;
-}
-
-bool FlightGravity::off() const {
-  const double departure = std::abs(acceleration - kStandardGravity);
-  return departure > kScaleTolerance * kStandardGravity && departure > 4.0 * standard_error;
 }
 
 bool would_show_offset(const FlightWobble& wobble, double offset) {

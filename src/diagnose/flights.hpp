@@ -20,7 +20,8 @@
 
 #include "core/clump.hpp"
 #include "core/recording.hpp"
-#include "dem/world.hpp"  // kStandardGravity
+#include "dem/world.hpp"             // kStandardGravity
+#include "diagnose/image_scale.hpp"  // ScaleReading
 
 namespace clumpforge {
 
@@ -38,36 +39,6 @@ struct FreeFlight {
   double fall_acceleration = 0.0;
 };
 
-/// What one drop recording's free flights after the first contact say of the camera's scale.
-/// Between bounces the body flies on a parabola whose curvature is g, whatever it does on the
-/// plate, so in the track's metres it is g times the image scale: a camera calibrated off the
-/// particle's plane reads every length, and g, a percent or so off. Air drag bends a flight too,
-/// but a rebound flight rises and falls: drag adds to g on the way up and takes from it on the
-/// way down, and its best parabola keeps g to first order (the first fall, drag's whole
-/// imprint, is not among these flights).
-struct FlightGravity {
-  std::size_t recording = 0;
-  int flights = 0;
-  double acceleration = 0.0;    ///< [m/s^2] the flights' mean fall_acceleration, weighed by precision
-  double standard_error = 0.0;  ///< [m/s^2] from the flights' scatter about it
-  /// The image scale the flights give: acceleration over kStandardGravity.
-  double scale() const { return acceleration / kStandardGravity; }
-  /// Off by more than kScaleTolerance and four standard errors.
-  bool off() const;
-};
-
-/// How a diagnosis reads a drop recording whose free flights fall off g (FlightGravity::off): through
-/// the image scale they give (each length divided by it), or as recorded.
-enum class ImageScale { FromFlights, AsRecorded };
-std::optional<ImageScale> parse_image_scale(std::string_view text);  ///< "flights", "as-recorded"
-std::string_view to_string(ImageScale mode);
-
-/// The departure of a camera's image scale from 1 that FlightGravity::off reports: 0.1 %. As
-/// recorded, 0.1 % left lab-like sphere control case-02's drops `none` and 0.2 % `unexplained`
-/// (docs/diagnose.md, "The image scale"); the flights of every lab-like drop recording, filmed
-/// at the true scale, give it within 0.05 %.
-inline constexpr double kScaleTolerance = 1e-3;
-
 /// The free flights of one drop trial's track: frames with z above `clearance` [m] (the
 /// body's reach from its tracked point, with a margin), after the first frame at or below
 /// it (before that the body has not touched anything, nor turned), split where the track
@@ -75,14 +46,16 @@ inline constexpr double kScaleTolerance = 1e-3;
 /// `min_frames` frames are dropped. `noise` [m] per coordinate is subtracted from each.
 std::vector<FreeFlight> free_flights(const Track& track, double clearance, double noise, int min_frames);
 
-/// Each drop recording's flights' fall acceleration (recordings with 6 or more flights on which
-/// the tracked point keeps to its parabola within half the camera noise), read on its own tracks (their camera noise
-/// estimated from them), for a body whose reach from its tracked point is `reach` [m].
-std::vector<FlightGravity> recorded_gravity(const std::vector<Recording>& recordings, double reach);
-
-/// `recordings` with each one whose flights are off (FlightGravity::off) read through the image
-/// scale they give: its tracks' x and z, and its rebound summaries, divided by it.
-std::vector<Recording> rescaled(const std::vector<Recording>& recordings, const std::vector<FlightGravity>& gravity);
+/// Each drop recording's image scale from its flights' fall acceleration (ScaleReading, source
+/// FreeFlights; recordings with 6 or more flights on which the tracked point keeps to its
+/// parabola within half the camera noise), read on its own tracks (their camera noise estimated
+/// from them), for a body whose reach from its tracked point is `reach` [m]. Between bounces a
+/// body flies on a parabola whose curvature is g, whatever it does on the plate, so in the
+/// track's metres it is g times the image scale. Air drag bends a flight too, but a rebound
+/// flight rises and falls: drag adds to g on the way up and takes from it on the way down, and
+/// its best parabola keeps g to first order (the first fall, drag's whole imprint, is not among
+/// these flights).
+std::vector<ScaleReading> recorded_gravity(const std::vector<Recording>& recordings, double reach);
 
 /// [m] How far a side camera's silhouette centroid wanders about the body's own centroid as
 /// the body turns: the RMS per coordinate (x and z pooled) of the silhouette centroid about its

@@ -250,8 +250,8 @@ TEST(FreeFlights, SilhouetteWanderOfASphereIsNoneAndOfTheTuberSmall) {
 /// The fall acceleration of the free flights of a lab-like case's drops on `surface` (the
 /// independent simulator's, ../shared/data/lab-like), their tracks' x and z multiplied by
 /// `scale` (a camera whose image scale is off), judged with a sphere's reach of `reach` [m].
-std::vector<FlightGravity> lab_like_flight_gravity(const std::string& case_id, const std::string& surface, double scale,
-                                                   double reach) {
+std::vector<ScaleReading> lab_like_flight_gravity(const std::string& case_id, const std::string& surface, double scale,
+                                                  double reach) {
   std::vector<Recording> drops;
   for (const char* height : {"0.2", "0.5", "1.0"}) {
     const auto dir = test::shared_dir() / "data" / "lab-like" / case_id / fmt::format("drop-{}-{}", surface, height);
@@ -286,9 +286,10 @@ TEST(FreeFlights, TheirFallAccelerationIsGravityInTheCamerasMetres) {
     for (double scale : {1.0, 1.01, 0.99}) {
       const auto gravity = lab_like_flight_gravity(c.id, c.surface, scale, c.reach);
       ASSERT_FALSE(gravity.empty());
-      for (const FlightGravity& g : gravity) {
+      for (const ScaleReading& g : gravity) {
         SCOPED_TRACE(fmt::format("scale {}, recording {}: {} flights, {:.4f} +- {:.4f} m/s^2", scale, g.recording,
-                                 g.flights, g.acceleration, g.standard_error));
+                                 g.samples, g.measured, g.standard_error));
+        EXPECT_EQ(g.source, ScaleSource::FreeFlights);
         EXPECT_NEAR(g.scale(), scale, scale == 1.0 ? kScaleTolerance : 2e-3);
         EXPECT_EQ(g.off(), scale != 1.0);
       }

@@ -207,7 +207,7 @@ def test_diagnose_takes_finer_clumps_of_the_same_body_only():
         cf.diagnose(small, recordings, roll_release="flat")
     with pytest.raises(cf.InvalidArgumentError, match="image_scale 'pixels'"):
         cf.diagnose(small, recordings, image_scale="pixels")
-    assert {"recording", "flights", "fall_acceleration_m_s2", "standard_error_m_s2", "scale", "off", "applied"} <= set(
+    assert {"recording", "source", "samples", "measured", "expected", "standard_error", "scale", "off", "applied"} <= set(
         dir(cf.RecordingScale)
     )
     assert "image_scale" in dir(cf.DiagnoseResult)
@@ -378,3 +378,20 @@ def test_the_bench_diagnoses_the_fill_diagnose_takes_on_the_default_scan():
     limit = 0.3e-3 / 3
     assert clumps["adaptive-32"].error.surface_rms > limit
     assert clumps["adaptive-64"].error.surface_rms <= limit
+
+
+def test_the_image_scale_is_measured_without_a_diagnosis():
+    """measure_image_scale reads each recording's image scale as diagnose does: a drop's free
+    flights for any body, a ball's rolls for a one-sphere clump (the scan's fill of the lab-like
+    ball), a tilt none. At the true scale none is off."""
+    ball = cf.fill(cf.load_mesh(str(SHARED / "data/lab-like/meshes/sphere.stl"), units="mm"), method="adaptive",
+                   surface_target=1e-4)
+    assert len(ball.radii) == 1
+    readings = cf.measure_image_scale(ball, cf.read_recordings(str(SHARED / "data/lab-like/case-02")))
+    sources = [r.source for r in readings]
+    assert sources.count("free_flights") == 5 and sources.count("rolling_height") == 3
+    assert not any(r.recording.startswith("tilt") for r in readings)
+    for r in readings:
+        assert not r.off and not r.applied, r.recording
+        assert abs(r.scale - 1.0) < 2e-3, (r.recording, r.scale)
+        assert r.samples > 5

@@ -1,0 +1,83 @@
+#pragma once
+/// The camera's image scale. Every length a camera gives passes through it; a lab calibrates it
+/// with a ruler in one plane, and a particle a few millimetres nearer or farther, or the lens's
+/// distortion, leaves every length a fraction of a percent off. A sphere control's drops filmed
+/// 0.2 % off came out `unexplained`, and its rolls filmed 1 % off named adhesion
+/// (docs/diagnose.md, "The image scale"). Two things a recording shows that no coefficient
+/// changes give the scale:
+/// - a drop's free flights after its first contact fall at g (FreeFlights), and
+/// - a ball rolling down an incline keeps its centre one radius above the slope (RollingHeight;
+///   a one-sphere clump only: a tumbling body's centre rises and falls as it turns).
+#include <cstddef>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "core/clump.hpp"
+#include "core/recording.hpp"
+
+namespace clumpforge {
+
+/// What a recording's image scale was read from.
+enum class ScaleSource {
+  FreeFlights,    ///< a drop's flights after the first contact: measured and expected are fall accelerations [m/s^2]
+  RollingHeight,  ///< a ball's centre above the incline: heights [m]
+};
+std::string_view to_string(ScaleSource source);  ///< "free_flights", "rolling_height"
+
+/// One recording's image scale as its tracks give it.
+struct ScaleReading {
+  std::size_t recording = 0;
+  ScaleSource source = ScaleSource::FreeFlights;
+  int samples = 0;              ///< flights, or frames
+  double measured = 0.0;        ///< as the camera gives it
+  double expected = 0.0;        ///< what it is in true metres: g, or the ball's radius
+  double standard_error = 0.0;  ///< of measured
+  double scale() const { return measured / expected; }
+  /// How far the scale may depart from 1 before it is said to be off: kScaleTolerance for the
+  /// flights, kRollingScaleTolerance for a ball's height.
+  double tolerance() const;
+  /// Off by more than its tolerance and four standard errors.
+  bool off() const;
+};
+
+/// The departure of a camera's image scale from 1 that ScaleReading::off reports: 0.1 %. As
+/// recorded, 0.1 % left lab-like sphere control case-02's drops `none` and 0.2 % `unexplained`
+/// (docs/diagnose.md, "The image scale"); the flights of every lab-like drop recording, filmed
+/// at the true scale, give it within 0.05 %.
+inline constexpr double kScaleTolerance = 1e-3;
+
+/// The same for a ball's rolling height: 0.3 %. The height carries the clump's radius besides the
+/// camera's scale (a sphere's scan, faceted, fills a sphere a little smaller than the ball) and
+/// the overlap under its weight (rolling_heights): the rolls of lab-like's 13 sphere cases,
+/// filmed at the true scale, read within 0.15 % (bench/image_scale_survey.py). As recorded,
+/// lab-like control case-02's rolls filmed 1 % long named adhesion, 0.5 % short came out
+/// `unexplained` (docs/diagnose.md, "The image scale").
+inline constexpr double kRollingScaleTolerance = 3e-3;
+/// How a diagnosis reads a recording whose image scale is off (ScaleReading::off): through the
+/// scale its tracks give (each length divided by it), or as recorded.
+enum class ImageScale { Measured, AsRecorded };
+/// "measured" (or "flights", its name before rolls were measured too), "as-recorded".
+std::optional<ImageScale> parse_image_scale(std::string_view text);
+std::string_view to_string(ImageScale mode);
+
+/// Each tracked roll recording's image scale from a ball's centre on the incline: its distance
+/// from the slope, while its contact point is more than a radius up from the foot, over its
+/// `radius` [m] (the one-sphere clump's); frames beyond three camera noise levels of the
+/// recording's median dropped. Recordings with fewer than 3 trials or 100 such frames give none;
+/// the standard error is the trials' scatter, or the noise's when larger. The overlap a ball's
+/// weight presses into the contact is not taken off: a DEM's softened contact sinks the lab-like
+/// sphere about 10 um (0.1 %), a real steel ball on steel a fraction of a micrometre, and a ball
+/// held before its release not at all.
+std::vector<ScaleReading> rolling_heights(const std::vector<Recording>& recordings, double radius);
+
+/// Every recording's image scale its tracks give: the drops' flights for any body
+/// (recorded_gravity: a body tracked away from its centre of mass bends them too), the rolls'
+/// heights for a one-sphere clump.
+std::vector<ScaleReading> measure_image_scale(const Clump& clump, const std::vector<Recording>& recordings);
+
+/// `recordings` with each one whose reading is off read through its scale: its tracks' x and z
+/// and its length summaries (rebound heights, roll distances) divided by it.
+std::vector<Recording> rescaled(const std::vector<Recording>& recordings, const std::vector<ScaleReading>& readings);
+
+}  // namespace clumpforge
