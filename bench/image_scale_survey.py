@@ -14,8 +14,9 @@ within 0.1 mm RMS of it), and prints one line per reading and a summary per sour
 
 A manifest's mesh is opened only inside its recording's folder or a --meshes folder the user
 names, never elsewhere because a recording names it. Recordings that name no mesh (the
-generated sets of bench_diagnose) are read with --mesh MESH [--units mm] [--density 1085],
-which, given, serves every recording.
+generated sets of bench_diagnose) are read with --mesh MESH [--units mm] [--density 1085], or
+with a stored clump, --clump LIBRARY.h5:NAME (the bench diagnoses the generated tuber sets with
+clumps/tuber-default-ladder.h5:adaptive-64); either, given, serves every recording.
 
 A reading is off when it departs from 1 by more than its tolerance (0.1 % for flights, 0.3 % for
 a ball's height) and four standard errors. Nothing is written but OUT.json (temporary file, then
@@ -81,14 +82,30 @@ def stated_particle(folder: pathlib.Path, names: list, args) -> tuple:
     return stated.pop()
 
 
+def stored_clump(cf, spec: str):
+    """The clump LIBRARY.h5:NAME names."""
+    library, _, name = spec.rpartition(":")
+    if not library or not name:
+        raise Refusal(f"--clump {spec}: not LIBRARY.h5:NAME")
+    if not pathlib.Path(library).is_file():
+        raise Refusal(f"--clump {spec}: {library} is not a file")
+    for clump in cf.read_library(library):
+        if clump.name == name:
+            return clump
+    raise Refusal(f"--clump {spec}: {library} holds no clump '{name}'")
+
+
 def survey(cf, root: pathlib.Path, args) -> list:
     clumps, rows = {}, []
+    given = stored_clump(cf, args.clump) if args.clump else None
     for folder, names in recording_folders(root).items():
-        mesh, units, density = stated_particle(folder, names, args)
-        if (mesh, units, density) not in clumps:
-            body = cf.load_mesh(mesh, units=units)
-            clumps[(mesh, units, density)] = cf.fill(body, method="adaptive", surface_target=1e-4, density=density)
-        clump = clumps[(mesh, units, density)]
+        if given is None:
+            key = stated_particle(folder, names, args)
+            if key not in clumps:
+                mesh, units, density = key
+                clumps[key] = cf.fill(cf.load_mesh(mesh, units=units), method="adaptive", surface_target=1e-4,
+                                      density=density)
+        clump = given or clumps[key]
         recordings = {name: cf.read_recording(str(folder / name)) for name in names}
         for r in cf.measure_image_scale(clump, recordings):
             rows.append({"set": str(folder.relative_to(root)) if folder != root else ".", "recording": r.recording,
@@ -122,6 +139,7 @@ def main(argv=None) -> int:
     parser.add_argument("set", type=pathlib.Path, help="a folder of recordings, or of cases of recordings")
     parser.add_argument("--meshes", type=pathlib.Path, help="a folder whose meshes the manifests may name")
     parser.add_argument("--mesh", type=pathlib.Path, help="the particle's mesh for every recording")
+    parser.add_argument("--clump", help="LIBRARY.h5:NAME, a stored clump for every recording")
     parser.add_argument("--units", default="mm", help="--mesh's length unit (default mm)")
     parser.add_argument("--density", type=float, default=1085.0, help="with --mesh [kg/m^3] (default 1085)")
     parser.add_argument("--json", type=pathlib.Path, help="also write every reading and the summary here")
@@ -131,6 +149,8 @@ def main(argv=None) -> int:
             raise Refusal(f"{args.set}: not a folder")
         cf = library()
         try:
+            if args.mesh and args.clump:
+                raise Refusal("--mesh and --clump: give one")
             if args.mesh and not args.mesh.is_file():
                 raise Refusal(f"--mesh {args.mesh}: not a file")
             if not 1.0 <= args.density <= 25000.0:

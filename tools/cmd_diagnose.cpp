@@ -33,7 +33,7 @@ void add_choice(CLI::App& sub, const std::string& name, std::string& value, std:
 struct DiagnoseArgs {
   std::vector<std::string> recordings, effects;
   std::string mesh, clump, clump_name, out, materials, units = "mm";
-  std::string roll_release = "on-edge", wall_mass = "whole", drop_drift = "track-end", image_scale = "as-recorded";
+  std::string roll_release = "on-edge", wall_mass = "whole", drop_drift = "track-end", image_scale = "auto";
   double density = 1085.0, orientation_prior_deg = 15.0, model_accuracy_mm = 0.3, impact_accuracy_pct = 1.0;
   int ensemble_replays = 12, ensemble_replays_at_gate = 48;
   int spheres = 0, max_evaluations = 45, release_orientations = 12, finer_clumps = 2;
@@ -153,7 +153,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   options.orientation_prior_deg = args.orientation_prior_deg;
   options.roll_release = parse_roll_posture(args.roll_release).value_or(RollPosture::OnEdge);  // CLI11 checked it
   options.drift_at = parse_drift_at(args.drop_drift).value_or(DriftAt::TrackEnd);              // CLI11 checked it
-  options.image_scale = parse_image_scale(args.image_scale).value_or(ImageScale::AsRecorded);  // CLI11 checked it
+  options.image_scale = parse_image_scale(args.image_scale).value_or(ImageScale::Auto);        // CLI11 checked it
   const auto wall_mass = parse_wall_mass_option(args.wall_mass);
   if (!wall_mass) return report_error(kCommand, wall_mass.error());
   options.lab.contact.wall_mass = *wall_mass;
@@ -239,11 +239,13 @@ Command add_diagnose_command(CLI::App& app) {
              "How the lab set the particle on a roll's incline: on-edge (a flattened particle stands on its rim "
              "and is turned at random about its flat faces' normal, or, when orientation_wxyz is recorded, at "
              "the turn nearest it; a sphere or equant body anyhow) or any (uniform over all orientations)");
-  add_choice(*sub, "--image-scale", args->image_scale, {"measured", "flights", "as-recorded"},
-             "A recording whose image scale is off by more than 0.1 % (a drop's free flights fall off g; a "
-             "ball's centre rolls off its resting height): as-recorded, or measured (read through the scale "
-             "its tracks give: x, z and length summaries divided by it; for a sphere, or a body tracked at its "
-             "centre of mass; 'flights' is its older name); measured either way (report.json image_scale)");
+  add_choice(*sub, "--image-scale", args->image_scale, {"auto", "measured", "flights", "as-recorded"},
+             "A recording whose image scale is off (a drop's free flights fall off g by more than 0.1 %; a "
+             "ball's centre rolls more than 0.3 % off its radius above the incline): measured (read through "
+             "the scale its tracks give: x, z and length summaries divided by it; 'flights' is its older "
+             "name), as-recorded, or auto (measured for a one-sphere clump, whose tracked point is its "
+             "centre; as recorded for any other body, whose tracked point bends its flights as it tumbles); "
+             "measured either way (report.json image_scale)");
   add_choice(*sub, "--drop-drift", args->drop_drift, {"track-end", "after-impact"},
              "Where a drop's drift is read beyond the release horizon, recorded and replayed alike: track-end "
              "(each track's last ten frames; default: right when the tracks run until the particle rests) or "

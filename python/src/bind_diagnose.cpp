@@ -335,7 +335,7 @@ DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, con
   const auto scale = parse_image_scale(image_scale);
   if (!scale)
     raise({ErrorCode::InvalidArgument,
-           fmt::format("image_scale '{}' is not measured, flights or as-recorded", image_scale)});
+           fmt::format("image_scale '{}' is not auto, measured, flights or as-recorded", image_scale)});
   options.image_scale = *scale;
   options.model_accuracy_m = model_accuracy;
   options.ensemble_replays = ensemble_replays;
@@ -398,14 +398,15 @@ void bind_diagnose(py::module_& m) {
         py::arg("effects") = std::vector<std::string>{}, py::arg("materials") = py::none(),
         py::arg("orientation_prior_deg") = 15.0, py::arg("model_accuracy") = 3e-4, py::arg("ensemble_replays") = 12,
         py::arg("max_evaluations") = 45, py::arg("seed") = 1, py::arg("finer_clumps") = std::vector<Clump>{},
-        py::arg("roll_release") = "on-edge", py::arg("image_scale") = "as-recorded", py::arg("progress") = py::none(),
+        py::arg("roll_release") = "on-edge", py::arg("image_scale") = "auto", py::arg("progress") = py::none(),
         "Finds which physics the model leaves out (`clumpforge diagnose`): recordings is {name: Recording} (as "
         "read_recordings returns), effects the candidates (default: every effect of the library), model_accuracy [m] "
         "how closely any clump follows the real particle, finer_clumps finer clumps of the same body (the "
         "resolution raised while replayed tracks change; refitted before a mismatch is blamed on missing physics), "
         "roll_release how the lab set the particle on a roll's incline (on-edge: a flattened particle on its rim; "
-        "any), image_scale how a recording whose image scale is off is read (as-recorded; measured: through the scale "
-        "its tracks give, for a sphere or a body tracked at its centre of mass; flights: measured's older name).");
+        "any), image_scale how a recording whose image scale is off is read (auto: through the scale its tracks give "
+        "for a one-sphere clump, as recorded for any other body; measured: through it always; flights: measured's "
+        "older name; as-recorded).");
   m.def(
       "measure_image_scale",
       [](const Clump& clump, const py::dict& recordings) {

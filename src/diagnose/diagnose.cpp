@@ -39,10 +39,9 @@ Result<std::pair<std::vector<TrialScore>, std::vector<TrialScore>>> whole_tracks
 
 /// Each recording's image scale as its tracks give it, applied or not.
 std::vector<RecordingScale> recording_scales(const std::vector<ScaleReading>& readings,
-                                             const std::vector<std::string>& names, ImageScale mode) {
+                                             const std::vector<std::string>& names, bool read_through) {
   std::vector<RecordingScale> out;
-  for (const ScaleReading& g : readings)
-    out.push_back({names[g.recording], g, g.off() && mode == ImageScale::Measured});
+  for (const ScaleReading& g : readings) out.push_back({names[g.recording], g, g.off() && read_through});
   return out;
 }
 
@@ -61,13 +60,13 @@ std::string scale_evidence(const std::string& name, const ScaleReading& g) {
       name, 1e3 * g.measured, 1e3 * g.standard_error, g.samples, 100.0 * (g.scale() - 1.0), 1e3 * g.expected);
 }
 
-/// What a diagnosis notes of the recordings whose image scale is off, and how it read them.
-/// Read as recorded, only for a one-sphere clump (`round`): a tracked point off the centre of
+/// What a diagnosis notes of the recordings whose image scale is off, and how it read them (under
+/// `mode`). Read as recorded, only for a one-sphere clump (`round`): a tracked point off the centre of
 /// mass circles it as a body turns and bends a flight too, and a tumbling tuber's
 /// silhouette-tracked flights fell off g by up to 0.5 % at the true scale; said of such a body,
 /// the note would blame a camera that is right.
 std::vector<std::string> image_scale_notes(const std::vector<RecordingScale>& scales,
-                                           const std::vector<Recording>& recordings, bool round) {
+                                           const std::vector<Recording>& recordings, bool round, ImageScale mode) {
   std::vector<std::string> notes;
   bool applied = false;
   std::vector<bool> measured(recordings.size(), false);
@@ -76,9 +75,9 @@ std::vector<std::string> image_scale_notes(const std::vector<RecordingScale>& sc
     if (!g.off() || !(read_so || round)) continue;
     applied = applied || read_so;
     const std::string said = scale_evidence(name, g) + "; calibrate the scale in the particle's plane";
-    notes.push_back(read_so ? fmt::format("{}. Read through the scale {:.4f} (--image-scale measured): its tracks' "
-                                          "x and z and its length summaries divided by it",
-                                          said, g.scale())
+    notes.push_back(read_so ? fmt::format("{}. Read through the scale {:.4f} (--image-scale {}; as-recorded reads it "
+                                          "as given): its tracks' x and z and its length summaries divided by it",
+                                          said, g.scale(), to_string(mode))
                             : fmt::format("{}. Read as recorded, a verdict on this recording may be the scale's: "
                                           "--image-scale measured reads it through it",
                                           said));
@@ -101,12 +100,13 @@ std::optional<Result<DiagnoseResult>> image_scale_stage(const Clump& clump, cons
                                                         const DiagnoseOptions& options, const RunContext& run,
                                                         DiagnoseResult& result) {
   const std::vector<ScaleReading> readings = measure_image_scale(clump, recordings);
-  result.image_scale = recording_scales(readings, names, options.image_scale);
+  result.image_scale = recording_scales(readings, names, reads_through(options.image_scale, clump.spheres.size()));
   result.image_scale_mode = options.image_scale;
   const bool round = clump.spheres.size() == 1;
   if (std::none_of(result.image_scale.begin(), result.image_scale.end(),
                    [](const RecordingScale& s) { return s.applied; })) {
-    for (auto& note : image_scale_notes(result.image_scale, recordings, round)) result.notes.push_back(std::move(note));
+    for (auto& note : image_scale_notes(result.image_scale, recordings, round, options.image_scale))
+      result.notes.push_back(std::move(note));
     return std::nullopt;
   }
   DiagnoseOptions as_rescaled = options;
@@ -115,7 +115,7 @@ std::optional<Result<DiagnoseResult>> image_scale_stage(const Clump& clump, cons
   if (rescaled_result) {
     rescaled_result->image_scale = std::move(result.image_scale);
     rescaled_result->image_scale_mode = options.image_scale;
-    const auto notes = image_scale_notes(rescaled_result->image_scale, recordings, round);
+    const auto notes = image_scale_notes(rescaled_result->image_scale, recordings, round, options.image_scale);
     rescaled_result->notes.insert(rescaled_result->notes.begin(), notes.begin(), notes.end());
   }
   return rescaled_result;

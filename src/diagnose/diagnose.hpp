@@ -87,12 +87,13 @@ struct DiagnoseOptions {
   /// diagnose/ensemble.hpp). False: every one is run (slower; a check that reading back
   /// changes nothing).
   bool reuse_replays = true;
-  /// A recording whose image scale is off by more than kScaleTolerance (measure_image_scale: a
-  /// drop's free flights fall off g, a ball's centre rolls off its resting height): read as
-  /// recorded (the default: a tumbling body's tracked point bends its flights too), or through
-  /// the scale its tracks give (each length divided by it). Measured either way
+  /// A recording whose image scale is off by more than its tolerance (measure_image_scale: a
+  /// drop's free flights fall off g, a ball's centre rolls off its radius above the incline):
+  /// read through the scale its tracks give (each length divided by it) for a one-sphere clump
+  /// and as recorded for any other body (Auto, the default: a tumbling body's tracked point bends
+  /// its flights too), through it always (Measured), or as recorded always. Measured either way
   /// (DiagnoseResult::image_scale).
-  ImageScale image_scale = ImageScale::AsRecorded;
+  ImageScale image_scale = ImageScale::Auto;
   std::uint64_t seed = 1;
 };
 
@@ -454,7 +455,7 @@ struct DiagnoseResult {
   /// a ball's rolls), and whether the diagnosis read it through that scale
   /// (DiagnoseOptions::image_scale).
   std::vector<RecordingScale> image_scale;
-  ImageScale image_scale_mode = ImageScale::AsRecorded;
+  ImageScale image_scale_mode = ImageScale::Auto;
   std::optional<OutcomeHoldout> heldout_outcomes;  ///< a name on the outcomes, checked on held-out trials
   std::optional<FlightHoldout> heldout_flights;    ///< a name from the free flights, checked on held-out trials
   int tracked_trials = 0, training_trials = 0, evaluations = 0;

@@ -94,13 +94,26 @@ bool ScaleReading::off() const {
 }
 
 std::optional<ImageScale> parse_image_scale(std::string_view text) {
+  if (text == "auto") return ImageScale::Auto;
   if (text == "measured" || text == "flights") return ImageScale::Measured;
   if (text == "as-recorded") return ImageScale::AsRecorded;
   return std::nullopt;
 }
 
 std::string_view to_string(ImageScale mode) {
-  return mode == ImageScale::Measured ? "measured" : "as-recorded";
+  switch (mode) {
+    case ImageScale::Auto:
+      return "auto";
+    case ImageScale::Measured:
+      return "measured";
+    case ImageScale::AsRecorded:
+      break;
+  }
+  return "as-recorded";
+}
+
+bool reads_through(ImageScale mode, std::size_t spheres) {
+  return mode == ImageScale::Measured || (mode == ImageScale::Auto && spheres == 1);
 }
 
 std::vector<ScaleReading> rolling_heights(const std::vector<Recording>& recordings, double radius) {

@@ -55,9 +55,12 @@ inline constexpr double kScaleTolerance = 1e-3;
 /// `unexplained` (docs/diagnose.md, "The image scale").
 inline constexpr double kRollingScaleTolerance = 3e-3;
 /// How a diagnosis reads a recording whose image scale is off (ScaleReading::off): through the
-/// scale its tracks give (each length divided by it), or as recorded.
-enum class ImageScale { Measured, AsRecorded };
-/// "measured" (or "flights", its name before rolls were measured too), "as-recorded".
+/// scale its tracks give (each length divided by it), or as recorded. Auto reads it through its
+/// scale for a one-sphere clump, whose tracked point is its centre, and as recorded for any other
+/// body, whose tracked point circles its centre of mass as it tumbles and bends its flights too
+/// (measured on the stored sets: docs/diagnose.md, "The image scale").
+enum class ImageScale { Auto, Measured, AsRecorded };
+/// "auto", "measured" (or "flights", its name before rolls were measured too), "as-recorded".
 std::optional<ImageScale> parse_image_scale(std::string_view text);
 std::string_view to_string(ImageScale mode);
 
@@ -75,6 +78,9 @@ std::vector<ScaleReading> rolling_heights(const std::vector<Recording>& recordin
 /// (recorded_gravity: a body tracked away from its centre of mass bends them too), the rolls'
 /// heights for a one-sphere clump.
 std::vector<ScaleReading> measure_image_scale(const Clump& clump, const std::vector<Recording>& recordings);
+
+/// Whether `mode` reads a recording whose scale is off through it, for a clump of `spheres`.
+bool reads_through(ImageScale mode, std::size_t spheres);
 
 /// `recordings` with each one whose reading is off read through its scale: its tracks' x and z
 /// and its length summaries (rebound heights, roll distances) divided by it.

@@ -64,3 +64,13 @@ def test_absurd_options_are_refused(tmp_path):
     assert run.returncode == 2 and "--mesh" in run.stderr and "not a file" in run.stderr
     run = survey(LAB_LIKE / "case-02", "--mesh", LAB_LIKE / "meshes" / "sphere.stl", "--density", "1e9")
     assert run.returncode == 2 and "outside [1, 25000]" in run.stderr
+    run = survey(LAB_LIKE / "case-02", "--clump", ROOT / "clumps" / "tuber-default-ladder.h5:adaptive-7")
+    assert run.returncode == 2 and "holds no clump 'adaptive-7'" in run.stderr
+
+
+def test_a_stored_clump_serves_every_recording(tmp_path):
+    """With a tuber's clump the sphere's rolls give no scale (a tumbling body's centre rises and
+    falls), its drops still do."""
+    run = survey(LAB_LIKE / "case-02", "--clump", ROOT / "clumps" / "tuber-default-ladder.h5:adaptive-64")
+    assert run.returncode == 0, run.stderr
+    assert "free_flights: 5 readings" in run.stdout and "rolling_height" not in run.stdout

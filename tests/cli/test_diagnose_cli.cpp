@@ -563,9 +563,10 @@ TEST(DiagnoseCli, DropsFilmedThroughAnImageScaleOffAreReadThroughTheScaleTheirFl
   EXPECT_NE(notes.find("drop-Q235-1.0: its free flights after the first contact fall at 9.9"), std::string::npos)
       << notes;
   EXPECT_NE(notes.find("Read through the scale 1.01"), std::string::npos) << notes;
-  // By default read as recorded, and said (a sphere: its tracked point is its centre).
-  const auto as_recorded = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --effects air_drag --json",
-                                                            (dir / "case-02" / "drop-Q235-0.2").string()));
+  // Read as recorded when asked, and said (a sphere: its tracked point is its centre).
+  const auto as_recorded =
+      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --effects air_drag --image-scale as-recorded --json",
+                                       (dir / "case-02" / "drop-Q235-0.2").string()));
   ASSERT_EQ(as_recorded.exit_code, 0) << as_recorded.err;
   const auto k = nlohmann::json::parse(as_recorded.out);
   EXPECT_EQ(k["image_scale"]["mode"], "as-recorded");
@@ -607,17 +608,18 @@ TEST(DiagnoseCli, RollsFilmedThroughAnImageScaleOffAreReadThroughTheScaleTheBall
   // Control case-02's three sphere rolls filmed through an image scale 1 % long. As recorded,
   // asked about adhesion alone, they name it (work of adhesion 0.129 J/m^2, delta-BIC 2.5e4:
   // docs/diagnose.md, "The image scale"), and with the whole library too. A ball rolling down an
-  // incline keeps its centre one radius above the slope: with --image-scale measured each
-  // recording's height gives the scale within 0.2 % (the scan's one-sphere fill is 0.07 % under
-  // the ball's 9.35 mm), the tracks are read through it, and the control is `none` again.
+  // incline keeps its centre one radius above the slope: each recording's height gives the scale
+  // within 0.2 % (the scan's one-sphere fill is 0.07 % under the ball's 9.35 mm), and by default
+  // (--image-scale auto: a one-sphere clump) the tracks are read through it and the control is
+  // `none` again.
   test::ScratchDir dir("diagnose-image-scale-rolls");
   scaled_rolls("case-02", dir / "case-02", 1.01);
-  const auto run = test::run_clumpforge(fmt::format(
-      "diagnose --recordings '{}' --effects adhesion --image-scale measured --json", (dir / "case-02").string()));
+  const auto run = test::run_clumpforge(
+      fmt::format("diagnose --recordings '{}' --effects adhesion --json", (dir / "case-02").string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   EXPECT_EQ(j["verdict"], "none") << j["statement"];
-  EXPECT_EQ(j["image_scale"]["mode"], "measured");
+  EXPECT_EQ(j["image_scale"]["mode"], "auto");  // a one-sphere clump: read through its scale
   ASSERT_EQ(j["image_scale"]["recordings"].size(), 3u) << j["image_scale"];
   for (const auto& r : j["image_scale"]["recordings"]) {
     EXPECT_EQ(r["from"], "rolling_height");
@@ -628,9 +630,10 @@ TEST(DiagnoseCli, RollsFilmedThroughAnImageScaleOffAreReadThroughTheScaleTheBall
   const std::string notes = j["notes"].dump();
   EXPECT_NE(notes.find("roll-Q235-70mm: the ball's centre rolls 9.4"), std::string::npos) << notes;
   EXPECT_NE(notes.find("Read through the scale 1.01"), std::string::npos) << notes;
-  // By default read as recorded, and said.
-  const auto as_recorded = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --effects adhesion --json",
-                                                            (dir / "case-02" / "roll-Q235-35mm").string()));
+  // Read as recorded when asked, and said.
+  const auto as_recorded =
+      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --effects adhesion --image-scale as-recorded --json",
+                                       (dir / "case-02" / "roll-Q235-35mm").string()));
   ASSERT_EQ(as_recorded.exit_code, 0) << as_recorded.err;
   const auto k = nlohmann::json::parse(as_recorded.out);
   ASSERT_EQ(k["image_scale"]["recordings"].size(), 1u);

@@ -114,11 +114,18 @@ TEST(RollingHeights, ScaledRecordingsAreReadThroughTheirScale) {
 }
 
 TEST(ImageScaleOption, ItsNamesAreRead) {
+  EXPECT_EQ(parse_image_scale("auto"), ImageScale::Auto);
   EXPECT_EQ(parse_image_scale("measured"), ImageScale::Measured);
   EXPECT_EQ(parse_image_scale("flights"), ImageScale::Measured);  // its name before the rolls were read
   EXPECT_EQ(parse_image_scale("as-recorded"), ImageScale::AsRecorded);
   EXPECT_FALSE(parse_image_scale("pixels"));
   EXPECT_EQ(to_string(ImageScale::Measured), "measured");
+  EXPECT_EQ(to_string(ImageScale::Auto), "auto");
+  // Auto reads through the scale for a one-sphere clump only.
+  EXPECT_TRUE(reads_through(ImageScale::Auto, 1));
+  EXPECT_FALSE(reads_through(ImageScale::Auto, 64));
+  EXPECT_TRUE(reads_through(ImageScale::Measured, 64));
+  EXPECT_FALSE(reads_through(ImageScale::AsRecorded, 1));
   EXPECT_EQ(to_string(ScaleSource::RollingHeight), "rolling_height");
 }
 
