@@ -98,13 +98,7 @@ std::vector<Outcome> outcomes_of(const Recording& rec) {
 /// The running median of five values (fewer at the two ends), against the camera's noise: the
 /// tilt's slide and the drop's lowest level read it.
 std::vector<double> running_median_of_five(const std::vector<double>& values) {
-  std::vector<double> out(values.size());
-  for (std::size_t k = 0; k < values.size(); ++k) {
-    const std::size_t a = k >= 2 ? k - 2 : 0, b = std::min(values.size(), k + 3);
-    out[k] = median(std::vector<double>(values.begin() + static_cast<std::ptrdiff_t>(a),
-                                        values.begin() + static_cast<std::ptrdiff_t>(b)));
-  }
-  return out;
+  return running_median(values, 2);
 }
 
 /// The first time a sequence of (time, value) pairs reaches `level`, interpolated between the

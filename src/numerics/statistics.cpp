@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -140,6 +141,22 @@ double median(std::vector<double> values) {
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
   return values[values.size() / 2];
+}
+
+std::vector<double> running_median(const std::vector<double>& values, std::size_t half_width) {
+  constexpr std::size_t kWidest = 15;
+  std::vector<double> out(values.size());
+  if (2 * half_width + 1 > kWidest) return out;
+  std::array<double, kWidest> window{};
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    const std::size_t a = k >= half_width ? k - half_width : 0, b = std::min(values.size(), k + half_width + 1);
+    const auto n = static_cast<std::ptrdiff_t>(b - a);
+    std::copy(values.begin() + static_cast<std::ptrdiff_t>(a), values.begin() + static_cast<std::ptrdiff_t>(b),
+              window.begin());
+    std::nth_element(window.begin(), window.begin() + n / 2, window.begin() + n);
+    out[k] = window[static_cast<std::size_t>(n / 2)];
+  }
+  return out;
 }
 
 double quantile(std::vector<double> values, double q) {

@@ -30,6 +30,9 @@ SampleSpread sample_spread(const std::vector<double>& values);
 double standard_error(const std::vector<double>& values);
 /// The median (the upper of the two middle values for an even count); NaN when empty.
 double median(std::vector<double> values);
+/// The running median of 2 `half_width` + 1 values (fewer at the two ends, as median takes them),
+/// at most 15 wide, without a copy per value.
+std::vector<double> running_median(const std::vector<double>& values, std::size_t half_width);
 /// The weighted median: the smallest value whose weight and the smaller values' reach half the
 /// total weight (weights >= 0; NaN for an empty sample or no weight).
 double weighted_median(const std::vector<double>& values, const std::vector<double>& weights);

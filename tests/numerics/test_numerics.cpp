@@ -134,6 +134,25 @@ TEST(ResidualProjection, LeavesWhatAFitOnTheColumnsCannotExplain) {
   EXPECT_EQ(none.diagonal(3), 1.0);
 }
 
+TEST(Statistics, ARunningMedianIsTheMedianOfEachWindow) {
+  // The same bits as median over each window (fewer values at the ends), on noisy data with
+  // ties; a window wider than 15 gives zeros, not a read past the buffer.
+  std::vector<double> values;
+  for (int k = 0; k < 200; ++k) values.push_back(std::round(10.0 * std::sin(0.37 * k) + 3.0 * std::cos(1.3 * k)));
+  for (std::size_t half : {0u, 1u, 2u, 7u}) {
+    const std::vector<double> running = running_median(values, half);
+    ASSERT_EQ(running.size(), values.size());
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      const std::size_t a = k >= half ? k - half : 0, b = std::min(values.size(), k + half + 1);
+      EXPECT_EQ(running[k], median(std::vector<double>(values.begin() + static_cast<std::ptrdiff_t>(a),
+                                                       values.begin() + static_cast<std::ptrdiff_t>(b))))
+          << "half width " << half << ", value " << k;
+    }
+  }
+  EXPECT_EQ(running_median(values, 8), std::vector<double>(values.size(), 0.0));
+  EXPECT_TRUE(running_median({}, 2).empty());
+}
+
 TEST(Statistics, MedianStandardErrorAndChiSquaredTail) {
   EXPECT_EQ(median({3.0, 1.0, 2.0}), 2.0);
   EXPECT_EQ(median({4.0, 1.0, 3.0, 2.0}), 3.0);
