@@ -243,8 +243,9 @@ Command add_diagnose_command(CLI::App& app) {
              "A recording whose image scale is off (a drop's free flights fall off g by more than 0.1 %; a "
              "ball's centre rolls more than 0.3 % off its radius above the incline): measured (read through "
              "the scale its tracks give: x, z and length summaries divided by it; 'flights' is its older "
-             "name), as-recorded, or auto (measured for a one-sphere clump, whose tracked point is its "
-             "centre; as recorded for any other body, whose tracked point bends its flights as it tumbles); "
+             "name), as-recorded, or auto (measured for a ball: one sphere within 1 % of its scan, whose "
+             "tracked point is its centre; as recorded for any other body, whose tracked point bends its "
+             "flights as it tumbles); "
              "measured either way (report.json image_scale)");
   add_choice(*sub, "--drop-drift", args->drop_drift, {"track-end", "after-impact"},
              "Where a drop's drift is read beyond the release horizon, recorded and replayed alike: track-end "

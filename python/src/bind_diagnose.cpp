@@ -405,8 +405,8 @@ void bind_diagnose(py::module_& m) {
         "resolution raised while replayed tracks change; refitted before a mismatch is blamed on missing physics), "
         "roll_release how the lab set the particle on a roll's incline (on-edge: a flattened particle on its rim; "
         "any), image_scale how a recording whose image scale is off is read (auto: through the scale its tracks give "
-        "for a one-sphere clump, as recorded for any other body; measured: through it always; flights: measured's "
-        "older name; as-recorded).");
+        "for a ball (one sphere within 1 % of its scan), as recorded for any other body; measured: through it "
+        "always; flights: measured's older name; as-recorded).");
   m.def(
       "measure_image_scale",
       [](const Clump& clump, const py::dict& recordings) {
@@ -422,7 +422,7 @@ void bind_diagnose(py::module_& m) {
       },
       py::arg("clump"), py::arg("recordings"),
       "Each recording's image scale as `clumpforge diagnose` reads it, without the diagnosis: [RecordingScale] "
-      "(a drop's free flights; a ball's rolls, for a one-sphere clump). recordings is {name: Recording}.");
+      "(a drop's free flights; a ball's rolls, for a ball). recordings is {name: Recording}.");
 }
 
 }  // namespace clumpforge::python

@@ -61,7 +61,7 @@ std::string scale_evidence(const std::string& name, const ScaleReading& g) {
 }
 
 /// What a diagnosis notes of the recordings whose image scale is off, and how it read them (under
-/// `mode`). Read as recorded, only for a one-sphere clump (`round`): a tracked point off the centre of
+/// `mode`). Read as recorded, only for a ball (`round`, is_ball): a tracked point off the centre of
 /// mass circles it as a body turns and bends a flight too, and a tumbling tuber's
 /// silhouette-tracked flights fell off g by up to 0.5 % at the true scale; said of such a body,
 /// the note would blame a camera that is right.
@@ -100,9 +100,9 @@ std::optional<Result<DiagnoseResult>> image_scale_stage(const Clump& clump, cons
                                                         const DiagnoseOptions& options, const RunContext& run,
                                                         DiagnoseResult& result) {
   const std::vector<ScaleReading> readings = measure_image_scale(clump, recordings);
-  result.image_scale = recording_scales(readings, names, reads_through(options.image_scale, clump.spheres.size()));
+  result.image_scale = recording_scales(readings, names, reads_through(options.image_scale, is_ball(clump)));
   result.image_scale_mode = options.image_scale;
-  const bool round = clump.spheres.size() == 1;
+  const bool round = is_ball(clump);
   if (std::none_of(result.image_scale.begin(), result.image_scale.end(),
                    [](const RecordingScale& s) { return s.applied; })) {
     for (auto& note : image_scale_notes(result.image_scale, recordings, round, options.image_scale))

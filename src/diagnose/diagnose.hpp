@@ -89,7 +89,7 @@ struct DiagnoseOptions {
   bool reuse_replays = true;
   /// A recording whose image scale is off by more than its tolerance (measure_image_scale: a
   /// drop's free flights fall off g, a ball's centre rolls off its radius above the incline):
-  /// read through the scale its tracks give (each length divided by it) for a one-sphere clump
+  /// read through the scale its tracks give (each length divided by it) for a ball (is_ball)
   /// and as recorded for any other body (Auto, the default: a tumbling body's tracked point bends
   /// its flights too), through it always (Measured), or as recorded always. Measured either way
   /// (DiagnoseResult::image_scale).

@@ -34,7 +34,7 @@ std::vector<double> frame_scales(const Track& track, double incline_deg, double 
   return out;
 }
 
-/// The mean of `values` within `band` of their median.
+/// The mean of `values` within `band` of `centre`, and how many those are.
 std::pair<double, int> clipped_mean(const std::vector<double>& values, double centre, double band) {
   double sum = 0.0;
   int n = 0;
@@ -112,8 +112,12 @@ std::string_view to_string(ImageScale mode) {
   return "as-recorded";
 }
 
-bool reads_through(ImageScale mode, std::size_t spheres) {
-  return mode == ImageScale::Measured || (mode == ImageScale::Auto && spheres == 1);
+bool is_ball(const Clump& clump) {
+  return clump.spheres.size() == 1 && clump.error.surface_rms <= kBallSurface * clump.spheres.front().radius;
+}
+
+bool reads_through(ImageScale mode, bool ball) {
+  return mode == ImageScale::Measured || (mode == ImageScale::Auto && ball);
 }
 
 std::vector<ScaleReading> rolling_heights(const std::vector<Recording>& recordings, double radius) {
@@ -127,7 +131,7 @@ std::vector<ScaleReading> rolling_heights(const std::vector<Recording>& recordin
 
 std::vector<ScaleReading> measure_image_scale(const Clump& clump, const std::vector<Recording>& recordings) {
   std::vector<ScaleReading> out = recorded_gravity(recordings, body_reach(clump.spheres));
-  if (clump.spheres.size() == 1) {
+  if (is_ball(clump)) {
     for (const ScaleReading& reading : rolling_heights(recordings, clump.spheres.front().radius))
       out.push_back(reading);
   }

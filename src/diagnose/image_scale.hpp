@@ -7,7 +7,7 @@
 /// changes give the scale:
 /// - a drop's free flights after its first contact fall at g (FreeFlights), and
 /// - a ball rolling down an incline keeps its centre one radius above the slope (RollingHeight;
-///   a one-sphere clump only: a tumbling body's centre rises and falls as it turns).
+///   a ball only, is_ball: a tumbling body's centre rises and falls as it turns).
 #include <cstddef>
 #include <optional>
 #include <string_view>
@@ -56,10 +56,10 @@ inline constexpr double kScaleTolerance = 1e-3;
 inline constexpr double kRollingScaleTolerance = 3e-3;
 /// How a diagnosis reads a recording whose image scale is off (ScaleReading::off): through the
 /// scale its tracks give (each length divided by it), or as recorded. Auto reads it through its
-/// scale for a one-sphere clump, whose tracked point is its centre, and as recorded for any other
+/// scale for a ball (is_ball), whose tracked point is its centre, and as recorded for any other
 /// body, whose tracked point circles its centre of mass as it tumbles and bends its flights too
 /// (measured on the stored sets: docs/diagnose.md, "The image scale").
-enum class ImageScale { Auto, Measured, AsRecorded };
+enum class ImageScale { Auto, Measured, AsRecorded };  // Auto: Measured for a ball (is_ball)
 /// "auto", "measured" (or "flights", its name before rolls were measured too), "as-recorded".
 std::optional<ImageScale> parse_image_scale(std::string_view text);
 std::string_view to_string(ImageScale mode);
@@ -76,11 +76,18 @@ std::vector<ScaleReading> rolling_heights(const std::vector<Recording>& recordin
 
 /// Every recording's image scale its tracks give: the drops' flights for any body
 /// (recorded_gravity: a body tracked away from its centre of mass bends them too), the rolls'
-/// heights for a one-sphere clump.
+/// heights for a ball (is_ball).
 std::vector<ScaleReading> measure_image_scale(const Clump& clump, const std::vector<Recording>& recordings);
 
-/// Whether `mode` reads a recording whose scale is off through it, for a clump of `spheres`.
-bool reads_through(ImageScale mode, std::size_t spheres);
+/// A ball: one sphere whose surface lies within kBallSurface of its radius, RMS, from its body's
+/// (ClumpError::surface_rms; 0.02 % for the lab-like ball's scan). Its tracked point is its
+/// centre, and its centre rides one radius above what it rolls on. A one-sphere clump of a
+/// tumbling body (`diagnose --spheres 1` on a tuber) is not one.
+bool is_ball(const Clump& clump);
+inline constexpr double kBallSurface = 0.01;
+
+/// Whether `mode` reads a recording whose scale is off through it, for a clump that is a ball or not.
+bool reads_through(ImageScale mode, bool ball);
 
 /// `recordings` with each one whose reading is off read through its scale: its tracks' x and z
 /// and its length summaries (rebound heights, roll distances) divided by it.

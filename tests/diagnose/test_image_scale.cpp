@@ -90,6 +90,17 @@ TEST(RollingHeights, ATumblingBodysRollsAndATiltShowNoScale) {
   EXPECT_EQ(round[1].source, ScaleSource::FreeFlights);
 }
 
+TEST(RollingHeights, AOneSphereClumpOfATumblingBodyIsNoBall) {
+  // `diagnose --spheres 1` on a tuber gives one sphere whose surface lies millimetres from the
+  // scan's: its rolls give no scale, and auto reads nothing through one.
+  Clump forced = lab_like_ball();
+  forced.error.surface_rms = 2e-3;
+  EXPECT_FALSE(is_ball(forced));
+  EXPECT_TRUE(is_ball(lab_like_ball()));
+  const auto readings = measure_image_scale(forced, lab_like("case-02", kRolls, 1.01));
+  EXPECT_TRUE(readings.empty());
+}
+
 TEST(RollingHeights, ScaledRecordingsAreReadThroughTheirScale) {
   // rescaled divides the lengths of the recordings that are off, and only those.
   const Clump ball = lab_like_ball();
@@ -122,10 +133,10 @@ TEST(ImageScaleOption, ItsNamesAreRead) {
   EXPECT_EQ(to_string(ImageScale::Measured), "measured");
   EXPECT_EQ(to_string(ImageScale::Auto), "auto");
   // Auto reads through the scale for a one-sphere clump only.
-  EXPECT_TRUE(reads_through(ImageScale::Auto, 1));
-  EXPECT_FALSE(reads_through(ImageScale::Auto, 64));
-  EXPECT_TRUE(reads_through(ImageScale::Measured, 64));
-  EXPECT_FALSE(reads_through(ImageScale::AsRecorded, 1));
+  EXPECT_TRUE(reads_through(ImageScale::Auto, true));
+  EXPECT_FALSE(reads_through(ImageScale::Auto, false));
+  EXPECT_TRUE(reads_through(ImageScale::Measured, false));
+  EXPECT_FALSE(reads_through(ImageScale::AsRecorded, true));
   EXPECT_EQ(to_string(ScaleSource::RollingHeight), "rolling_height");
 }
 
