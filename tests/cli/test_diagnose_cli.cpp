@@ -537,6 +537,22 @@ TEST(DiagnoseCli, DropsFilmedFromAfterTheReleaseWithLostFramesAreDiagnosed) {
   }
 }
 
+namespace {
+/// One recording whose image scale is off, diagnosed about `effect` with --image-scale
+/// as-recorded: its scale measured and off, not applied, and the note naming the option.
+void expect_noted_as_recorded(const std::filesystem::path& recording, const std::string& effect) {
+  const auto run = test::run_clumpforge(fmt::format(
+      "diagnose --recordings '{}' --effects {} --image-scale as-recorded --json", recording.string(), effect));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto k = nlohmann::json::parse(run.out);
+  EXPECT_EQ(k["image_scale"]["mode"], "as-recorded");
+  ASSERT_EQ(k["image_scale"]["recordings"].size(), 1u);
+  EXPECT_TRUE(k["image_scale"]["recordings"][0]["off"].get<bool>());
+  EXPECT_FALSE(k["image_scale"]["recordings"][0]["applied"].get<bool>());
+  EXPECT_NE(k["notes"].dump().find("--image-scale measured reads it through it"), std::string::npos) << k["notes"];
+}
+}  // namespace
+
 TEST(DiagnoseCli, DropsFilmedThroughAnImageScaleOffAreReadThroughTheScaleTheirFlightsGive) {
   // The control of DropsFilmedFromAfterTheRelease... filmed by a camera whose image scale is 1 %
   // off (calibrated off the particle's plane): every length 1.01 times too long, g too. As
@@ -564,16 +580,7 @@ TEST(DiagnoseCli, DropsFilmedThroughAnImageScaleOffAreReadThroughTheScaleTheirFl
       << notes;
   EXPECT_NE(notes.find("Read through the scale 1.01"), std::string::npos) << notes;
   // Read as recorded when asked, and said (a sphere: its tracked point is its centre).
-  const auto as_recorded =
-      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --effects air_drag --image-scale as-recorded --json",
-                                       (dir / "case-02" / "drop-Q235-0.2").string()));
-  ASSERT_EQ(as_recorded.exit_code, 0) << as_recorded.err;
-  const auto k = nlohmann::json::parse(as_recorded.out);
-  EXPECT_EQ(k["image_scale"]["mode"], "as-recorded");
-  ASSERT_EQ(k["image_scale"]["recordings"].size(), 1u);
-  EXPECT_TRUE(k["image_scale"]["recordings"][0]["off"].get<bool>());
-  EXPECT_FALSE(k["image_scale"]["recordings"][0]["applied"].get<bool>());
-  EXPECT_NE(k["notes"].dump().find("--image-scale measured reads it through it"), std::string::npos) << k["notes"];
+  expect_noted_as_recorded(dir / "case-02" / "drop-Q235-0.2", "air_drag");
 }
 
 namespace {
@@ -631,15 +638,7 @@ TEST(DiagnoseCli, RollsFilmedThroughAnImageScaleOffAreReadThroughTheScaleTheBall
   EXPECT_NE(notes.find("roll-Q235-70mm: the ball's centre rolls 9.4"), std::string::npos) << notes;
   EXPECT_NE(notes.find("Read through the scale 1.01"), std::string::npos) << notes;
   // Read as recorded when asked, and said.
-  const auto as_recorded =
-      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --effects adhesion --image-scale as-recorded --json",
-                                       (dir / "case-02" / "roll-Q235-35mm").string()));
-  ASSERT_EQ(as_recorded.exit_code, 0) << as_recorded.err;
-  const auto k = nlohmann::json::parse(as_recorded.out);
-  ASSERT_EQ(k["image_scale"]["recordings"].size(), 1u);
-  EXPECT_TRUE(k["image_scale"]["recordings"][0]["off"].get<bool>());
-  EXPECT_FALSE(k["image_scale"]["recordings"][0]["applied"].get<bool>());
-  EXPECT_NE(k["notes"].dump().find("--image-scale measured reads it through it"), std::string::npos) << k["notes"];
+  expect_noted_as_recorded(dir / "case-02" / "roll-Q235-35mm", "adhesion");
 }
 
 TEST(DiagnoseCli, ASphereWhoseTrialsPartIsNotBlamedOnItsUnknownRelease) {
