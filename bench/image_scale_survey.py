@@ -29,19 +29,11 @@ import pathlib
 import sys
 import tempfile
 
+from built_module import library  # the clumpforge module, PYTHONPATH or the build tree
+
 
 class Refusal(Exception):
     """Bad input: the message names the file and what is wrong."""
-
-
-def library():
-    """The clumpforge Python module (PYTHONPATH, else the build tree's build/python)."""
-    try:
-        import clumpforge
-    except ImportError:
-        sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "build" / "python"))
-        import clumpforge
-    return clumpforge
 
 
 def recording_folders(root: pathlib.Path) -> dict:

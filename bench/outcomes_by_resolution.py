@@ -26,6 +26,8 @@ import subprocess
 import sys
 import tempfile
 
+from built_module import library  # the clumpforge module, PYTHONPATH or the build tree
+
 
 def track_rows(track: pathlib.Path) -> tuple:
     """A track's frames with finite coordinates: (t, x, z) lists."""
@@ -50,17 +52,6 @@ def rest_distance(x: list) -> float:
 
 
 G = 9.81
-
-
-def library():
-    """The clumpforge Python module (PYTHONPATH, else the build tree's build/python): the track
-    readings the diagnosis makes are its, not copied here."""
-    try:
-        import clumpforge
-    except ImportError:
-        sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "build" / "python"))
-        import clumpforge
-    return clumpforge
 
 
 def free_fall_fit(t: list, z: list) -> tuple:

@@ -309,17 +309,22 @@ void bind_result(py::module_& m) {
       .def_readonly("seconds", &DiagnoseResult::seconds);
 }
 
+/// {name: Recording} as the library takes it: the recordings and their names, in the dict's order.
+std::pair<std::vector<Recording>, std::vector<std::string>> recordings_of(const py::dict& recordings) {
+  std::pair<std::vector<Recording>, std::vector<std::string>> out;
+  for (const auto& [name, recording] : recordings) {
+    out.second.push_back(py::cast<std::string>(name));
+    out.first.push_back(py::cast<Recording>(recording));
+  }
+  return out;
+}
+
 DiagnoseResult run_diagnosis(const Clump& clump, const py::dict& recordings, const std::vector<std::string>& effects,
                              std::optional<MaterialTable> materials, double orientation_prior_deg,
                              double model_accuracy, int ensemble_replays, int max_evaluations, std::uint64_t seed,
                              const std::vector<Clump>& finer_clumps, const std::string& roll_release,
                              const std::string& image_scale, const py::object& progress) {
-  std::vector<Recording> list;
-  std::vector<std::string> names;
-  for (const auto& [name, recording] : recordings) {
-    names.push_back(py::cast<std::string>(name));
-    list.push_back(py::cast<Recording>(recording));
-  }
+  const auto [list, names] = recordings_of(recordings);
   if (list.empty()) raise({ErrorCode::InvalidArgument, "no recordings to diagnose"});
   const MaterialTable table = materials ? *materials : default_material_table();
   for (const auto& r : list) unwrap(table.find(r.surface));
@@ -410,15 +415,8 @@ void bind_diagnose(py::module_& m) {
   m.def(
       "measure_image_scale",
       [](const Clump& clump, const py::dict& recordings) {
-        std::vector<Recording> list;
-        std::vector<std::string> names;
-        for (const auto& [name, recording] : recordings) {
-          names.push_back(py::cast<std::string>(name));
-          list.push_back(py::cast<Recording>(recording));
-        }
-        std::vector<RecordingScale> out;
-        for (const ScaleReading& g : measure_image_scale(clump, list)) out.push_back({names[g.recording], g, false});
-        return out;
+        const auto [list, names] = recordings_of(recordings);
+        return recording_scales(measure_image_scale(clump, list), names, false);
       },
       py::arg("clump"), py::arg("recordings"),
       "Each recording's image scale as `clumpforge diagnose` reads it, without the diagnosis: [RecordingScale] "

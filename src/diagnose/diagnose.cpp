@@ -37,14 +37,6 @@ Result<std::pair<std::vector<TrialScore>, std::vector<TrialScore>>> whole_tracks
   return std::pair{std::move(*full_base), std::move(*full_improved)};
 }
 
-/// Each recording's image scale as its tracks give it, applied or not.
-std::vector<RecordingScale> recording_scales(const std::vector<ScaleReading>& readings,
-                                             const std::vector<std::string>& names, bool read_through) {
-  std::vector<RecordingScale> out;
-  for (const ScaleReading& g : readings) out.push_back({names[g.recording], g, g.off() && read_through});
-  return out;
-}
-
 /// What one reading off says it measured, and why that is the scale.
 std::string scale_evidence(const std::string& name, const ScaleReading& g) {
   if (g.source == ScaleSource::FreeFlights)
@@ -91,42 +83,54 @@ std::vector<std::string> image_scale_notes(const std::vector<RecordingScale>& sc
   return notes;
 }
 
-/// Measures each tracked recording's image scale (result.image_scale) and notes those off.
-/// Where the options read some through their scale, the diagnosis of the rescaled copy, with
-/// those notes first.
-std::optional<Result<DiagnoseResult>> image_scale_stage(const Clump& clump, const MaterialTable& table,
-                                                        const std::vector<Recording>& recordings,
-                                                        const std::vector<std::string>& names,
-                                                        const DiagnoseOptions& options, const RunContext& run,
-                                                        DiagnoseResult& result) {
-  const std::vector<ScaleReading> readings = measure_image_scale(clump, recordings);
-  result.image_scale = recording_scales(readings, names, reads_through(options.image_scale, is_ball(clump)));
-  result.image_scale_mode = options.image_scale;
-  const bool round = is_ball(clump);
-  if (std::none_of(result.image_scale.begin(), result.image_scale.end(),
-                   [](const RecordingScale& s) { return s.applied; })) {
-    for (auto& note : image_scale_notes(result.image_scale, recordings, round, options.image_scale))
-      result.notes.push_back(std::move(note));
-    return std::nullopt;
-  }
-  DiagnoseOptions as_rescaled = options;
-  as_rescaled.image_scale = ImageScale::AsRecorded;
-  auto rescaled_result = diagnose(clump, table, rescaled(recordings, readings), names, as_rescaled, run);
-  if (rescaled_result) {
-    rescaled_result->image_scale = std::move(result.image_scale);
-    rescaled_result->image_scale_mode = options.image_scale;
-    const auto notes = image_scale_notes(rescaled_result->image_scale, recordings, round, options.image_scale);
-    rescaled_result->notes.insert(rescaled_result->notes.begin(), notes.begin(), notes.end());
-  }
-  return rescaled_result;
-}
+/// The diagnosis of tracked recordings as they are read (the image scale decided): every stage
+/// after the image scale's, the clock started at `started`.
+Result<DiagnoseResult> diagnose_tracks(const Clump& clump, const MaterialTable& table,
+                                       const std::vector<Recording>& recordings, const std::vector<std::string>& names,
+                                       const DiagnoseOptions& options, const RunContext& run,
+                                       std::chrono::steady_clock::time_point started);
 }  // namespace
+
+std::vector<RecordingScale> recording_scales(const std::vector<ScaleReading>& readings,
+                                             const std::vector<std::string>& names, bool read_through) {
+  std::vector<RecordingScale> out;
+  for (const ScaleReading& g : readings) out.push_back({names[g.recording], g, g.off() && read_through});
+  return out;
+}
 
 Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
                                 const std::vector<Recording>& recordings, const std::vector<std::string>& names,
                                 const DiagnoseOptions& options, const RunContext& run) {
-  using namespace diagnosis;  // the stages (stages.hpp), run here in order
+  using namespace diagnosis;  // check_inputs
   const auto started = std::chrono::steady_clock::now();
+  if (auto ok = check_inputs(clump, recordings, names, options); !ok) return std::unexpected(ok.error());
+  bool any_track = false;
+  for (const auto& r : recordings) {
+    for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
+  }
+  if (!any_track) return diagnose_summaries(clump, table, recordings, names, options, run);
+  // The image scale, measured once: a drop's flights fall at g and a ball rolls one radius above
+  // the incline, in true metres. The recordings read through their scale are diagnosed as so read.
+  const std::vector<ScaleReading> readings = measure_image_scale(clump, recordings);
+  const bool ball = is_ball(clump);
+  std::vector<RecordingScale> scales = recording_scales(readings, names, reads_through(options.image_scale, ball));
+  const bool applied = std::any_of(scales.begin(), scales.end(), [](const RecordingScale& s) { return s.applied; });
+  auto result = diagnose_tracks(clump, table, applied ? rescaled(recordings, readings) : recordings, names, options,
+                                run, started);
+  if (!result) return result;
+  const auto notes = image_scale_notes(scales, recordings, ball, options.image_scale);
+  result->notes.insert(result->notes.begin(), notes.begin(), notes.end());
+  result->image_scale = std::move(scales);
+  result->image_scale_mode = options.image_scale;
+  return result;
+}
+
+namespace {
+Result<DiagnoseResult> diagnose_tracks(const Clump& clump, const MaterialTable& table,
+                                       const std::vector<Recording>& recordings, const std::vector<std::string>& names,
+                                       const DiagnoseOptions& options, const RunContext& run,
+                                       std::chrono::steady_clock::time_point started) {
+  using namespace diagnosis;  // the stages (stages.hpp), run here in order
   auto lap = started;
   DiagnoseResult result;
   // Closes a stage: the time since the last one closed.
@@ -135,18 +139,6 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
     result.stage_seconds.push_back({stage, std::chrono::duration<double>(now - lap).count()});
     lap = now;
   };
-  if (auto ok = check_inputs(clump, recordings, names, options); !ok) return std::unexpected(ok.error());
-  bool any_track = false;
-  for (const auto& r : recordings) {
-    for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
-  }
-  if (!any_track) return diagnose_summaries(clump, table, recordings, names, options, run);
-  // The image scale: a drop recording's flights fall at g in true metres. Those read through
-  // their scale: the whole diagnosis on the rescaled copy.
-  if (auto rescaled_result = image_scale_stage(clump, table, recordings, names, options, run, result)) {
-    if (*rescaled_result) (*rescaled_result)->seconds = seconds_since(started);
-    return std::move(*rescaled_result);
-  }
 
   Context c;
   if (options.reuse_replays) c.ev.memo = &c.memo;
@@ -272,5 +264,6 @@ Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
   run.report("done", 1.0);
   return result;
 }
+}  // namespace
 
 }  // namespace clumpforge

@@ -484,6 +484,11 @@ Decision decide(const std::vector<HypothesisReport>& hypotheses, double min_delt
 /// undecidable.
 std::string verdict_name(const DiagnoseResult& result);
 
+/// Each reading as a RecordingScale under its recording's name (`names` parallel to the
+/// recordings), applied when it is off and `read_through` (reads_through).
+std::vector<RecordingScale> recording_scales(const std::vector<ScaleReading>& readings,
+                                             const std::vector<std::string>& names, bool read_through);
+
 /// Diagnoses `recordings` (names parallel to them) for `clump`. Recordings without tracks
 /// give the summaries-only statement (see diagnose_summaries).
 Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,

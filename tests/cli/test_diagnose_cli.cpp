@@ -102,13 +102,17 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
   EXPECT_NE(run.exit_code, 0);
   EXPECT_NE(run.err.find("must lie in [0, 10] mm, not 20 mm"), std::string::npos) << run.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "accuracy"));
-  // A release posture the tool does not know: refused by name, nothing written.
-  run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --roll-release flat --output '{}'",
-                                         (dir / "rec").string(), clump(), (dir / "posture").string()));
-  EXPECT_NE(run.exit_code, 0);
-  EXPECT_NE(run.err.find("--roll-release"), std::string::npos) << run.err;
-  EXPECT_NE(run.err.find("flat"), std::string::npos) << run.err;
-  EXPECT_FALSE(std::filesystem::exists(dir / "posture"));
+  // A release posture, or a way of reading the image scale, the tool does not know: refused by
+  // name, nothing written.
+  for (const auto& [option, value] : {std::pair{"--roll-release", "flat"}, std::pair{"--image-scale", "pixels"}}) {
+    const auto out = dir / fmt::format("refused{}", option);
+    run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' {} {} --output '{}'",
+                                           (dir / "rec").string(), clump(), option, value, out.string()));
+    EXPECT_NE(run.exit_code, 0) << option;
+    EXPECT_NE(run.err.find(option), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find(value), std::string::npos) << run.err;
+    EXPECT_FALSE(std::filesystem::exists(out)) << option;
+  }
   // A wall-contact mass the DEM does not know: refused by name, nothing written.
   run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --wall-mass half --output '{}'",
                                          (dir / "rec").string(), clump(), (dir / "mass").string()));
