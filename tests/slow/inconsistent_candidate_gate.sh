@@ -8,7 +8,7 @@
 # Each finer clump's move is measured on 48 replays from the start, so no move is a gate.
 set -u
 source "$(dirname "$0")/generated_case.sh"
-diagnose_generated_case "$1" "$2" "$3" static_kinetic_friction realistic || exit 1
+diagnose_generated_case "$1" "$2" "$3" nine static_kinetic_friction realistic || exit 1
 python3 - "$dir/out/report.json" <<'PY' || exit 1
 import json, sys
 r = json.load(open(sys.argv[1]))
