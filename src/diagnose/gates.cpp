@@ -217,6 +217,18 @@ std::vector<GateFound> gates_at(const DiagnoseResult& result, double min_delta_b
   return found;
 }
 
+GatePlan gate_plan(const std::vector<GateFound>& gates) {
+  // An inconsistent candidate past the margin has no check of its own: calibrated again alone on
+  // 48 replays from where the first draw left it, the generated nine-set-up strong friction drop
+  // stayed inconsistent (tail 3.8e-10), and the whole comparison with 48 made it consistent and
+  // named it. So it is compared again whole, and the other gates need no check.
+  const auto unfitted = std::find_if(gates.begin(), gates.end(),
+                                     [](const GateFound& g) { return g.retry.gate == Gate::CandidateInconsistent; });
+  if (unfitted != gates.end()) return GatePlan{.retry = unfitted->retry, .whole = true};
+  if (gates.empty()) return GatePlan{};
+  return GatePlan{.retry = gates.front().retry, .whole = false};
+}
+
 Result<bool> gates_hold(Context& c, const DiagnoseResult& result, const Model& baseline,
                         const std::vector<TrialScore>& full_scores, const std::vector<GateFound>& gates,
                         const EnsembleOptions& eo, GateRetry& retry) {
@@ -274,19 +286,14 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
                                            ? gates_at(result, options.min_delta_bic)
                                            : std::vector<GateFound>{};
   if (!gates.empty()) {
-    // An inconsistent candidate past the margin has no check of its own: calibrated again alone on
-    // 48 replays from where the first draw left it, the generated nine-set-up strong friction drop
-    // stayed inconsistent (tail 3.8e-10), and the whole comparison with 48 made it consistent and
-    // named it. So it is compared again whole, and the other gates need no check.
-    const auto unfitted = std::find_if(gates.begin(), gates.end(),
-                                       [](const GateFound& g) { return g.retry.gate == Gate::CandidateInconsistent; });
-    GateRetry retry = unfitted != gates.end() ? unfitted->retry : gates.front().retry;
+    const GatePlan plan = gate_plan(gates);
+    GateRetry retry = plan.retry;
     retry.replays_first = options.ensemble_replays;
     retry.replays_second = options.ensemble_replays_at_gate;
     retry.replayed_first = result.ensemble ? result.ensemble->replays : 0;
     retry.seconds_first = seconds_since(started);
     const auto second = std::chrono::steady_clock::now();
-    if (unfitted == gates.end()) {
+    if (!plan.whole) {
       const EnsembleOptions more_eo = ensemble_options(c, options, options.ensemble_replays_at_gate);
       auto held = gates_hold(c, result, baseline, full_scores, gates, more_eo, retry);
       if (!held) return std::unexpected(held.error());
@@ -305,7 +312,7 @@ Result<void> ensemble_stage(Context& c, DiagnoseResult& result, const Model& bas
       more.ensemble_replays = options.ensemble_replays_at_gate;
       if (auto ok = judge_ensembles(c, result, baseline, full_scores, effects, more); !ok) return ok;
       const std::string why =
-          unfitted != gates.end()
+          plan.whole
               ? fmt::format("a candidate is calibrated on {} only in a whole comparison", retry.replays_second)
               : fmt::format("judged again with {} from the first draw's coefficients a gate decided otherwise ({})",
                             retry.replays_second, checks_said(retry.checks));

@@ -457,6 +457,16 @@ Result<RungModel> rung_model(const Context& c, const Model& baseline, const std:
 /// over the null, then its closest rival's gap below it), an inconsistent candidate past the margin. (A finer clump's
 /// move is no gate: it is measured with EnsembleOptions::move_replays, the replays a check would take.)
 std::vector<GateFound> gates_at(const DiagnoseResult& result, double min_delta_bic);
+/// How a comparison that decided at `gates` (gates_at, not empty) is taken again: the retry it
+/// reports (the inconsistent candidate's gate when there is one, else the first found), and
+/// whether it is made again whole at once (an inconsistent candidate past the margin: its gate
+/// has no check, and the other gates need none) or each gate's decision judged first
+/// (gates_hold).
+struct GatePlan {
+  GateRetry retry;
+  bool whole = false;
+};
+GatePlan gate_plan(const std::vector<GateFound>& gates);
 /// Each gate's decision judged again on `eo.replays` replays per recording from release
 /// orientations drawn afresh, at the first draw's calibrated coefficients: the null's
 /// consistency, the candidate's delta-BIC over the null (or its gap to the rival). Appends a

@@ -1399,6 +1399,18 @@ TEST(EnsembleGate, EveryGateIsFoundWithWhatDecidedThere) {
   EXPECT_EQ(gates[2].retry.gate, Gate::CandidateInconsistent);
   EXPECT_EQ(gates[2].best, Effect::ComOffset);
   EXPECT_LT(gates[2].retry.value, gates[2].retry.threshold);  // its means at 72 over 17 degrees of freedom
+
+  // With the inconsistent candidate among them the comparison is made again whole at once, its
+  // gate the one reported, whatever gate was found first; without it each gate is judged first,
+  // the first found reported.
+  const diagnosis::GatePlan whole = diagnosis::gate_plan(gates);
+  EXPECT_TRUE(whole.whole);
+  EXPECT_EQ(whole.retry.gate, Gate::CandidateInconsistent);
+  EXPECT_EQ(whole.retry.value, gates[2].retry.value);
+  const diagnosis::GatePlan judged = diagnosis::gate_plan({gates[1], gates[0]});
+  EXPECT_FALSE(judged.whole);
+  EXPECT_EQ(judged.retry.gate, Gate::CandidateMargin);
+  EXPECT_EQ(judged.retry.value, gates[1].retry.value);
 }
 
 // A best candidate at its own gate does not hide its rival's: lab-like case-08 at seed 2, the
