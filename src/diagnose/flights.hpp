@@ -20,8 +20,7 @@
 
 #include "core/clump.hpp"
 #include "core/recording.hpp"
-#include "dem/world.hpp"             // kStandardGravity
-#include "diagnose/image_scale.hpp"  // ScaleReading
+#include "dem/world.hpp"  // kStandardGravity
 
 namespace clumpforge {
 
@@ -45,17 +44,6 @@ struct FreeFlight {
 /// dips to the clearance or loses more than three frames running; flights of fewer than
 /// `min_frames` frames are dropped. `noise` [m] per coordinate is subtracted from each.
 std::vector<FreeFlight> free_flights(const Track& track, double clearance, double noise, int min_frames);
-
-/// Each drop recording's image scale from its flights' fall acceleration (ScaleReading, source
-/// FreeFlights; recordings with 6 or more flights on which the tracked point keeps to its
-/// parabola within half the camera noise), read on its own tracks (their camera noise estimated
-/// from them), for a body whose reach from its tracked point is `reach` [m]. Between bounces a
-/// body flies on a parabola whose curvature is g, whatever it does on the plate, so in the
-/// track's metres it is g times the image scale. Air drag bends a flight too, but a rebound
-/// flight rises and falls: drag adds to g on the way up and takes from it on the way down, and
-/// its best parabola keeps g to first order (the first fall, drag's whole imprint, is not among
-/// these flights).
-std::vector<ScaleReading> recorded_gravity(const std::vector<Recording>& recordings, double reach);
 
 /// [m] How far a side camera's silhouette centroid wanders about the body's own centroid as
 /// the body turns: the RMS per coordinate (x and z pooled) of the silhouette centroid about its
@@ -83,6 +71,12 @@ struct FlightWobbleOptions {
   int resamples = 400;  ///< bootstrap over flights, for the offset's interval
   std::uint64_t seed = 1;
 };
+
+/// The free flights of every tracked drop recording with a camera noise (`noise` per recording,
+/// NaN: none), each marked with its recording and trial: the body's reach (options.reach_m), a
+/// margin and three noise levels clear of the plate.
+std::vector<FreeFlight> drop_flights(const std::vector<Recording>& recordings, const std::vector<double>& noise,
+                                     const FlightWobbleOptions& options);
 
 /// What the free flights say about the tracked point.
 struct FlightWobble {

@@ -5,13 +5,50 @@
 #include <limits>
 #include <numbers>
 
-#include "diagnose/flights.hpp"  // recorded_gravity
+#include "dem/world.hpp"         // kStandardGravity
+#include "diagnose/flights.hpp"  // drop_flights, body_reach
 #include "diagnose/tracks.hpp"   // estimate_noise
 #include "numerics/statistics.hpp"
 
 namespace clumpforge {
 
 namespace {
+
+/// Each drop recording's flights' fall acceleration (a ScaleReading): their mean weighed by the
+/// precision of a parabola's curvature (frames times duration^4), and its standard error from
+/// their weighed scatter. Only flights on which the tracked point keeps to its parabola within
+/// half the camera noise count: a point off the centre of mass circles it as the body turns,
+/// and at a spin w it accelerates by w^2 d besides g (1 mm at 100 rad/s: 10 m/s^2), which a
+/// flight of less than a few turns does not average out (a generated tuber's silhouette
+/// centroid, 0.1 mm from its centre of mass, gave a flight of 9.70 m/s^2). Recordings with
+/// fewer than kGravityFlights such flights are left out.
+constexpr std::size_t kGravityFlights = 6;
+
+std::vector<ScaleReading> flight_gravity(const std::vector<FreeFlight>& flights, const std::vector<double>& noise) {
+  std::vector<ScaleReading> out;
+  for (std::size_t r = 0; r < noise.size(); ++r) {
+    std::vector<double> g, w;
+    for (const FreeFlight& f : flights) {
+      if (f.recording != r || !(f.excess_variance < 0.25 * noise[r] * noise[r])) continue;
+      g.push_back(f.fall_acceleration);
+      w.push_back(f.frames * std::pow(f.end - f.start, 4));
+    }
+    if (g.size() < kGravityFlights) continue;
+    double sum_w = 0.0, mean = 0.0;
+    for (std::size_t k = 0; k < g.size(); ++k) sum_w += w[k], mean += w[k] * g[k];
+    mean /= sum_w;
+    double scatter = 0.0;
+    for (std::size_t k = 0; k < g.size(); ++k) scatter += w[k] * std::pow(g[k] - mean, 2);
+    const double k = static_cast<double>(g.size());
+    out.push_back({.recording = r,
+                   .source = ScaleSource::FreeFlights,
+                   .samples = static_cast<int>(g.size()),
+                   .measured = mean,
+                   .expected = kStandardGravity,
+                   .standard_error = std::sqrt(scatter / sum_w / (k - 1.0))});
+  }
+  return out;
+}
 
 constexpr int kMinRollTrials = 3;
 constexpr int kMinRollFrames = 100;
@@ -127,6 +164,21 @@ std::vector<ScaleReading> rolling_heights(const std::vector<Recording>& recordin
     if (auto reading = rolling_height(recordings[r], r, radius)) out.push_back(*reading);
   }
   return out;
+}
+
+std::vector<ScaleReading> recorded_gravity(const std::vector<Recording>& recordings, double reach) {
+  std::vector<double> noise(recordings.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    if (recordings[r].test != LabTest::Drop) continue;
+    std::vector<const Track*> tracks;
+    for (const auto& t : recordings[r].trials) {
+      if (t.track) tracks.push_back(&*t.track);
+    }
+    if (!tracks.empty()) noise[r] = estimate_noise(tracks);
+  }
+  FlightWobbleOptions options;
+  options.reach_m = reach;
+  return flight_gravity(drop_flights(recordings, noise, options), noise);
 }
 
 std::vector<ScaleReading> measure_image_scale(const Clump& clump, const std::vector<Recording>& recordings) {

@@ -74,6 +74,17 @@ std::string_view to_string(ImageScale mode);
 /// held before its release not at all.
 std::vector<ScaleReading> rolling_heights(const std::vector<Recording>& recordings, double radius);
 
+/// Each drop recording's image scale from its flights' fall acceleration (ScaleReading, source
+/// FreeFlights; recordings with 6 or more flights on which the tracked point keeps to its
+/// parabola within half the camera noise), read on its own tracks (their camera noise estimated
+/// from them), for a body whose reach from its tracked point is `reach` [m]. Between bounces a
+/// body flies on a parabola whose curvature is g, whatever it does on the plate, so in the
+/// track's metres it is g times the image scale. Air drag bends a flight too, but a rebound
+/// flight rises and falls: drag adds to g on the way up and takes from it on the way down, and
+/// its best parabola keeps g to first order (the first fall, drag's whole imprint, is not among
+/// these flights).
+std::vector<ScaleReading> recorded_gravity(const std::vector<Recording>& recordings, double reach);
+
 /// Every recording's image scale its tracks give: the drops' flights for any body
 /// (recorded_gravity: a body tracked away from its centre of mass bends them too), the rolls'
 /// heights for a ball (is_ball).

@@ -15,6 +15,7 @@
 #include "diagnose/bodies.hpp"
 #include "diagnose/conceal.hpp"
 #include "diagnose/flights.hpp"
+#include "diagnose/image_scale.hpp"  // recorded_gravity
 #include "io/clump_library.hpp"
 #include "io/recording_io.hpp"
 #include "support/test_support.hpp"
