@@ -88,47 +88,6 @@ std::vector<std::string> image_scale_notes(const std::vector<RecordingScale>& sc
 Result<DiagnoseResult> diagnose_tracks(const Clump& clump, const MaterialTable& table,
                                        const std::vector<Recording>& recordings, const std::vector<std::string>& names,
                                        const DiagnoseOptions& options, const RunContext& run,
-                                       std::chrono::steady_clock::time_point started);
-}  // namespace
-
-std::vector<RecordingScale> recording_scales(const std::vector<ScaleReading>& readings,
-                                             const std::vector<std::string>& names, bool read_through) {
-  std::vector<RecordingScale> out;
-  for (const ScaleReading& g : readings) out.push_back({names[g.recording], g, g.off() && read_through});
-  return out;
-}
-
-Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
-                                const std::vector<Recording>& recordings, const std::vector<std::string>& names,
-                                const DiagnoseOptions& options, const RunContext& run) {
-  using namespace diagnosis;  // check_inputs
-  const auto started = std::chrono::steady_clock::now();
-  if (auto ok = check_inputs(clump, recordings, names, options); !ok) return std::unexpected(ok.error());
-  bool any_track = false;
-  for (const auto& r : recordings) {
-    for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
-  }
-  if (!any_track) return diagnose_summaries(clump, table, recordings, names, options, run);
-  // The image scale, measured once: a drop's flights fall at g and a ball rolls one radius above
-  // the incline, in true metres. The recordings read through their scale are diagnosed as so read.
-  const std::vector<ScaleReading> readings = measure_image_scale(clump, recordings);
-  const bool ball = is_ball(clump);
-  std::vector<RecordingScale> scales = recording_scales(readings, names, reads_through(options.image_scale, ball));
-  const bool applied = std::any_of(scales.begin(), scales.end(), [](const RecordingScale& s) { return s.applied; });
-  auto result = diagnose_tracks(clump, table, applied ? rescaled(recordings, readings) : recordings, names, options,
-                                run, started);
-  if (!result) return result;
-  const auto notes = image_scale_notes(scales, recordings, ball, options.image_scale);
-  result->notes.insert(result->notes.begin(), notes.begin(), notes.end());
-  result->image_scale = std::move(scales);
-  result->image_scale_mode = options.image_scale;
-  return result;
-}
-
-namespace {
-Result<DiagnoseResult> diagnose_tracks(const Clump& clump, const MaterialTable& table,
-                                       const std::vector<Recording>& recordings, const std::vector<std::string>& names,
-                                       const DiagnoseOptions& options, const RunContext& run,
                                        std::chrono::steady_clock::time_point started) {
   using namespace diagnosis;  // the stages (stages.hpp), run here in order
   auto lap = started;
@@ -265,5 +224,39 @@ Result<DiagnoseResult> diagnose_tracks(const Clump& clump, const MaterialTable& 
   return result;
 }
 }  // namespace
+
+std::vector<RecordingScale> recording_scales(const std::vector<ScaleReading>& readings,
+                                             const std::vector<std::string>& names, bool read_through) {
+  std::vector<RecordingScale> out;
+  for (const ScaleReading& g : readings) out.push_back({names[g.recording], g, g.off() && read_through});
+  return out;
+}
+
+Result<DiagnoseResult> diagnose(const Clump& clump, const MaterialTable& table,
+                                const std::vector<Recording>& recordings, const std::vector<std::string>& names,
+                                const DiagnoseOptions& options, const RunContext& run) {
+  using namespace diagnosis;  // check_inputs
+  const auto started = std::chrono::steady_clock::now();
+  if (auto ok = check_inputs(clump, recordings, names, options); !ok) return std::unexpected(ok.error());
+  bool any_track = false;
+  for (const auto& r : recordings) {
+    for (const auto& t : r.trials) any_track = any_track || (t.track && t.track->size() > 0);
+  }
+  if (!any_track) return diagnose_summaries(clump, table, recordings, names, options, run);
+  // The image scale, measured once: a drop's flights fall at g and a ball rolls one radius above
+  // the incline, in true metres. The recordings read through their scale are diagnosed as so read.
+  const std::vector<ScaleReading> readings = measure_image_scale(clump, recordings);
+  const bool ball = is_ball(clump);
+  std::vector<RecordingScale> scales = recording_scales(readings, names, reads_through(options.image_scale, ball));
+  const bool applied = std::any_of(scales.begin(), scales.end(), [](const RecordingScale& s) { return s.applied; });
+  auto result = diagnose_tracks(clump, table, applied ? rescaled(recordings, readings) : recordings, names, options,
+                                run, started);
+  if (!result) return result;
+  const auto notes = image_scale_notes(scales, recordings, ball, options.image_scale);
+  result->notes.insert(result->notes.begin(), notes.begin(), notes.end());
+  result->image_scale = std::move(scales);
+  result->image_scale_mode = options.image_scale;
+  return result;
+}
 
 }  // namespace clumpforge

@@ -12,7 +12,7 @@
 # its checks'.
 set -u
 source "$(dirname "$0")/generated_case.sh"
-diagnose_generated_case "$1" "$2" "$3" four epsd_rolling realistic || exit 1
+diagnose_generated_case "$1" "$2" "$3" epsd_rolling realistic || exit 1
 python3 - "$dir/out/report.json" <<'PY' || exit 1
 import json, sys
 r = json.load(open(sys.argv[1]))
