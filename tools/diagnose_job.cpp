@@ -434,6 +434,7 @@ nlohmann::json hypotheses_json(const std::vector<HypothesisReport>& hypotheses) 
                    {"fit_start", std::string(fit_start_name(h.fit_start))},
                    {"profile_searched", h.profile_searched},
                    {"smallest_detectable", finite_or_null(h.smallest_detectable)},
+                   {"detectable_at_any_magnitude", h.detectable_at_any_magnitude},
                    {"replay_shown", finite_or_null(h.replay_shown)},
                    {"strong_delta_chi2", finite_or_null(h.strong_delta_chi2)},
                    {"strong_resolution_chi2", finite_or_null(h.strong_resolution_chi2)},

@@ -105,6 +105,10 @@ void bind_parts(py::module_& m) {
           "with verdict none: the smallest magnitude of its first parameter these recordings would have "
           "revealed: a replay shows it and the recordings reject it (NaN where they do not decide the effect, and "
           "under any other verdict)")
+      .def_readonly("detectable_at_any_magnitude", &HypothesisReport::detectable_at_any_magnitude,
+                    "with smallest_detectable claimed: the law departs from the null's at any magnitude (a replay at "
+                    "a millionth of the strong one shows, and the recordings reject it); smallest_detectable is then "
+                    "only the smallest magnitude tried")
       .def_readonly("replay_shown", &HypothesisReport::replay_shown,
                     "with verdict none: the smallest magnitude a replay of the diagnosed clump showed (NaN: none)")
       .def_readonly("strong_delta_chi2", &HypothesisReport::strong_delta_chi2,

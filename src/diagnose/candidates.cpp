@@ -529,19 +529,6 @@ double largest_fraction(const EffectSpec& spec) {
   return t;
 }
 
-/// What a candidate's replays show against the baseline's: the squared norm of their move once
-/// the coefficients absorb what they can (noise units), and the largest misfit it would leave in
-/// a phase, already a fraction of a large misfit (largest_signal_misfit: 1 is large). The
-/// signal is scaled to its margin: `shown()` is the smaller ratio (1 or more: it shows).
-struct Shown {
-  double signal = 0.0, misfit = 0.0;
-  double needed = 1.0;
-  double shown() const { return std::min(signal / needed, misfit); }
-  /// The fraction of `t` at which both would reach their margins were the response linear in
-  /// the magnitude (both grow as its square).
-  double linear_scale() const { return std::max(std::sqrt(needed / signal), std::sqrt(1.0 / misfit)); }
-};
-
 /// The recordings' own answer to a probe (cells are residuals): its chi^2 minus the baseline's,
 /// each after the coefficients absorb what they can to first order (the first of rejected()'s
 /// checks).
@@ -551,67 +538,11 @@ double first_order_rejection(const ResidualProjection& keep, const Eigen::Vector
 }
 
 /// What a probe's cells show against the baseline's once the coefficients absorb what they can.
-Shown measure(const Context& c, const std::vector<std::pair<GroupKey, Axis>>& keys, const ResidualProjection& keep,
-              const Eigen::VectorXd& base_cells, const Eigen::VectorXd& probe_cells, double needed) {
+ReplaySignal measure(const Context& c, const std::vector<std::pair<GroupKey, Axis>>& keys,
+                     const ResidualProjection& keep, const Eigen::VectorXd& base_cells,
+                     const Eigen::VectorXd& probe_cells, double needed) {
   const Eigen::VectorXd kept = keep(base_cells - probe_cells);
-  return Shown{kept.squaredNorm(), largest_signal_misfit(c, keys, kept), needed};
-}
-
-/// How many replays check a candidate's first-order smallest detectable magnitude, and the
-/// ratio of magnitudes (that showed / that did not) at which the search stops.
-constexpr int kDetectableReplays = 3;
-constexpr double kBracketRatio = 1.15;
-
-/// The fractions of its strong magnitude a candidate's replays were tried at: the smallest that
-/// showed (both margins; NaN when none did) and the largest below it that did not.
-struct Bracket {
-  double shown = NAN, missed = 0.0;
-  double first_order = NAN;                    ///< the first guess (quadratic scaling from the strong magnitude)
-  std::vector<std::pair<double, bool>> tried;  ///< each fraction replayed, and whether it showed
-};
-
-/// The smallest fraction of its strong magnitude at which a replay of the candidate shows. The first-order figure (what
-/// shows at the strong magnitude, scaled quadratically) is only a first guess: a response that is not linear in the
-/// magnitude scales wrongly (lab-like case-21, a sphere: adhesion "would show" from a work of adhesion of 0.0096 J/m^2
-/// scaled down from its strong 0.4, where a pull-off of half the weight captures the last bounces; recorded with about
-/// 0.08, the coefficients absorbed it to the noise). Each guess is replayed and the next taken from that replay's
-/// scale, kept within the inner half (in log) of the bracket between the largest fraction that did not show and the
-/// smallest that did.
-Result<Bracket> smallest_shown_fraction(CellProbe& cells, const Model& baseline, const EffectSpec& spec,
-                                        const Eigen::VectorXd& base_cells, const ResidualProjection& keep,
-                                        const Shown& strong, const Context& c) {
-  const bool strong_shows = strong.shown() >= 1.0;
-  double shown = strong_shows ? 1.0 : NAN, missed = strong_shows ? 0.0 : 1.0;
-  const double top = largest_fraction(spec);
-  double t = strong.linear_scale();
-  Bracket out{.first_order = t};
-  if (strong_shows && !(t < 1.0)) return out;  // nothing below the strong magnitude to try
-  for (int k = 0; k < kDetectableReplays; ++k) {
-    if (std::isfinite(shown) && missed > 0.0) {
-      // Within the inner half of the bracket (in log), so that each replay narrows it.
-      const double lo = std::log(missed), hi = std::log(shown);
-      t = std::clamp(t, std::exp(0.75 * lo + 0.25 * hi), std::exp(0.25 * lo + 0.75 * hi));
-    } else if (std::isfinite(shown)) {
-      if (!(t < shown)) t = shown / 4.0;
-    } else if (!(t > missed)) {
-      t = 2.0 * missed;
-    }
-    t = std::min(t, top);
-    if (!(t > missed)) break;
-    auto probed = cells(effect_at(baseline, spec, t));
-    if (!probed) return std::unexpected(probed.error());
-    if (probed->values.size() != base_cells.size()) break;
-    const Shown at = measure(c, cells.keys, keep, base_cells, probed->values, strong.needed);
-    (at.shown() >= 1.0 ? shown : missed) = t;
-    out.tried.emplace_back(t, at.shown() >= 1.0);
-    if (std::isfinite(shown) && shown < kBracketRatio * missed) break;
-    t = at.signal > 0.0 && at.misfit > 0.0 ? t * at.linear_scale() : 2.0 * t;
-    // A replay that showed and a next guess within the bracket's ratio of it: close enough.
-    if (at.shown() >= 1.0 && t * kBracketRatio > shown && t < shown) break;
-  }
-  out.shown = shown;
-  out.missed = missed;
-  return out;
+  return ReplaySignal{kept.squaredNorm(), largest_signal_misfit(c, keys, kept), needed};
 }
 
 /// The smallest magnitude of a candidate's first parameter at which a replay showed (NaN: none
@@ -619,15 +550,16 @@ Result<Bracket> smallest_shown_fraction(CellProbe& cells, const Model& baseline,
 struct ReplayShown {
   double magnitude = NAN;
   std::string said;
-  double fraction = NAN;  ///< the magnitude as a fraction of the strong one
+  double fraction = NAN;       ///< the magnitude as a fraction of the strong one
+  bool any_magnitude = false;  ///< Bracket::any_magnitude: `magnitude` is only where it was tried
 };
 
 /// Where a candidate's replays show against the baseline's: for a log-scale parameter its strong
 /// magnitude only; otherwise the first-order figure refined by replays (smallest_shown_fraction),
 /// each replay noted.
 Result<ReplayShown> replay_shown(Context& c, CellProbe& cells, const Model& baseline, const EffectSpec& spec,
-                                 const Eigen::VectorXd& base_cells, const ResidualProjection& keep, const Shown& strong,
-                                 DiagnoseResult& result) {
+                                 const Eigen::VectorXd& base_cells, const ResidualProjection& keep,
+                                 const ReplaySignal& strong, DiagnoseResult& result) {
   const auto& first = spec.parameters[0];
   const bool shows = strong.shown() >= 1.0;
   if (first.log_scale)
@@ -637,7 +569,13 @@ Result<ReplayShown> replay_shown(Context& c, CellProbe& cells, const Model& base
                        shows ? 1.0 : NAN};
   Bracket tried{.shown = NAN, .missed = 0.0};
   if (strong.signal > 0.0 && strong.misfit > 0.0) {
-    auto bracket = smallest_shown_fraction(cells, baseline, spec, base_cells, keep, strong, c);
+    const FractionReplay replay = [&](double t) -> Result<std::optional<ReplaySignal>> {
+      auto probed = cells(effect_at(baseline, spec, t));
+      if (!probed) return std::unexpected(probed.error());
+      if (probed->values.size() != base_cells.size()) return std::nullopt;
+      return measure(c, cells.keys, keep, base_cells, probed->values, strong.needed);
+    };
+    auto bracket = smallest_shown_fraction(strong, largest_fraction(spec), replay);
     if (!bracket) return std::unexpected(bracket.error());
     tried = *bracket;
   }
@@ -650,6 +588,13 @@ Result<ReplayShown> replay_shown(Context& c, CellProbe& cells, const Model& base
                     return fmt::format("{:.3g} ({})", magnitude(r.first), r.second ? "shows" : "does not show");
                   }),
                   ", ")));
+  if (tried.any_magnitude)
+    return ReplayShown{
+        magnitude(tried.shown),
+        fmt::format("at any {} above {:.3g} (its law departs from the null's: a replay at {:.3g}, {:.0e} "
+                    "of its strong {:.3g}, shows)",
+                    first.name, magnitude(0.0), magnitude(tried.shown), tried.shown, first.strong),
+        tried.shown, true};
   if (std::isfinite(tried.shown))
     return ReplayShown{magnitude(tried.shown), fmt::format("{} {:.3g}", first.name, magnitude(tried.shown)),
                        tried.shown};
@@ -731,7 +676,9 @@ std::string why_undecided(const EffectSpec& spec, const ReplayShown& shown, cons
                           double needed) {
   const EffectParameter& first = spec.parameters[0];
   if (!std::isfinite(shown.magnitude)) return fmt::format("{} ({})", spec.name, shown.said);
-  const std::string replay = fmt::format("a replay shows {} {:.3g}", first.name, shown.magnitude);
+  const std::string replay =
+      shown.any_magnitude ? fmt::format("a replay shows it at any {} (at {:.3g} already)", first.name, shown.magnitude)
+                          : fmt::format("a replay shows {} {:.3g}", first.name, shown.magnitude);
   if (!shows)
     return fmt::format("{} ({}, but its strong {:.3g} does not reach both margins)", spec.name, replay, first.strong);
   // A share is reported only where the preference reached the margin, so strong_delta_chi2 < 0 here.
@@ -756,6 +703,61 @@ std::string why_undecided(const EffectSpec& spec, const ReplayShown& shown, cons
 }
 
 }  // namespace
+
+/// The first-order figure (what shows at the strong magnitude, scaled quadratically) is only a
+/// first guess: a response that is not linear in the magnitude scales wrongly (lab-like case-21,
+/// a sphere: adhesion "would show" from a work of adhesion of 0.0096 J/m^2 scaled down from its
+/// strong 0.4, where a pull-off of half the weight captures the last bounces; recorded with about
+/// 0.08, the coefficients absorbed it to the noise). Each guess is replayed and the next taken
+/// from that replay's scale. A response that does not vanish with the magnitude never settles:
+/// on lab-like's sphere rolls epsd_rolling showed at 1.82, 0.0446 and 0.000845 of a strong 30
+/// (case-02), because any compliance switches the null's constant torque (type A) to the spring
+/// (type C); the replay at kVanishingFraction says so.
+Result<Bracket> smallest_shown_fraction(const ReplaySignal& strong, double top, const FractionReplay& replay) {
+  const bool strong_shows = strong.shown() >= 1.0;
+  double shown = strong_shows ? 1.0 : NAN, missed = strong_shows ? 0.0 : 1.0;
+  double t = strong.linear_scale();
+  Bracket out{.first_order = t};
+  if (strong_shows && !(t < 1.0)) return out;  // nothing below the strong magnitude to try
+  bool settled = false;
+  for (int k = 0; k < kDetectableReplays && !settled; ++k) {
+    if (std::isfinite(shown) && missed > 0.0) {
+      // Within the inner half of the bracket (in log), so that each replay narrows it.
+      const double lo = std::log(missed), hi = std::log(shown);
+      t = std::clamp(t, std::exp(0.75 * lo + 0.25 * hi), std::exp(0.25 * lo + 0.75 * hi));
+    } else if (std::isfinite(shown)) {
+      if (!(t < shown)) t = shown / 4.0;
+    } else if (!(t > missed)) {
+      t = 2.0 * missed;
+    }
+    t = std::min(t, top);
+    auto at = t > missed ? replay(t) : Result<std::optional<ReplaySignal>>(std::nullopt);
+    if (!at) return std::unexpected(at.error());
+    settled = !*at;  // nothing more to try
+    if (settled) break;
+    const bool shows = (*at)->shown() >= 1.0;
+    (shows ? shown : missed) = t;
+    out.tried.emplace_back(t, shows);
+    const double next = (*at)->signal > 0.0 && (*at)->misfit > 0.0 ? t * (*at)->linear_scale() : 2.0 * t;
+    // A bracket narrow enough, or a replay that showed and a next guess within the bracket's
+    // ratio of it: close enough.
+    settled = (std::isfinite(shown) && shown < kBracketRatio * missed) ||
+              (shows && next * kBracketRatio > shown && next < shown);
+    t = next;
+  }
+  if (!settled && missed == 0.0 && !out.tried.empty() && shown > kVanishingFraction) {
+    auto at = replay(kVanishingFraction);
+    if (!at) return std::unexpected(at.error());
+    if (*at) {
+      out.any_magnitude = (*at)->shown() >= 1.0;
+      (out.any_magnitude ? shown : missed) = kVanishingFraction;
+      out.tried.emplace_back(kVanishingFraction, out.any_magnitude);
+    }
+  }
+  out.shown = shown;
+  out.missed = missed;
+  return out;
+}
 
 /// For a `none`: each candidate replayed at its strong magnitude. Its signal there (its
 /// replays minus the baseline's, the part the coefficients could absorb projected out),
@@ -810,8 +812,8 @@ Result<DetectionLimits> detection_limits(Context& c, DiagnoseResult& result, con
     const double needed =
         options.min_delta_bic + static_cast<double>(spec.parameters.size()) * std::log(std::max(1, report.values_used));
     // Named frame by frame only over a large misfit too: some phase's chi^2 per value at
-    // large_misfit_level, of which the noise gives one (Shown::misfit reaching 1).
-    Shown strong{.needed = needed};
+    // large_misfit_level, of which the noise gives one (ReplaySignal::misfit reaching 1).
+    ReplaySignal strong{.needed = needed};
     report.strong_delta_chi2 = NAN;
     if (probe_cells.size() == base_cells.size()) {
       strong = measure(c, cells.keys, keep, base_cells, probe_cells, needed);
@@ -834,6 +836,7 @@ Result<DetectionLimits> detection_limits(Context& c, DiagnoseResult& result, con
       if (!claimed) return std::unexpected(claimed.error());
       const bool as_shown = *claimed == shown->fraction;
       report.smallest_detectable = as_shown ? shown->magnitude : magnitude_at(spec, 0, *claimed);
+      report.detectable_at_any_magnitude = as_shown && shown->any_magnitude;
       out.limits.push_back(
           as_shown ? fmt::format("{} {}", spec.name, shown->said)
                    : fmt::format("{} {} {:.3g}", spec.name, spec.parameters[0].name, report.smallest_detectable));

@@ -230,6 +230,11 @@ struct HypothesisReport {
   /// The smallest tried that a replay showed (replay_shown or above) and the recordings reject by
   /// the same whole check as the strong magnitude (releases, refit, finer clump, recalibration).
   double smallest_detectable = NAN;
+  /// With smallest_detectable claimed: every replay showed down to a millionth of the strong
+  /// magnitude (kVanishingFraction), and the recordings reject that too. The law departs from
+  /// the null's at any magnitude (epsd_rolling: any compliance swaps the constant torque for the
+  /// spring), so smallest_detectable is only the smallest magnitude tried, not an edge.
+  bool detectable_at_any_magnitude = false;
   /// With verdict "none": the smallest magnitude of its first parameter at which a replay of the
   /// diagnosed clump showed against the baseline (the coefficients absorbing what they can to
   /// first order): that clump's response, not a claim about the recordings. NaN when none did.

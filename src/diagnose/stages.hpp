@@ -12,8 +12,10 @@
 /// - beyond_horizon.cpp: the free flights, and the outcomes over the unknown release compared
 ///   with replay ensembles;
 /// - verdict.cpp: the decision between the hypotheses and what the result says.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -467,6 +469,47 @@ struct GatePlan {
   bool whole = false;
 };
 GatePlan gate_plan(const std::vector<GateFound>& gates);
+/// What a candidate's replays show against the baseline's: the squared norm of their move once
+/// the coefficients absorb what they can (noise units), and the largest misfit it would leave in
+/// a phase, already a fraction of a large misfit (largest_signal_misfit: 1 is large). The
+/// signal is scaled to its margin: `shown()` is the smaller ratio (1 or more: it shows).
+struct ReplaySignal {
+  double signal = 0.0, misfit = 0.0;
+  double needed = 1.0;
+  double shown() const { return std::min(signal / needed, misfit); }
+  /// The fraction of `t` at which both would reach their margins were the response linear in
+  /// the magnitude (both grow as its square).
+  double linear_scale() const { return std::max(std::sqrt(needed / signal), std::sqrt(1.0 / misfit)); }
+};
+/// How many replays refine a candidate's first-order smallest detectable magnitude, and the
+/// ratio of magnitudes (that showed / that did not) at which the search stops.
+inline constexpr int kDetectableReplays = 3;
+inline constexpr double kBracketRatio = 1.15;
+/// The fraction of its strong magnitude replayed once more when every replay showed and the
+/// search did not settle: whether the candidate's response vanishes with its magnitude at all.
+inline constexpr double kVanishingFraction = 1e-6;
+/// The fractions of its strong magnitude a candidate's replays were tried at: the smallest that
+/// showed (both margins; NaN when none did) and the largest below it that did not.
+struct Bracket {
+  double shown = NAN, missed = 0.0;
+  double first_order = NAN;                    ///< the first guess (quadratic scaling from the strong magnitude)
+  std::vector<std::pair<double, bool>> tried;  ///< each fraction replayed, and whether it showed
+  /// A replay at kVanishingFraction showed too: the candidate's law departs from the null's at
+  /// any magnitude (epsd_rolling: type C at its stiffest spring is not the null's type A), so
+  /// there is no smallest magnitude to find, only the law.
+  bool any_magnitude = false;
+};
+/// A replay of a candidate at a fraction of its strong magnitude: what it shows, or nullopt
+/// where its cells do not compare with the baseline's.
+using FractionReplay = std::function<Result<std::optional<ReplaySignal>>(double)>;
+/// The smallest fraction of its strong magnitude at which a replay of the candidate shows, from
+/// the first-order guess (`strong` scaled quadratically) refined by up to kDetectableReplays
+/// replays, each next guess scaled from the last replay and kept within the inner half (in log)
+/// of the bracket; `top` is the largest fraction its ranges allow. Where every replay showed
+/// and the search did not settle, one more at kVanishingFraction says whether the response
+/// vanishes with the magnitude (Bracket::any_magnitude).
+Result<Bracket> smallest_shown_fraction(const ReplaySignal& strong, double top, const FractionReplay& replay);
+
 /// Each gate's decision judged again on `eo.replays` replays per recording from release
 /// orientations drawn afresh, at the first draw's calibrated coefficients: the null's
 /// consistency, the candidate's delta-BIC over the null (or its gap to the rival). Appends a

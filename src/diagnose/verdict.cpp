@@ -324,6 +324,7 @@ void withdraw_limits(DiagnoseResult& result) {
     if (!std::isfinite(h.smallest_detectable)) continue;
     withdrawn.push_back(fmt::format("{} {:.3g}", h.name, h.smallest_detectable));
     h.smallest_detectable = NAN;
+    h.detectable_at_any_magnitude = false;
   }
   if (!withdrawn.empty())
     result.notes.push_back(fmt::format(

@@ -6,7 +6,8 @@
 # 0.0133 J/m^2 with the coefficients absorbing it to first order, and until the commit after
 # f01998e that was the claimed limit. Refitted, the coefficients absorb more: the recordings fit
 # 0.0133 better than the null (by about 2,900), and 0.073 and 0.171 too. The claim must pass the
-# whole check its strong magnitude passes, so none at or below the concealed 0.08 may stand.
+# whole check its strong magnitude passes, so none at or below the concealed 0.08 may stand. And
+# a law that departs from the null's at any magnitude (epsd_rolling) is claimed as such.
 # Usage: sphere_adhesion_limit.sh SOURCE_DIR BUILD_DIR SPHERE_MESH
 set -u
 export SPHERE_MESH=$3
@@ -32,4 +33,13 @@ assert len(checked) == 1 and "not rejected" in checked[0], r["notes"]
 for h in r["hypotheses"]:
     if h["smallest_detectable"] is not None:
         assert h["replay_shown"] is not None and h["smallest_detectable"] >= h["replay_shown"] * (1 - 1e-9), h
+# A law that departs from the null's at any magnitude claims no edge: on these rolls any rolling
+# compliance swaps the constant torque for the spring (measured: 6.29, 0.673, 0.0417 and 3e-5 of a
+# strong 30 show, and the recordings reject 3e-5 by 1.7e7). Before, 0.0417 was claimed as an edge.
+# The other candidates' responses vanish with their magnitude, and they claim an edge.
+for h in r["hypotheses"]:
+    assert h["detectable_at_any_magnitude"] == (h["name"] == "epsd_rolling"), h
+epsd = next(h for h in r["hypotheses"] if h["name"] == "epsd_rolling")
+assert epsd["smallest_detectable"] is not None and epsd["smallest_detectable"] < 1e-4, epsd
+assert "epsd_rolling at any rolling_compliance" in r["statement"], r["statement"]
 PY
