@@ -92,7 +92,7 @@ Result<void> store_item(const fs::path& dir, const ItemResult& r, const BatchOpt
 
 std::optional<ItemResult> load_item(const fs::path& dir, const std::string& scan, const BatchOptions& options) {
   auto text = read_file_bytes(item_json(dir, scan));
-  if (!text) return std::nullopt;
+  if (!text || json_nesting_beyond(*text)) return std::nullopt;  // not one this run wrote: run the item again
   try {
     const json j = json::parse(*text);
     if (j.at("format") != kItemFormat || j.at("scan") != scan || j.at("options_sha256") != options_fingerprint(options))

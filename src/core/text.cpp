@@ -98,4 +98,30 @@ std::string csv_field(std::string_view text) {
   return out + "\"";
 }
 
+std::optional<std::size_t> json_nesting_beyond(std::string_view text, int max_depth) {
+  int depth = 0;
+  std::size_t line = 1;
+  bool in_string = false, escaped = false;
+  for (char c : text) {
+    if (c == '\n') ++line;
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) return line;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace clumpforge

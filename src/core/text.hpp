@@ -32,4 +32,13 @@ std::string csv_field(std::string_view text);
 std::optional<std::string> read_file_bytes(const std::filesystem::path& path,
                                            std::size_t limit = std::numeric_limits<std::size_t>::max());
 
+/// The deepest nesting of arrays and objects a JSON file clumpforge reads may have: a recording's
+/// manifest nests four deep. A parser holds deeper text, but copying or writing the value back
+/// recurses once per level, and 200,000 levels kept among a manifest's extra keys overflowed the
+/// stack (a crash, not a message).
+inline constexpr int kMaxJsonDepth = 64;
+/// The 1-based line where JSON `text` first nests deeper than `max_depth` arrays and objects
+/// (nullopt: it never does). Brackets inside strings, escaped quotes included, do not count.
+std::optional<std::size_t> json_nesting_beyond(std::string_view text, int max_depth = kMaxJsonDepth);
+
 }  // namespace clumpforge

@@ -4,7 +4,6 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -242,11 +241,13 @@ double rolling_lever_ratio(const Clump& clump, int samples, std::uint64_t seed) 
 
 namespace {
 Result<StoredCalibration> apply_calibration_json(const std::filesystem::path& path, MaterialTable base,
-                                                 const std::string& particle, std::ifstream& in) {
-  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+                                                 const std::string& particle, const std::string& text) {
   auto bad = [&](const std::string& what) {
     return fail(ErrorCode::ParseError, fmt::format("calibration '{}': {}", path.string(), what));
   };
+  if (const auto line = json_nesting_beyond(text))
+    return bad(fmt::format("line {}: nested deeper than {} arrays and objects", *line, kMaxJsonDepth));
+  const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return bad("not a JSON object");
   auto number_at = [](const nlohmann::json& v) -> std::optional<double> {
     const nlohmann::json& x = v.is_object() && v.contains("value") ? v["value"] : v;
@@ -294,10 +295,10 @@ Result<StoredCalibration> apply_calibration_json(const std::filesystem::path& pa
 
 Result<StoredCalibration> apply_calibration(const std::filesystem::path& path, MaterialTable base,
                                             const std::string& particle) {
-  std::ifstream in(path);
-  if (!in) return fail(ErrorCode::IoError, fmt::format("cannot read calibration '{}'", path.string()));
+  const auto text = read_file_bytes(path);
+  if (!text) return fail(ErrorCode::IoError, fmt::format("cannot read calibration '{}'", path.string()));
   try {
-    return apply_calibration_json(path, std::move(base), particle, in);
+    return apply_calibration_json(path, std::move(base), particle, *text);
   } catch (const nlohmann::json::exception& e) {  // a key of another type than calibrate writes
     return fail(ErrorCode::ParseError, fmt::format("calibration '{}': {}", path.string(), e.what()));
   }

@@ -13,6 +13,10 @@ Result<MaterialTable> read_materials(const std::filesystem::path& path, Material
   const auto text = read_file_bytes(path);
   if (!text)
     return fail(ErrorCode::NotFound, fmt::format("'{}': no such materials file, or not readable", path.string()));
+  if (const auto line = json_nesting_beyond(*text)) {
+    return fail(ErrorCode::ParseError,
+                fmt::format("'{}':{}: nested deeper than {} arrays and objects", path.string(), *line, kMaxJsonDepth));
+  }
   json file;
   try {
     file = json::parse(*text);

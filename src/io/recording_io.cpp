@@ -99,12 +99,44 @@ std::string_view column_unit(const std::string& column) {
   return "rad";
 }
 
+/// What a path that is not a regular file is, for a message.
+std::string_view file_kind(fs::file_type type) {
+  switch (type) {
+    case fs::file_type::directory:
+      return "a folder";
+    case fs::file_type::fifo:
+      return "a named pipe";
+    case fs::file_type::block:
+    case fs::file_type::character:
+      return "a device";
+    case fs::file_type::socket:
+      return "a socket";
+    default:
+      return "not a regular file";
+  }
+}
+
+/// Refused unless `path` is missing (its reader says so) or a regular file, links followed: a
+/// named pipe would hold the reader until something writes to it, a device may never end.
+Result<void> regular_or_missing(const fs::path& path, std::string_view what, const std::string& name) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found || status.type() == fs::file_type::regular) return {};
+  return fail(ErrorCode::InvalidArgument,
+              fmt::format("{} '{}' is {}, not a file", what, printable_text(name), file_kind(status.type())));
+}
+
 /// A file a recording names (`what`: "the track path", "the particle's mesh"), resolved inside
-/// the recording's folder: an absolute path, a `..` component or a link that leads out of the
-/// folder is refused, and nothing is opened.
+/// the recording's folder: an absolute path, a `..` component, a link that leads out of the
+/// folder, a name with a NUL (the name the system opened would end there) and anything but a
+/// regular file are refused, and nothing is opened.
 Result<fs::path> inside_folder(const fs::path& dir, const std::string& name, std::string_view what) {
   const fs::path relative(name);
   if (name.empty()) return fail(ErrorCode::InvalidArgument, fmt::format("{} is empty", what));
+  if (name.find('\0') != std::string::npos) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("{} '{}' holds a NUL character, which no file name can", what, printable_text(name)));
+  }
   if (relative.is_absolute() || relative.has_root_name() || relative.has_root_directory()) {
     return fail(ErrorCode::InvalidArgument,
                 fmt::format("{} '{}' is absolute; it must name a file inside the recording's folder", what, name));
@@ -123,6 +155,7 @@ Result<fs::path> inside_folder(const fs::path& dir, const std::string& name, std
     return fail(ErrorCode::InvalidArgument,
                 fmt::format("{} '{}' leads out of the recording's folder (through a link)", what, name));
   }
+  if (auto ok = regular_or_missing(dir / relative, what, name); !ok) return std::unexpected(ok.error());
   return dir / relative;
 }
 
@@ -429,9 +462,15 @@ std::string track_csv(const Track& track) {
 Result<Recording> read_recording(const fs::path& path) {
   std::error_code ec;
   const fs::path manifest_path = fs::is_directory(path, ec) ? path / "recording.json" : path;
+  if (auto ok = regular_or_missing(manifest_path, "the recording manifest", manifest_path.string()); !ok)
+    return std::unexpected(ok.error());
   const auto read = read_file_bytes(manifest_path);
   if (!read) return fail(ErrorCode::NotFound, fmt::format("{}: no recording manifest", manifest_path.string()));
   const std::string& text = *read;
+  if (const auto line = json_nesting_beyond(text)) {
+    return fail(ErrorCode::ParseError, fmt::format("{}:{}: nested deeper than {} arrays and objects",
+                                                   manifest_path.string(), *line, kMaxJsonDepth));
+  }
   json manifest;
   try {
     manifest = json::parse(text);

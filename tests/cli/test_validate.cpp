@@ -149,6 +149,22 @@ TEST(MaterialsCli, ShippedFileIsTheBuiltInTableAndOverridesWork) {
   EXPECT_EQ(huge.exit_code, 1);
   EXPECT_NE(huge.err.find("huge.json' is not valid JSON"), std::string::npos) << huge.err;
   EXPECT_EQ(huge.err.find("internal error"), std::string::npos) << huge.err;
+  // JSON nested 200,000 deep: a crash (the copy of the value recursed once per level), now refused
+  // before it is parsed, naming the file and line; the same for a calibration file.
+  const std::string deep = std::string(200000, '[') + std::string(200000, ']');
+  test::write_text(dir / "deep.json", R"({"materials": [{"name": )" + deep + R"(, "youngs_modulus_pa": 1}]})");
+  const auto nested = test::run_clumpforge(fmt::format("materials --materials '{}'", (dir / "deep.json").string()));
+  EXPECT_EQ(nested.exit_code, 1);
+  EXPECT_NE(nested.err.find("deep.json':1: nested deeper than 64 arrays and objects"), std::string::npos) << nested.err;
+  test::write_text(dir / "deep-calibration.json", R"({"method": "joint",)"
+                                                  "\n"
+                                                  R"("surfaces": )" +
+                                                      deep + "}");
+  const auto cal_nested =
+      test::run_clumpforge(fmt::format("materials --calibration '{}'", (dir / "deep-calibration.json").string()));
+  EXPECT_EQ(cal_nested.exit_code, 1);
+  EXPECT_NE(cal_nested.err.find("deep-calibration.json': line 2: nested deeper than 64"), std::string::npos)
+      << cal_nested.err;
   // A calibration file whose keys hold another type than calibrate writes: the same clean error
   // (each was "internal error" from an uncaught type_error).
   for (const char* text : {R"({"method": 3})", R"({"method": "paper", "results": {"Q235": 3}})",

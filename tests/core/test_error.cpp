@@ -46,6 +46,21 @@ TEST(PrintableText, OneLineTextKeepsACommentOnItsLine) {
   EXPECT_EQ(one_line_text("\x1b[2J"), "\\x1B[2J");
 }
 
+TEST(JsonNesting, TheFirstLineBeyondTheDepthIsFoundAndStringsDoNotCount) {
+  EXPECT_EQ(json_nesting_beyond(R"({"a": [1, {"b": [2]}]})", 4), std::nullopt);  // four deep
+  EXPECT_EQ(json_nesting_beyond(R"({"a": [1, {"b": [2]}]})", 3), 1u);
+  EXPECT_EQ(json_nesting_beyond("{\n \"a\":\n  [[\n", 2), 3u);
+  // Brackets in strings, after an escaped quote and an escaped backslash, are text.
+  EXPECT_EQ(json_nesting_beyond(R"({"a": "[[[[\"[[{{", "b": "\\", "c": "]]]"})", 1), std::nullopt);
+  EXPECT_EQ(json_nesting_beyond(R"({"a": "\\", "b": [[1]]})", 2), 1u);
+  // Closing brackets beyond the opening ones do not lower the depth below zero.
+  EXPECT_EQ(json_nesting_beyond("]]]]{[[", 2), 1u);
+  // What a manifest holds is far within the default; 200,000 levels are not.
+  EXPECT_EQ(json_nesting_beyond(R"({"trials": [{"summary": {"rebound_height_m": 0.03}}]})"), std::nullopt);
+  EXPECT_EQ(json_nesting_beyond(std::string(200000, '[') + std::string(200000, ']')), 1u);
+  EXPECT_EQ(json_nesting_beyond(std::string(kMaxJsonDepth, '[') + std::string(kMaxJsonDepth, ']')), std::nullopt);
+}
+
 TEST(PrintableText, CsvFieldQuotesOnlyWhatWouldSplitARow) {
   EXPECT_EQ(csv_field("tuber-01.stl"), "tuber-01.stl");
   EXPECT_EQ(csv_field("tuber, left.stl"), "\"tuber, left.stl\"");

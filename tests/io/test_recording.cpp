@@ -1,13 +1,19 @@
 // Recordings exactly as ../shared/spec/recording-format.md defines them.
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <thread>
 
 #include "io/recording_io.hpp"
 #include "support/test_support.hpp"
@@ -214,6 +220,63 @@ TEST(RecordingLimits, SymlinkLeavingTheFolderIsRefused) {
   fs::remove(dir / "r" / "link.csv");
   fs::create_symlink(dir / "r" / "tracks" / "t.csv", dir / "r" / "link.csv");
   EXPECT_TRUE(read_recording(dir / "r"));
+}
+
+TEST(RecordingLimits, ATrackThatIsNotAFileIsRefusedUnopened) {
+  // A folder, a named pipe (which would hold the reader until something wrote to it: the
+  // diagnosis hung) and a name with a NUL (the system would open the name cut at it).
+  test::ScratchDir dir("rec-limits");
+  std::string m = refusal(dir / "r", with_track("sub"));
+  fs::create_directories(dir / "r" / "sub");
+  const auto folder = read_recording(dir / "r");
+  ASSERT_FALSE(folder);
+  EXPECT_NE(folder.error().message.find("recording.json:2: trial '1': the track path 'sub' is a folder, not a file"),
+            std::string::npos)
+      << folder.error().message;
+
+  ASSERT_EQ(::mkfifo((dir / "r" / "pipe.csv").c_str(), 0600), 0);
+  test::write_text(dir / "r" / "recording.json", with_track("pipe.csv"));
+  // Were the pipe opened, a writer lets the reader go within 5 s, so the test fails, not hangs.
+  std::atomic<bool> done = false;
+  std::thread writer([&] {
+    for (int k = 0; k < 100 && !done; ++k) {
+      const int fd = ::open((dir / "r" / "pipe.csv").c_str(), O_WRONLY | O_NONBLOCK);
+      if (fd >= 0) {
+        ::close(fd);
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+  const auto pipe = read_recording(dir / "r");
+  done = true;
+  writer.join();
+  ASSERT_FALSE(pipe);
+  EXPECT_NE(pipe.error().message.find("the track path 'pipe.csv' is a named pipe, not a file"), std::string::npos)
+      << pipe.error().message;
+
+  m = refusal(dir / "r", with_track("t.csv\\u0000.txt"));
+  EXPECT_NE(m.find("the track path 't.csv\\x00.txt' holds a NUL character"), std::string::npos) << m;
+}
+
+TEST(RecordingLimits, AManifestThatIsNotAFileOrNestsTooDeepIsRefused) {
+  test::ScratchDir dir("rec-limits");
+  fs::create_directories(dir / "r");
+  ASSERT_EQ(::mkfifo((dir / "r" / "recording.json").c_str(), 0600), 0);
+  const auto pipe = read_recording(dir / "r");
+  ASSERT_FALSE(pipe);
+  EXPECT_NE(pipe.error().message.find("recording.json' is a named pipe, not a file"), std::string::npos)
+      << pipe.error().message;
+  // Extra keys are kept and written back; 200,000 levels of them crashed the reader (the copy
+  // recursed once per level). Refused before they are parsed, with the line they pass the limit.
+  std::string deep = kDrop;
+  deep.insert(deep.rfind('}'), ",\n \"x\": " + std::string(200000, '[') + std::string(200000, ']'));
+  const std::string message = refusal(dir / "r", deep);
+  EXPECT_NE(message.find("recording.json:3: nested deeper than 64 arrays and objects"), std::string::npos) << message;
+  // Nested as deep as data is, they are read and kept.
+  std::string kept = with_track("t.csv");
+  kept.insert(kept.rfind('}'), ", \"x\": [[[{\"y\": [1]}]]]");
+  EXPECT_EQ(refusal(dir / "r", kept), "(accepted)");
 }
 
 TEST(RecordingLimits, CoordinateBeyond100MetresIsRefused) {
