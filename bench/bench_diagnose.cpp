@@ -31,6 +31,7 @@
 #include "compare_runs.hpp"
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
+#include "core/text.hpp"
 #include "diagnose/conceal.hpp"
 #include "diagnose/ensemble.hpp"
 #include "diagnose/flights.hpp"
@@ -447,18 +448,38 @@ std::string twin_line(const std::vector<std::pair<std::string, std::optional<ben
 /// Diagnoses every case of a recording set made elsewhere (case-NN/ with recordings, the
 /// particle named in their manifests) in process, blind, then scores the
 /// verdicts against the set's ANSWERS.json, read only here.
+/// The ids `only` picks from `ids` (all of them when `only` is empty), in `ids`' order, or an
+/// error naming an id that is not a case of the set.
+Result<std::vector<std::string>> picked_cases(const std::vector<std::string>& ids,
+                                              const std::vector<std::string>& only) {
+  for (const std::string& id : only)
+    if (std::ranges::find(ids, id) == ids.end())
+      return fail(ErrorCode::InvalidArgument,
+                  fmt::format("--cases: '{}' is not a case of this set{}", id, did_you_mean(id, ids)));
+  std::vector<std::string> out;
+  for (const std::string& id : ids)
+    if (only.empty() || std::ranges::find(only, id) != only.end()) out.push_back(id);
+  return out;
+}
+
 int run_recordings_set(const fs::path& set, const fs::path& out, const cli::DiagnoseJob& base, bool existing_only,
-                       const Team& team) {
+                       const std::vector<std::string>& only, const Team& team) {
   std::ifstream answers_in(set / "ANSWERS.json");
   const auto answers = nlohmann::json::parse(answers_in, nullptr, false);
   if (answers.is_discarded() || !answers.contains("cases")) {
     std::cerr << (set / "ANSWERS.json").string() << ": no readable answers\n";
     return 1;
   }
-  fs::create_directories(out);
-  std::vector<std::string> ids;
+  std::vector<std::string> all;
   for (const auto& [id, answer] : answers["cases"].items())
-    if (fs::is_directory(set / id)) ids.push_back(id);
+    if (fs::is_directory(set / id)) all.push_back(id);
+  auto picked = picked_cases(all, only);
+  if (!picked) {
+    std::cerr << picked.error().message << "\n";
+    return 1;
+  }
+  const std::vector<std::string>& ids = *picked;
+  fs::create_directories(out);
   const bool ran =
       existing_only || run_missing(
                            team, ids, [&](std::size_t i) { return !fs::exists(out / ids[i] / "report.json"); },
@@ -492,7 +513,7 @@ int run_recordings_set(const fs::path& set, const fs::path& out, const cli::Diag
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [id, answer] : answers["cases"].items()) {
     const fs::path report = out / id / "report.json";
-    if (!fs::exists(report)) continue;
+    if (!fs::exists(report) || std::ranges::find(ids, id) == ids.end()) continue;
     std::ifstream in(report);
     const auto j = nlohmann::json::parse(in, nullptr, false);
     if (j.is_discarded()) {
@@ -861,6 +882,7 @@ struct BenchOptions {
   int controls = 50, trials = 4;
   std::uint64_t seed = 1;
   std::vector<std::string> only;
+  std::vector<std::string> cases;  ///< --cases: only these case ids (empty: every case)
   bool full_set = false, nine_set_ups = false, existing_only = false, generate_only = false;
   bool one_start = false;  ///< DiagnoseOptions::held_starts off
   // The recordings come from a finer clump of the same scan than the one diagnosed (340 spheres
@@ -912,6 +934,11 @@ void add_options(CLI::App& app, BenchOptions& o) {
                  "Seed of the whole benchmark: the generated recordings and each diagnosis's release orientations "
                  "(with --recordings-set, the latter alone; as diagnose --seed)");
   app.add_option("--effects", o.only, "Only these effects, by name (space- or comma-separated; default: the library)")
+      ->delimiter(',');
+  app.add_option("--cases", o.cases,
+                 "Only these cases, by id (space- or comma-separated: case-02 control-07 epsd_rolling-realistic; "
+                 "default: every case), diagnosed and scored alone; a generated case is the same case it is in the "
+                 "whole set")
       ->delimiter(',');
   app.add_flag("--full-set", o.full_set,
                "Six recordings per case (drops 0.2/0.5/1 m, rolls 35/100 mm, tilt) instead of four");
@@ -1219,7 +1246,7 @@ int main(int argc, char** argv) {
   if (!o.recordings_set.empty()) {
     cli::DiagnoseJob job{.spheres = o.spheres, .finer_clumps = o.finer_clumps};
     o.set_diagnosis_options(job.options);
-    return compared(run_recordings_set(o.recordings_set, o.out, job, o.existing_only, *team));
+    return compared(run_recordings_set(o.recordings_set, o.out, job, o.existing_only, o.cases, *team));
   }
   const MaterialTable table = default_material_table();
   auto generator = generator_clump(o);
@@ -1228,9 +1255,16 @@ int main(int argc, char** argv) {
     std::cerr << cases.error().message << "\n";
     return 1;
   }
+  std::vector<std::string> every;
+  for (const auto& c : *cases) every.push_back(c.id);
+  const auto picked = picked_cases(every, o.cases);
+  if (!picked) {
+    std::cerr << picked.error().message << "\n";
+    return 1;
+  }
+  std::erase_if(*cases, [&](const Case& c) { return std::ranges::find(*picked, c.id) == picked->end(); });
   fs::create_directories(o.out);
-  std::vector<std::string> ids;
-  for (const auto& c : *cases) ids.push_back(c.id);
+  const std::vector<std::string>& ids = *picked;
   // With --generate-only a case is missing until its answer (written last) is stored.
   const char* stored = o.generate_only ? "answer.json" : "report.json";
   const bool ran =
