@@ -8,18 +8,8 @@ set -u
 bench=$1 mesh=$2
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
-mkdir -p "$dir/set/meshes"
-cp "$mesh" "$dir/set/meshes/sphere.stl"
-for c in case-01 case-02; do
-  mkdir -p "$dir/set/$c/drop"
-  cat > "$dir/set/$c/drop/recording.json" <<'JSON'
-{"format": "recording/1", "test": "drop", "surface": "Q235",
- "particle": {"mesh": "../../meshes/sphere.stl", "mesh_units": "mm", "density_kg_m3": 1085.0},
- "setup": {"release_height_m": 0.2}, "camera": {"frame_rate_hz": 1000},
- "trials": [{"id": "01", "track": "trial-01.csv"}]}
-JSON
-  printf 't_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n' > "$dir/set/$c/drop/trial-01.csv"
-done
+source "$(dirname "$0")/scoring_common.sh"
+for c in case-01 case-02; do short_drop_case "$dir/set" "$c" "$mesh"; done
 echo '{"cases": {"case-01": {"effect": "none"}, "case-02": {"effect": "none"}}}' > "$dir/set/ANSWERS.json"
 
 "$bench" --recordings-set "$dir/set" --cases case-02 -o "$dir/out" >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }

@@ -1,5 +1,5 @@
 # Shared by the scorer tests (sourced; needs $bench and $dir): score stored reports with
-# --existing-only and read one summary line back.
+# --existing-only and read one summary line back; and a one-case set that diagnoses at once.
 
 # score_generated OUT: the generated-set scorer over OUT (a --full-set run with 2 controls).
 score_generated() {
@@ -23,4 +23,18 @@ expect_line() {
   local line
   line=$(grep "^$2" "$1")
   [ "$line" = "$3" ] || { echo "$1: $line"; exit 1; }
+}
+
+# short_drop_case SET CASE MESH: SET/CASE, one drop of MESH (copied to SET/meshes) whose one track
+# is too short to decide anything, so diagnosed `undecidable` at once.
+short_drop_case() {
+  mkdir -p "$1/meshes" "$1/$2/drop"
+  cp "$3" "$1/meshes/sphere.stl"
+  cat >"$1/$2/drop/recording.json" <<'JSON'
+{"format": "recording/1", "test": "drop", "surface": "Q235",
+ "particle": {"mesh": "../../meshes/sphere.stl", "mesh_units": "mm", "density_kg_m3": 1085.0},
+ "setup": {"release_height_m": 0.2}, "camera": {"frame_rate_hz": 1000},
+ "trials": [{"id": "01", "track": "trial-01.csv"}]}
+JSON
+  printf 't_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n' >"$1/$2/drop/trial-01.csv"
 }

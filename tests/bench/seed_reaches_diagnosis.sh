@@ -7,15 +7,8 @@ set -u
 bench=$1 mesh=$2
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
-mkdir -p "$dir/set/meshes" "$dir/set/case-01/drop"
-cp "$mesh" "$dir/set/meshes/sphere.stl"
-cat > "$dir/set/case-01/drop/recording.json" <<'JSON'
-{"format": "recording/1", "test": "drop", "surface": "Q235",
- "particle": {"mesh": "../../meshes/sphere.stl", "mesh_units": "mm", "density_kg_m3": 1085.0},
- "setup": {"release_height_m": 0.2}, "camera": {"frame_rate_hz": 1000},
- "trials": [{"id": "01", "track": "trial-01.csv"}]}
-JSON
-printf 't_s,x_m,z_m\n0.000,0,0.21\n0.001,0,0.21\n' > "$dir/set/case-01/drop/trial-01.csv"
+source "$(dirname "$0")/scoring_common.sh"
+short_drop_case "$dir/set" case-01 "$mesh"
 echo '{"cases": {"case-01": {"effect": "none"}}}' > "$dir/set/ANSWERS.json"
 for seed in default 7; do
   args=()
