@@ -159,7 +159,7 @@ std::vector<double> load_tracks(Context& c, DiagnoseResult& result, const std::v
     if (!tracks.empty()) result.noise_m.emplace_back(names[r], sigma);
   }
   // The trials that can be used.
-  std::vector<std::string> too_short;
+  std::vector<std::string> too_short, cut_short;
   for (std::size_t r = 0; r < recordings.size(); ++r) {
     const Recording& rec = recordings[r];
     int used = 0;
@@ -180,7 +180,11 @@ std::vector<double> load_tracks(Context& c, DiagnoseResult& result, const std::v
       const double rate = rec.tilt_rate_deg_per_s.value_or(options.lab.tilt_rate_deg_per_s);
       tt.shift_guess = guess_shift(*track, rec.test, rate, rec.incline_deg);
       const double last = track->t.back() - tt.shift_guess;
-      tt.duration = std::clamp(last + 0.05, 0.05, rec.test == LabTest::Tilt ? 89.0 / rate : 6.0);
+      const double longest = rec.test == LabTest::Tilt ? 89.0 / rate : 6.0;  // a tilt to 89 degrees; 6 s of a throw
+      tt.duration = std::clamp(last + 0.05, 0.05, longest);
+      if (last + 0.05 > longest)
+        cut_short.push_back(fmt::format("{} trial {} (tracked to {:.3g} s after release, replayed to {:.3g} s)",
+                                        names[r], rec.trials[i].id, last, longest));
       if (rec.test == LabTest::Tilt) tt.record_from = std::max(0.0, track->t.front() - tt.shift_guess - 0.05);
       (tt.training ? c.training : c.heldout).push_back(c.ev.trials.size());
       c.all.push_back(c.ev.trials.size());
@@ -192,6 +196,9 @@ std::vector<double> load_tracks(Context& c, DiagnoseResult& result, const std::v
   result.training_trials = static_cast<int>(c.training.size());
   if (!too_short.empty())
     result.notes.push_back(fmt::format("left out (too short or no noise estimate): {}", fmt::join(too_short, ", ")));
+  if (!cut_short.empty())
+    result.notes.push_back(
+        fmt::format("frames after the longest replay are not compared: {}", fmt::join(cut_short, ", ")));
   c.camera_noise = camera_noise;
   return camera_noise;
 }

@@ -601,6 +601,31 @@ TEST(DiagnoseBlind, TooShortOrTooNoisyIsUndecidable) {
   EXPECT_EQ(result->basis, Basis::TooFewTrials) << result->statement;
 }
 
+TEST(DiagnoseBlind, FramesBeyondTheLongestReplayAreSaidNotCompared) {
+  // A camera left running: a frame 20 s after the drop's last. A throw is replayed for 6 s at
+  // most, so those frames are not compared, and the report says so (it said nothing).
+  const Clump clump = diagnosis_clump();
+  const MaterialTable table = default_material_table();
+  ConcealOptions conceal;
+  conceal.trials = 1;  // one usable trial: undecidable at once, after the trials are read
+  conceal.drop_heights = {0.2};
+  conceal.roll_starts = {};
+  conceal.tilt = false;
+  auto made = make_concealed_recordings(clump, table, conceal);
+  ASSERT_TRUE(made) << made.error().message;
+  Track& t = *made->recordings[0].trials[0].track;
+  t.t.push_back(t.t.back() + 20.0);
+  t.x.push_back(t.x.back());
+  t.z.push_back(t.z.back());
+  auto result = diagnose(clump, table, made->recordings, made->names, {});
+  ASSERT_TRUE(result) << result.error().message;
+  EXPECT_EQ(result->basis, Basis::TooFewTrials) << result->statement;
+  const auto said = std::ranges::find_if(result->notes, [](const std::string& n) {
+    return n.starts_with("frames after the longest replay are not compared") && n.find("replayed to 6 s") != n.npos;
+  });
+  EXPECT_NE(said, result->notes.end());
+}
+
 TEST(DiagnoseParticleModel, AControlMadeFromAFinerBodyIsTheClumpsNotMissingPhysics) {
   // Recordings of bundled tuber 01 made from its 394-sphere clump, diagnosed with a 4-sphere
   // fill of its scan: the tumbling tuber's rebounds and rolls beyond the release horizon
