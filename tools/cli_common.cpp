@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "core/recording.hpp"
 #include "core/sha256.hpp"
 #include "core/text.hpp"
 #include "core/units.hpp"
@@ -102,9 +103,7 @@ Result<LoadedBody> load_closed_body(const std::string& path, const std::string& 
                                     const SdfOptions& sdf, const RunContext& context) {
   auto unit = parse_length_unit(units);
   if (!unit) return std::unexpected(unit.error());
-  if (!(density > 0.0) || density > 1e5) {
-    return fail(ErrorCode::InvalidArgument, fmt::format("--density {} is not a plausible density in kg/m^3", density));
-  }
+  if (auto ok = check_density_option(density); !ok) return std::unexpected(ok.error());
   auto loaded = load_mesh(path, {.unit = *unit});
   if (!loaded) return std::unexpected(loaded.error());
   auto digest = sha256_file(path);
@@ -150,6 +149,14 @@ CLI::Option* add_materials_option(CLI::App& app, std::string& path, const std::s
 
 CLI::Option* add_units_option(CLI::App& app, std::string& units, const std::string& what) {
   return app.add_option("--units", units, what)->type_name("mm|cm|m")->capture_default_str()->group(kSharedOptions);
+}
+
+Result<void> check_density_option(double density) {
+  if (density >= RecordingLimits::min_density && density <= RecordingLimits::max_density) return {};
+  return fail(ErrorCode::InvalidArgument,
+              fmt::format("--density {} is not a plausible density: it must lie in [{:g}, {:g}] kg/m^3 (the Corydalis "
+                          "tuber's is 1085)",
+                          density, RecordingLimits::min_density, RecordingLimits::max_density));
 }
 
 CLI::Option* add_density_option(CLI::App& app, double& density, const std::string& what) {

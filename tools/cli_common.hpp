@@ -65,6 +65,10 @@ CLI::Option* add_threads_option(CLI::App& app, int& threads);
 CLI::Option* add_materials_option(CLI::App& app, std::string& path, const std::string& what);
 CLI::Option* add_units_option(CLI::App& app, std::string& units, const std::string& what);
 CLI::Option* add_density_option(CLI::App& app, double& density, const std::string& what);
+/// A --density no body has is refused: outside [1, 25000] kg/m^3, the limits a recording's
+/// stated density keeps (RecordingLimits), or not a number. Every command that takes --density
+/// asks this one check.
+Result<void> check_density_option(double density);
 inline constexpr const char* kSharedOptions = "Shared options";
 
 /// "a, b,c" -> {"a", "b", "c"} (each trimmed; empty items kept, for the caller to refuse).

@@ -34,9 +34,7 @@ Result<BatchOptions> options_of(const BatchArgs& a) {
   auto unit = parse_length_unit(a.units);
   if (!unit) return std::unexpected(unit.error());
   o.units = *unit;
-  if (!(a.density > 0.0) || a.density > 1e5)
-    return fail(ErrorCode::InvalidArgument,
-                fmt::format("--density {} is not a plausible density in kg/m^3", a.density));
+  if (auto ok = check_density_option(a.density); !ok) return std::unexpected(ok.error());
   o.density = a.density;
   if (a.trials < 1 || a.trials > 10000) return fail(ErrorCode::InvalidArgument, "--trials must be between 1 and 10000");
   o.trials = a.trials;

@@ -37,11 +37,7 @@ void print_human(const PropsArgs& args, const MassProperties& p) {
 
 int run_props(const PropsArgs& args) {
   constexpr std::string_view kCommand = "props";
-  if (!(args.density > 0.0) || args.density > 1e5) {
-    return report_error(
-        kCommand, {ErrorCode::InvalidArgument,
-                   fmt::format("--density {} is not a plausible density (expected kg/m^3, e.g. 1085)", args.density)});
-  }
+  if (auto ok = check_density_option(args.density); !ok) return report_error(kCommand, ok.error());
   auto unit = parse_length_unit(args.units);
   if (!unit) return report_error(kCommand, unit.error());
   auto loaded = load_mesh(args.input, {.unit = *unit});

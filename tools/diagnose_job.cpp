@@ -94,6 +94,12 @@ Result<ParticleChoice> mesh_choice(const DiagnoseJob& job, const StatedParticle&
 // recordings or the default; a density given and stated must agree (a library's clump: in
 // library_models).
 Result<ParticleChoice> particle_choice(const DiagnoseJob& job, const StatedParticle& stated) {
+  if (job.density) {
+    if (auto ok = check_density_option(*job.density); !ok) return std::unexpected(ok.error());
+  }
+  if (job.units) {  // checked whether or not a mesh is read: --library took --units furlong without a word
+    if (auto unit = parse_length_unit(*job.units); !unit) return std::unexpected(unit.error());
+  }
   if (job.density && stated.density && !same_density(*job.density, *stated.density))
     return fail(ErrorCode::InvalidArgument,
                 fmt::format("{} states the particle's density {:g} kg/m^3, --density gives {:g}: one particle, one "

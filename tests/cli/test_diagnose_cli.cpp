@@ -277,7 +277,13 @@ TEST(DiagnoseCli, AParticleTheCommandLineOrTheRecordingsContradictIsRefusedAndNo
       {fmt::format("'{}' --library '{}' --density 900", (dir / "a").string(), clump()), "states the particle's density",
        "--density gives 900"},
       {fmt::format("'{}' --library '{}' --mesh '{}'", (dir / "a").string(), clump(), sphere),
-       "exactly one of --mesh and --library", "not both"}};
+       "exactly one of --mesh and --library", "not both"},
+      // A density no body has, given with a library: inf was taken, as "the same" as any density
+      // (|inf - 1085| <= 1 % of inf), and the diagnosis ran.
+      {fmt::format("'{}' --library '{}' --density inf", (dir / "a").string(), clump()), "--density inf",
+       "must lie in [1, 25000] kg/m^3"},
+      {fmt::format("'{}' --mesh '{}' --density 30000", (dir / "heavy").string(), sphere), "--density 30000",
+       "must lie in [1, 25000] kg/m^3"}};
   for (const auto& [arguments, said, also] : cases) {
     SCOPED_TRACE(arguments);
     const auto run =
@@ -288,6 +294,13 @@ TEST(DiagnoseCli, AParticleTheCommandLineOrTheRecordingsContradictIsRefusedAndNo
     EXPECT_TRUE(run.out.empty()) << run.out;
     EXPECT_FALSE(std::filesystem::exists(dir / "out"));
   }
+  // A unit that is none, even where no mesh is read (it was taken without a word with --library).
+  const auto furlong =
+      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --units furlong --output '{}'",
+                                       (dir / "a").string(), clump(), (dir / "out").string()));
+  EXPECT_EQ(furlong.exit_code, 1);
+  EXPECT_NE(furlong.err.find("unknown length unit 'furlong' (expected mm, cm or m)"), std::string::npos) << furlong.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
 TEST(ConcealCli, BadOptionsAreRefusedAndNothingIsWritten) {
