@@ -47,9 +47,10 @@ struct Trial {
 /// command line's and a clump's (1 %: a lab's 1084.6 is the library's 1085).
 inline constexpr double kStatedDensityTolerance = 0.01;
 
-/// Whether two densities [kg/m^3] are one particle's, within kStatedDensityTolerance.
+/// Whether two densities [kg/m^3] are one particle's, within kStatedDensityTolerance. Never for
+/// a density that is not finite (1 % of infinity holds any difference).
 inline bool same_density(double a, double b) {
-  return std::abs(a - b) <= kStatedDensityTolerance * std::max(a, b);
+  return std::isfinite(a) && std::isfinite(b) && std::abs(a - b) <= kStatedDensityTolerance * std::max(a, b);
 }
 
 /// Limits no experiment exceeds: a value beyond them is refused as a broken recording.

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <thread>
@@ -553,6 +554,16 @@ void summary_drop(const fs::path& dir, const std::string& particle) {
       particle.empty() ? std::string() : fmt::format(R"( "particle": {},)", particle));
 }
 }  // namespace
+
+TEST(StatedParticle, TwoDensitiesAreOneParticlesWithinOnePercentNeverAtInfinity) {
+  EXPECT_TRUE(same_density(1085.0, 1084.6));
+  EXPECT_TRUE(same_density(1085.0, 1095.0));
+  EXPECT_FALSE(same_density(1085.0, 1300.0));
+  // 1 % of infinity holds any difference: inf was "the same" as 1085, and taken.
+  EXPECT_FALSE(same_density(std::numeric_limits<double>::infinity(), 1085.0));
+  EXPECT_FALSE(same_density(1085.0, std::numeric_limits<double>::infinity()));
+  EXPECT_FALSE(same_density(std::numeric_limits<double>::quiet_NaN(), 1085.0));
+}
 
 TEST(StatedParticle, TheRecordingsAgreeOnOneParticleOrAreRefusedNamingBoth) {
   test::ScratchDir dir("stated-particle");
