@@ -507,10 +507,12 @@ Result<void> check_lab_setup(const Recording& setup) {
   if (!(setup.release_height > 0.0 && setup.release_height < 10.0) ||
       !(setup.incline_deg > 0.0 && setup.incline_deg < 90.0) ||
       !(setup.start_distance > 0.0 && setup.start_distance < 0.45) ||
-      (setup.tilt_rate_deg_per_s && !(*setup.tilt_rate_deg_per_s > 0.0 && std::isfinite(*setup.tilt_rate_deg_per_s))))
+      (setup.tilt_rate_deg_per_s &&
+       !(*setup.tilt_rate_deg_per_s > 0.0 && *setup.tilt_rate_deg_per_s <= RecordingLimits::max_tilt_rate)))
     return fail(ErrorCode::InvalidArgument,
-                "the set-up is out of range (height in (0, 10) m, incline in (0, 90) deg, start in (0, 0.45) m, tilt "
-                "rate > 0)");
+                fmt::format("the set-up is out of range (height in (0, 10) m, incline in (0, 90) deg, start in (0, "
+                            "0.45) m, tilt rate in (0, {:g}] deg/s)",
+                            RecordingLimits::max_tilt_rate));
   return {};
 }
 

@@ -447,6 +447,13 @@ Result<void> check_time_step(double dt, const TimeStepEstimate& estimate) {
                             "{:.3g} s)",
                             dt, estimate.largest_allowed, rayleigh, estimate.hertz));
   }
+  // A step far below the estimate is no more accurate, only slower: 1e-15 s ran a drop for ever.
+  if (dt < kSmallestStepFraction * estimate.chosen) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("time step {:.3g} s is below {:g} of the estimated step {:.3g} s: the run would take more "
+                            "than {:g} times the steps it needs",
+                            dt, kSmallestStepFraction, estimate.chosen, 1.0 / kSmallestStepFraction));
+  }
   return {};
 }
 

@@ -42,7 +42,10 @@ struct TimeStepEstimate {
 TimeStepEstimate estimate_time_step(const World& world, double impact_speed, int steps_per_contact = 50,
                                     TimeStepRule rule = TimeStepRule::RayleighAndHertz);
 
-/// Fails when dt is not positive or exceeds the estimate's largest allowed step.
+/// The smallest time step a run takes, as a fraction of the estimate's chosen one.
+inline constexpr double kSmallestStepFraction = 1e-3;
+/// Fails when dt is not positive, exceeds the estimate's largest allowed step or lies below
+/// kSmallestStepFraction of its chosen one.
 Result<void> check_time_step(double dt, const TimeStepEstimate& estimate);
 
 /// Advances by one step of `dt` [s].

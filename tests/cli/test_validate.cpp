@@ -55,6 +55,12 @@ TEST(ValidateCli, BadInputIsAClearError) {
        "must be in [0, 10]"},
       {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --time-step 0.01", library()),
        "stable limit"},
+      // A step no more accurate, only slower (1e-15 s ran for ever), and a tilt no lab makes
+      // (1e9 deg/s was run).
+      {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235 --time-step 1e-15", library()),
+       "below 0.001 of the estimated step"},
+      {fmt::format("validate '{}' --clump lattice-4mm --test tilt --surface Q235 --tilt-rate 1e9", library()),
+       "tilt rate in (0, 1000] deg/s"},
       {fmt::format("validate '{}' --test drop --surface Q235", library()), "choose one with --clump"},
       {fmt::format("validate '{}' --clump lattice-4mm --test drop --surface Q235",
                    (test::source_dir() / "meshes" / "tuber-default.stl").string()),

@@ -252,7 +252,7 @@ TEST(Dynamics, ASymmetricTopsAxisPrecessesAboutTheMomentumAtMomentumOverTheTrans
   EXPECT_NEAR(axis.dot(momentum.normalized()), std::cos(theta), 1e-12);
 }
 
-TEST(TimeStep, EstimatesAndRefusalOfTooLargeSteps) {
+TEST(TimeStep, EstimatesAndRefusalOfTooLargeAndTooSmallSteps) {
   World world = soft_sphere_world({0.5, 0.5, 0.0}, 1e-3);
   const auto estimate = estimate_time_step(world, 2.0);
   const double t_r = kPi * 1e-3 * std::sqrt(1000.0 / kSoft.shear_modulus()) / (0.1631 * 0.3 + 0.8766);
@@ -263,6 +263,11 @@ TEST(TimeStep, EstimatesAndRefusalOfTooLargeSteps) {
   ASSERT_FALSE(refused);
   EXPECT_NE(refused.error().message.find("stable limit"), std::string::npos);
   EXPECT_FALSE(check_time_step(-1.0, estimate));
+  // Far below the estimate: no more accurate, only slower (1e-15 s ran a drop for ever).
+  EXPECT_TRUE(check_time_step(estimate.chosen * kSmallestStepFraction, estimate));
+  const auto tiny = check_time_step(estimate.chosen * kSmallestStepFraction / 2.0, estimate);
+  ASSERT_FALSE(tiny);
+  EXPECT_NE(tiny.error().message.find("below 0.001 of the estimated step"), std::string::npos) << tiny.error().message;
 }
 
 }  // namespace clumpforge
