@@ -28,6 +28,7 @@
 #include <optional>
 #include <sstream>
 
+#include "cli_common.hpp"
 #include "compare_runs.hpp"
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
@@ -932,7 +933,8 @@ void add_options(CLI::App& app, BenchOptions& o) {
   app.add_option("--trials", o.trials, "Trials per recording");
   app.add_option("--seed", o.seed,
                  "Seed of the whole benchmark: the generated recordings and each diagnosis's release orientations "
-                 "(with --recordings-set, the latter alone; as diagnose --seed)");
+                 "(with --recordings-set, the latter alone; as diagnose --seed)")
+      ->check(cli::seed_validator());
   app.add_option("--effects", o.only, "Only these effects, by name (space- or comma-separated; default: the library)")
       ->delimiter(',');
   app.add_option("--cases", o.cases,

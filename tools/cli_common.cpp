@@ -6,11 +6,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <charconv>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <vector>
 
 #include "core/recording.hpp"
@@ -129,8 +131,25 @@ CLI::Option* add_json_flag(CLI::App& app, bool& json, const std::string& what) {
   return app.add_flag("--json", json, what)->group(kSharedOptions);
 }
 
+CLI::Validator seed_validator() {
+  return CLI::Validator(
+      [](const std::string& text) {
+        std::uint64_t value = 0;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+        return ec == std::errc() && end == text.data() + text.size()
+                   ? std::string()
+                   : fmt::format("a seed is a whole number from 0 to {}, not {}",
+                                 std::numeric_limits<std::uint64_t>::max(), text);
+      },
+      "UINT");
+}
+
 CLI::Option* add_seed_option(CLI::App& app, std::uint64_t& seed, const std::string& what) {
-  return app.add_option("--seed", seed, what)->type_name("UINT")->capture_default_str()->group(kSharedOptions);
+  return app.add_option("--seed", seed, what)
+      ->type_name("UINT")
+      ->capture_default_str()
+      ->check(seed_validator())
+      ->group(kSharedOptions);
 }
 
 CLI::Option* add_threads_option(CLI::App& app, int& threads) {

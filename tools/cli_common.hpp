@@ -59,6 +59,9 @@ CLI::Option* add_clump_option(CLI::App& app, std::string& clump, const std::stri
 /// types and lists them alike (under "Shared options" in --help); `what` says what the
 /// option means for that command.
 CLI::Option* add_json_flag(CLI::App& app, bool& json, const std::string& what);
+/// A seed as the command line gives it: a whole number in [0, 2^64); a negative one (which CLI11
+/// wrapped round to 2^64 - 5) or one beyond the range is refused.
+CLI::Validator seed_validator();
 CLI::Option* add_seed_option(CLI::App& app, std::uint64_t& seed, const std::string& what);
 /// --threads N: threads per process (per MPI rank); 0 = automatic.
 CLI::Option* add_threads_option(CLI::App& app, int& threads);

@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
   app.add_option("--magnitude", magnitude, "realistic, strong, or the parameter values (comma-separated, SI)");
   app.add_option("--surface", surface, "Plate material");
   app.add_option("--trials", trials, "Trials per recording");
-  app.add_option("--seed", seed, "Seed of orientations, noise and time origins");
+  app.add_option("--seed", seed, "Seed of orientations, noise and time origins")->check(cli::seed_validator());
   app.add_option("--noise", noise, "Camera noise per coordinate [m] (labs: 1e-4 at 1000 fps, 5e-4 at 240 fps)");
   app.add_option("--fps", fps, "Camera frame rate [Hz]");
   app.add_flag("--no-pre-roll", no_pre_roll, "Tracks begin 2-20 ms after the release (default: 5-30 ms before it)");

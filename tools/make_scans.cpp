@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
   int large_faces = 0;
   app.add_option("-o,--output", out_dir, "Output directory")->capture_default_str();
   app.add_option("--out", out_dir, "same as --output")->group("");
-  app.add_option("--seed", seed, "Batch seed")->capture_default_str();
+  app.add_option("--seed", seed, "Batch seed")->capture_default_str()->check(cli::seed_validator());
   app.add_option("--count", count, "Scans in the batch besides the default one")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));

@@ -84,6 +84,15 @@ TEST(Cli, UsageErrorsExitTwo) {
   EXPECT_EQ(test::run_clumpforge("frobnicate").exit_code, 2);
   EXPECT_EQ(test::run_clumpforge(fmt::format("props '{}'", default_scan())).exit_code, 2);   // no --density
   EXPECT_EQ(test::run_clumpforge(fmt::format("repair '{}'", default_scan())).exit_code, 2);  // no -o
+  // A negative seed was wrapped round to 2^64 - 5 and run; one past 2^64 - 1 too.
+  for (const char* seed : {"-5", "18446744073709551616"}) {
+    const auto run =
+        test::run_clumpforge(fmt::format("validate '{}' --test drop --surface Q235 --seed {}", default_scan(), seed));
+    EXPECT_EQ(run.exit_code, 2) << seed;
+    EXPECT_NE(run.err.find(fmt::format("a seed is a whole number from 0 to 18446744073709551615, not {}", seed)),
+              std::string::npos)
+        << run.err;
+  }
 }
 
 TEST(Cli, BadOptionsAreClearErrorsAndWriteNothing) {
