@@ -112,7 +112,7 @@ std::string_view file_kind(fs::file_type type) {
     case fs::file_type::socket:
       return "a socket";
     default:
-      return "not a regular file";
+      return "its kind cannot be told (a loop of links, or no permission to look)";
   }
 }
 
@@ -123,7 +123,7 @@ Result<void> regular_or_missing(const fs::path& path, std::string_view what, con
   const fs::file_status status = fs::status(path, ec);
   if (status.type() == fs::file_type::not_found || status.type() == fs::file_type::regular) return {};
   return fail(ErrorCode::InvalidArgument,
-              fmt::format("{} '{}' is {}, not a file", what, printable_text(name), file_kind(status.type())));
+              fmt::format("{} '{}' is not a file: {}", what, printable_text(name), file_kind(status.type())));
 }
 
 /// A file a recording names (`what`: "the track path", "the particle's mesh"), resolved inside

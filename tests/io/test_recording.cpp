@@ -231,7 +231,7 @@ TEST(RecordingLimits, ATrackThatIsNotAFileIsRefusedUnopened) {
   fs::create_directories(dir / "r" / "sub");
   const auto folder = read_recording(dir / "r");
   ASSERT_FALSE(folder);
-  EXPECT_NE(folder.error().message.find("recording.json:2: trial '1': the track path 'sub' is a folder, not a file"),
+  EXPECT_NE(folder.error().message.find("recording.json:2: trial '1': the track path 'sub' is not a file: a folder"),
             std::string::npos)
       << folder.error().message;
 
@@ -253,7 +253,7 @@ TEST(RecordingLimits, ATrackThatIsNotAFileIsRefusedUnopened) {
   done = true;
   writer.join();
   ASSERT_FALSE(pipe);
-  EXPECT_NE(pipe.error().message.find("the track path 'pipe.csv' is a named pipe, not a file"), std::string::npos)
+  EXPECT_NE(pipe.error().message.find("the track path 'pipe.csv' is not a file: a named pipe"), std::string::npos)
       << pipe.error().message;
 
   m = refusal(dir / "r", with_track("t.csv\\u0000.txt"));
@@ -266,7 +266,7 @@ TEST(RecordingLimits, AManifestThatIsNotAFileOrNestsTooDeepIsRefused) {
   ASSERT_EQ(::mkfifo((dir / "r" / "recording.json").c_str(), 0600), 0);
   const auto pipe = read_recording(dir / "r");
   ASSERT_FALSE(pipe);
-  EXPECT_NE(pipe.error().message.find("recording.json' is a named pipe, not a file"), std::string::npos)
+  EXPECT_NE(pipe.error().message.find("recording.json' is not a file: a named pipe"), std::string::npos)
       << pipe.error().message;
   // Extra keys are kept and written back; 200,000 levels of them crashed the reader (the copy
   // recursed once per level). Refused before they are parsed, with the line they pass the limit.
