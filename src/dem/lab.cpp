@@ -317,7 +317,7 @@ TrialOutcome tilt_trial(World world, const Recording& setup, const LabOptions& o
       slip_angle = angle;
       break;
     }
-    if (angle > 89.0) break;
+    if (angle > kTiltEndDeg) break;
   }
   out.trial.summary = std::isnan(slip_angle) ? 90.0 : slip_angle;
   out.trial.track = sampler.take();

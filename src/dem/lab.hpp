@@ -13,6 +13,10 @@
 
 namespace clumpforge {
 
+/// [deg] The plate angle a tilt test runs to when the body has not slid (90 would stand it
+/// upright): the DEM's tilt, its replays and concealed recordings all end there.
+inline constexpr double kTiltEndDeg = 89.0;
+
 struct LabOptions {
   int trials = 10;                         ///< >= 1
   std::uint64_t seed = 1;                  ///< trial i uses substream i: any thread count, the same bits
@@ -29,7 +33,7 @@ struct LabOptions {
   TimeStepRule time_step_rule = TimeStepRule::RayleighAndHertz;
   double frame_rate_hz = 1000.0;     ///< track sampling, like a high-speed camera
   double tilt_rate_deg_per_s = 5.0;  ///< used when the recording has none
-  double max_time = 6.0;             ///< [s] simulated time limit of a drop or roll trial (a tilt runs to 89 deg)
+  double max_time = 6.0;             ///< [s] simulated time limit of a drop or roll trial (a tilt runs to kTiltEndDeg)
   std::string particle_material = "tuber";
   std::vector<PhysicsTerm> terms;  ///< extra physics
   /// Centre of mass relative to the visible centroid, in the clump's body frame [m]: a

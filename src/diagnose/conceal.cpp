@@ -82,7 +82,7 @@ ReplayOptions replay_options(const Recording& r) {
       o.stop_after_rest = 0.15;
       break;
     case LabTest::Tilt:
-      o.duration = 89.0 / *r.tilt_rate_deg_per_s;
+      o.duration = kTiltEndDeg / *r.tilt_rate_deg_per_s;
       o.stop_after_slip = 0.15;
       break;
   }

@@ -180,7 +180,7 @@ std::vector<double> load_tracks(Context& c, DiagnoseResult& result, const std::v
       const double rate = rec.tilt_rate_deg_per_s.value_or(options.lab.tilt_rate_deg_per_s);
       tt.shift_guess = guess_shift(*track, rec.test, rate, rec.incline_deg);
       const double last = track->t.back() - tt.shift_guess;
-      const double longest = rec.test == LabTest::Tilt ? 89.0 / rate : 6.0;  // a tilt to 89 degrees; 6 s of a throw
+      const double longest = rec.test == LabTest::Tilt ? kTiltEndDeg / rate : options.lab.max_time;
       tt.duration = std::clamp(last + 0.05, 0.05, longest);
       if (last + 0.05 > longest)
         cut_short.push_back(fmt::format("{} trial {} (tracked to {:.3g} s after release, replayed to {:.3g} s)",

@@ -563,7 +563,7 @@ std::vector<std::pair<Outcome, double>> replay_for(const PlanJob& job, const Pla
   if (rec.test == LabTest::Tilt) {
     // Until it has slid 10 mm, however late that is: a replay that stopped where the
     // recorded tracks stop would leave out the replays that slide later.
-    replay.duration = 89.0 / plan.tilt_rate_deg_per_s;
+    replay.duration = kTiltEndDeg / plan.tilt_rate_deg_per_s;
     replay.stop_after_slip = 0.0;
     replay.tilt_start_deg = job.tilt_start;
   }

@@ -156,6 +156,7 @@ TEST(DiagnoseCli, BadInputIsAClearError) {
 // file, exit 1, nothing written, and nothing outside the recording opened.
 TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
   test::ScratchDir dir("diagnose-hostile");
+  const std::string kFolder = "(a folder)";  // the track made a folder, not a file
   write(dir / "outside.csv", "t_s,x_m,z_m\nSECRET-LINE,0,0\n");
   const std::string drop =
       R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": %H%},
@@ -176,12 +177,21 @@ TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
       {R"({"format": "recording/1", "test": "roll", "surface": "Q235",
           "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "trials": [{"id": "01", "track": "trial-01.csv"}]})",
        uphill_roll(), "x_m must be positive in the direction of travel"},
+      // A name the system would cut at its NUL, a track that is a folder, JSON nested 200,000
+      // deep (it crashed the reader).
+      {manifest("0.2", "trial-01.csv\\u0000x"), "t_s,x_m,z_m\n0,0,0.2\n", "holds a NUL character"},
+      {manifest("0.2", "trial-01.csv"), kFolder, "is not a file: a folder"},
+      {manifest("0.2", "trial-01.csv").insert(1, "\"x\": " + std::string(200000, '[') + std::string(200000, ']') + ","),
+       "t_s,x_m,z_m\n0,0,0.2\n", "nested deeper than 64 arrays and objects"},
   };
   for (const auto& [m, track, expected] : cases) {
     SCOPED_TRACE(expected);
     std::filesystem::remove_all(dir / "rec");
     write(dir / "rec" / "recording.json", m);
-    if (!track.empty()) write(dir / "rec" / "trial-01.csv", track);
+    if (track == kFolder)
+      std::filesystem::create_directories(dir / "rec" / "trial-01.csv");
+    else if (!track.empty())
+      write(dir / "rec" / "trial-01.csv", track);
     const auto run = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --library '{}' --output '{}' --json",
                                                       (dir / "rec").string(), clump(), (dir / "out").string()));
     EXPECT_EQ(run.exit_code, 1) << run.err;
