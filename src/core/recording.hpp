@@ -3,6 +3,8 @@
 /// ../shared/spec/recording-format.md defines it (format "recording/1").
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,6 +66,10 @@ struct RecordingLimits {
   static constexpr double max_density = 25000.0;       ///< [kg/m^3]
   static constexpr double max_noise = 0.1;             ///< [m] stated camera noise: (0, this]
   static constexpr double max_tilt_rate = 1000.0;      ///< [deg/s] (0, this]
+  /// [bytes] a track file: 10 million frames of five columns, written to a micrometre.
+  static constexpr std::uintmax_t max_track_bytes = 1ull << 30;
+  /// Lines after a track's header: 10 million frames, about 3 hours at 1000 fps.
+  static constexpr std::size_t max_track_lines = 10'000'000;
 };
 
 struct Recording {

@@ -1,6 +1,7 @@
 #include "core/text.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <fstream>
 #include <vector>
 
@@ -54,6 +55,55 @@ std::string did_you_mean(std::string_view input, std::initializer_list<std::stri
 }
 std::string did_you_mean(std::string_view input, std::span<const std::string> candidates) {
   return closest(input, candidates);
+}
+
+std::optional<std::string_view> not_a_regular_file(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  switch (fs::status(path, ec).type()) {
+    case fs::file_type::regular:
+    case fs::file_type::not_found:
+      return std::nullopt;
+    case fs::file_type::directory:
+      return "a folder";
+    case fs::file_type::fifo:
+      return "a named pipe";
+    case fs::file_type::block:
+    case fs::file_type::character:
+      return "a device";
+    case fs::file_type::socket:
+      return "a socket";
+    default:
+      return "its kind cannot be told (a loop of links, or no permission to look)";
+  }
+}
+
+std::optional<std::uintmax_t> size_beyond(const std::filesystem::path& path, std::uintmax_t max_bytes) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec || size <= max_bytes) return std::nullopt;
+  return size;
+}
+
+Result<std::string> read_whole_file(const std::filesystem::path& path, std::string_view what,
+                                    std::uintmax_t max_bytes) {
+  namespace fs = std::filesystem;
+  const std::string name = "'" + path.string() + "'", kind(what);
+  const auto beyond = [&](const std::string& size) {
+    return fail(ErrorCode::InvalidArgument, name + ": " + size + " bytes, beyond the limit of " +
+                                                std::to_string(max_bytes >> 20) + " MiB for a " + kind);
+  };
+  std::error_code ec;
+  const fs::file_type type = fs::status(path, ec).type();
+  if (type == fs::file_type::not_found) return fail(ErrorCode::NotFound, name + ": no such " + kind);
+  if (type != fs::file_type::regular && type != fs::file_type::fifo && type != fs::file_type::character)
+    return fail(ErrorCode::InvalidArgument, name + " is not a file: " + std::string(*not_a_regular_file(path)));
+  if (const auto size = size_beyond(path, max_bytes)) return beyond(std::to_string(*size));
+  const std::size_t limit = static_cast<std::size_t>(std::min<std::uintmax_t>(max_bytes, SIZE_MAX - 1));
+  auto bytes = read_file_bytes(path, limit + 1);
+  if (!bytes) return fail(ErrorCode::IoError, name + ": cannot read the " + kind);
+  if (bytes->size() > limit) return beyond("more than " + std::to_string(limit));
+  return std::move(*bytes);
 }
 
 std::optional<std::string> read_file_bytes(const std::filesystem::path& path, std::size_t limit) {

@@ -1,6 +1,7 @@
 #pragma once
 /// Small text helpers shared by the parsers.
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <initializer_list>
 #include <limits>
@@ -8,6 +9,8 @@
 #include <span>
 #include <string>
 #include <string_view>
+
+#include "core/error.hpp"
 
 namespace clumpforge {
 
@@ -27,10 +30,33 @@ std::string one_line_text(std::string_view text);
 /// comma, a quote or a line break; else as it is. A scan's file name may hold any of them.
 std::string csv_field(std::string_view text);
 
+/// What the entry at `path` is when it exists but is not a regular file, links followed ("a
+/// folder", "a named pipe", "a device", "a socket", or that its kind cannot be told); nothing for
+/// a regular file or a missing path. A file a recording names must be regular: a named pipe
+/// would hold the reader until something wrote to it, and a device may never end.
+std::optional<std::string_view> not_a_regular_file(const std::filesystem::path& path);
+
+/// The size of the file at `path` when it is larger than `max_bytes`, told without reading it;
+/// nothing otherwise (or when its size cannot be told: its reader says why).
+std::optional<std::uintmax_t> size_beyond(const std::filesystem::path& path, std::uintmax_t max_bytes);
+
 /// The bytes of the file at `path`, at most `limit` of them; nullopt when it cannot be opened or
 /// read (a missing file, a folder, no permission). The one whole-file reader the parsers share.
 std::optional<std::string> read_file_bytes(const std::filesystem::path& path,
                                            std::size_t limit = std::numeric_limits<std::size_t>::max());
+
+/// The largest JSON file clumpforge reads (a recording's manifest, --materials, --calibration, a
+/// batch's item): a few kilobytes per hundred trials, and parsed JSON takes several times its
+/// bytes in memory.
+inline constexpr std::uintmax_t kMaxJsonBytes = 64ull << 20;
+
+/// The whole file at `path` (read_file_bytes), refused with a message that names it and `what`
+/// it was to be ("materials file", "calibration"): missing, a folder or a socket, larger than
+/// `max_bytes` (a regular file told by its size, unread; a named pipe or a device read up to the
+/// limit: `/dev/zero` as --materials filled the memory), or unreadable. A named pipe the user
+/// names is read as a pipe (`--materials <(ssh host cat m.json)`): it waits for its writer.
+Result<std::string> read_whole_file(const std::filesystem::path& path, std::string_view what,
+                                    std::uintmax_t max_bytes = std::numeric_limits<std::uintmax_t>::max());
 
 /// The deepest nesting of arrays and objects a JSON file clumpforge reads may have: a recording's
 /// manifest nests four deep. A parser holds deeper text, but copying or writing the value back

@@ -357,10 +357,11 @@ std::string seal_header(std::string_view sealed) {
   return header;
 }
 
+/// The largest clump library read: 2 GiB (a thousand clumps of 2000 spheres take 64 MB).
+constexpr std::uintmax_t kMaxLibraryBytes = 2ull << 30;
+
 Result<std::string> read_bytes(const fs::path& path) {
-  auto bytes = read_file_bytes(path);
-  if (!bytes) return fail(ErrorCode::IoError, fmt::format("cannot read '{}'", path.string()));
-  return std::move(*bytes);
+  return read_whole_file(path, "clump library", kMaxLibraryBytes);
 }
 
 // Writes the seal over the user block of the closed file at `temporary`.

@@ -295,8 +295,8 @@ Result<StoredCalibration> apply_calibration_json(const std::filesystem::path& pa
 
 Result<StoredCalibration> apply_calibration(const std::filesystem::path& path, MaterialTable base,
                                             const std::string& particle) {
-  const auto text = read_file_bytes(path);
-  if (!text) return fail(ErrorCode::IoError, fmt::format("cannot read calibration '{}'", path.string()));
+  const auto text = read_whole_file(path, "calibration", kMaxJsonBytes);
+  if (!text) return std::unexpected(text.error());
   try {
     return apply_calibration_json(path, std::move(base), particle, *text);
   } catch (const nlohmann::json::exception& e) {  // a key of another type than calibrate writes

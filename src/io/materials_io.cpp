@@ -10,9 +10,8 @@ namespace clumpforge {
 using nlohmann::json;
 
 Result<MaterialTable> read_materials(const std::filesystem::path& path, MaterialTable table) {
-  const auto text = read_file_bytes(path);
-  if (!text)
-    return fail(ErrorCode::NotFound, fmt::format("'{}': no such materials file, or not readable", path.string()));
+  const auto text = read_whole_file(path, "materials file", kMaxJsonBytes);
+  if (!text) return std::unexpected(text.error());
   if (const auto line = json_nesting_beyond(*text)) {
     return fail(ErrorCode::ParseError,
                 fmt::format("'{}':{}: nested deeper than {} arrays and objects", path.string(), *line, kMaxJsonDepth));

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <sstream>
 
 #include "core/atomic_file.hpp"
@@ -99,31 +100,21 @@ std::string_view column_unit(const std::string& column) {
   return "rad";
 }
 
-/// What a path that is not a regular file is, for a message.
-std::string_view file_kind(fs::file_type type) {
-  switch (type) {
-    case fs::file_type::directory:
-      return "a folder";
-    case fs::file_type::fifo:
-      return "a named pipe";
-    case fs::file_type::block:
-    case fs::file_type::character:
-      return "a device";
-    case fs::file_type::socket:
-      return "a socket";
-    default:
-      return "its kind cannot be told (a loop of links, or no permission to look)";
-  }
-}
-
 /// Refused unless `path` is missing (its reader says so) or a regular file, links followed: a
 /// named pipe would hold the reader until something writes to it, a device may never end.
 Result<void> regular_or_missing(const fs::path& path, std::string_view what, const std::string& name) {
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (status.type() == fs::file_type::not_found || status.type() == fs::file_type::regular) return {};
+  const auto kind = not_a_regular_file(path);
+  if (!kind) return {};
+  return fail(ErrorCode::InvalidArgument, fmt::format("{} '{}' is not a file: {}", what, printable_text(name), *kind));
+}
+
+/// Refused when the file at `path` is larger than `limit` bytes, before a byte is read: a
+/// file of gigabytes would be held in memory whole.
+Result<void> within_size(const fs::path& path, std::uintmax_t limit, std::string_view what) {
+  const auto size = size_beyond(path, limit);
+  if (!size) return {};
   return fail(ErrorCode::InvalidArgument,
-              fmt::format("{} '{}' is not a file: {}", what, printable_text(name), file_kind(status.type())));
+              fmt::format("{}: {} bytes, beyond the limit of {} MiB for {}", path.string(), *size, limit >> 20, what));
 }
 
 /// A file a recording names (`what`: "the track path", "the particle's mesh"), resolved inside
@@ -186,12 +177,16 @@ std::vector<double> tracked(const std::vector<double>& column) {
 /// between units, in words: "(x100: centimetres?)". A track written in centimetres or millimetres
 /// under a metre header moves 100 or 1000 times as far; one within the coordinates' limit (100 m)
 /// passes every other check and ran to a verdict on a body 100 times the size.
-std::string units_hint(double ratio) {
-  for (const auto& [factor, unit] : {std::pair{1000.0, "millimetres"}, {100.0, "centimetres"}, {39.37, "inches"}}) {
+std::string units_hint(double ratio, std::span<const std::pair<double, const char*>> units) {
+  for (const auto& [factor, unit] : units) {
     if (ratio > 0.5 * factor && ratio < 2.0 * factor) return fmt::format(" (about {:g} times: {}?)", factor, unit);
   }
   return {};
 }
+constexpr std::array<std::pair<double, const char*>, 3> kLengthUnits{
+    {{1000.0, "millimetres"}, {100.0, "centimetres"}, {39.37, "inches"}}};
+/// A t_s column written in milliseconds or microseconds, or a video's playback time.
+constexpr std::array<std::pair<double, const char*>, 2> kTimeUnits{{{1000.0, "milliseconds"}, {1e6, "microseconds"}}};
 
 /// What is wrong with a drop's track that does not fall as the drop does, or nothing. The
 /// particle is released from rest with its lowest point `height` above the plate, so its
@@ -210,7 +205,7 @@ std::optional<std::string> wrong_drop_track(const Track& track, double height) {
     return fmt::format(
         "its tracked point falls {:.4g} m, where a drop from {:g} m falls about that far: x_m and z_m must be in "
         "metres{}",
-        fall, height, units_hint(fall / height));
+        fall, height, units_hint(fall / height, kLengthUnits));
   }
   if (fall >= 0.25 * height) return std::nullopt;
   if (rise >= 0.25 * height) {
@@ -242,7 +237,7 @@ std::optional<std::string> wrong_roll_track(const Track& track, double start_dis
     return fmt::format(
         "its tracked point comes down {:.4g} m, where a roll from {:g} m along a {:g} deg incline comes down about "
         "{:.3g} m: x_m and z_m must be in metres{}",
-        descent, start_distance, incline_deg, rise, units_hint(descent / std::max(rise, 1e-3)));
+        descent, start_distance, incline_deg, rise, units_hint(descent / std::max(rise, 1e-3), kLengthUnits));
   }
   const double moved = median({x.end() - 5, x.end()}) - median({x.begin(), x.begin() + 5});
   if (moved >= -std::max(0.25 * run, 5e-3)) return std::nullopt;
@@ -252,7 +247,86 @@ std::optional<std::string> wrong_roll_track(const Track& track, double start_dis
       -moved * 1e3);
 }
 
+/// What is wrong with a track whose rows are not the camera's frames, or nothing. The spec writes
+/// one row per video frame, so where the manifest states the frame rate the rows' median spacing
+/// is its frame interval (a lost frame is a row with empty cells; a row left out moves the median
+/// only when most are). Rows 1000 times that far apart are a t_s column in milliseconds: such a
+/// recording ran for minutes to `unexplained`, its particle falling a million times too slowly.
+/// Within 5 % (a camera's nominal rate against its clock). Judged on 10 or more rows.
+std::optional<std::string> wrong_frame_spacing(const Track& track, double frame_rate) {
+  if (track.t.size() < 10) return std::nullopt;
+  std::vector<double> steps(track.t.size() - 1);
+  for (std::size_t i = 0; i + 1 < track.t.size(); ++i) steps[i] = track.t[i + 1] - track.t[i];
+  const double ratio = median(std::move(steps)) * frame_rate;
+  if (std::abs(ratio - 1.0) <= 0.05) return std::nullopt;
+  return fmt::format(
+      "its rows are {:.4g} s apart (the median), where one row per frame of the camera's {:g} Hz (the manifest's "
+      "camera.frame_rate_hz) is {:.4g} s: t_s must be in seconds, one row per frame{}",
+      ratio / frame_rate, frame_rate, 1.0 / frame_rate, units_hint(ratio, kTimeUnits));
+}
+
+/// What is wrong with a drop's track whose fall is not a fall under gravity, or nothing. Released
+/// from rest, the particle falls freely to the plate (air drag takes a few per cent of g from a
+/// tuber at 1 m), so its tracked heights between a fifth and four fifths of the fall lie on a
+/// parabola whose acceleration is g. One outside [g / 3, 3 g] is a track in other time units (a
+/// video's slowed playback time among them); this holds where the manifest states no frame rate.
+/// Judged on drops of 5 cm or more (a shorter fall's last fifth can hold the first contact) with
+/// 6 or more heights in that stretch.
+std::optional<std::string> wrong_drop_timing(const Track& track, double height) {
+  if (height < 0.05) return std::nullopt;
+  std::vector<double> t, z;
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    if (std::isfinite(track.z[i])) t.push_back(track.t[i]), z.push_back(track.z[i]);
+  }
+  if (z.size() < 10) return std::nullopt;
+  const double start = median({z.begin(), z.begin() + 5});
+  const double fall = start - std::ranges::min(z);
+  std::vector<double> ts, zs;
+  for (std::size_t i = 0; i < z.size() && z[i] >= start - 0.8 * fall; ++i) {
+    if (z[i] <= start - 0.2 * fall) ts.push_back(t[i] - t.front()), zs.push_back(z[i]);
+  }
+  if (zs.size() < 6) return std::nullopt;
+  constexpr double g = 9.81;
+  const double acceleration = -2.0 * fit_quadratic(ts, zs).a;
+  if (acceleration >= g / 3.0 && acceleration <= 3.0 * g) return std::nullopt;
+  const std::string hint = acceleration > 0.0 ? units_hint(std::sqrt(g / acceleration), kTimeUnits) : "";
+  return fmt::format(
+      "its tracked point falls with an acceleration of {:.3g} m/s^2 (a parabola through its heights from {:.1f} to "
+      "{:.1f} mm), where a dropped particle falls at about {:g}: t_s must be in seconds{}",
+      acceleration, zs.front() * 1e3, zs.back() * 1e3, g, hint);
+}
+
+/// What is wrong with a tilt's track whose plate does not tilt at the set-up's stated rate, or
+/// nothing. The spec's plate tilts at a steady rate, so where the track has a tilt_deg column
+/// the plate's angle rises between a tenth and nine tenths of its largest at that rate; one off
+/// by more than a factor of 2 is a track in other time units or from another set-up (read at
+/// the stretch's ends: an encoder's steps leave them). Judged where the plate tilts 2 deg or
+/// more.
+std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
+  if (track.tilt.size() != track.t.size()) return std::nullopt;
+  std::vector<std::size_t> rows;
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    if (std::isfinite(track.tilt[i])) rows.push_back(i);
+  }
+  if (rows.size() < 10) return std::nullopt;
+  const double start = track.tilt[rows.front()];
+  double top = start;
+  for (std::size_t i : rows) top = std::max(top, track.tilt[i]);
+  if (top - start < 2.0) return std::nullopt;
+  const double low = start + 0.1 * (top - start), high = start + 0.9 * (top - start);
+  const auto first = std::ranges::find_if(rows, [&](std::size_t i) { return track.tilt[i] >= low; });
+  const auto upper = std::ranges::find_if(rows, [&](std::size_t i) { return track.tilt[i] >= high; });
+  if (first == rows.end() || upper == rows.end() || *upper <= *first) return std::nullopt;
+  const double rate = (track.tilt[*upper] - track.tilt[*first]) / (track.t[*upper] - track.t[*first]);
+  if (rate >= 0.5 * stated && rate <= 2.0 * stated) return std::nullopt;
+  return fmt::format(
+      "its plate tilts at {:.4g} deg/s (tilt_deg from {:.3g} to {:.3g} deg), where the set-up's "
+      "tilt_rate_deg_per_s is {:g}: t_s must be in seconds{}",
+      rate, track.tilt[*first], track.tilt[*upper], stated, units_hint(stated / rate, kTimeUnits));
+}
+
 Result<Track> read_track(const fs::path& path) {
+  if (auto ok = within_size(path, RecordingLimits::max_track_bytes, "a track"); !ok) return std::unexpected(ok.error());
   std::ifstream in(path);
   if (!in) return fail(ErrorCode::NotFound, fmt::format("{}: track file not found", path.string()));
   std::string line;
@@ -291,7 +365,11 @@ Result<Track> read_track(const fs::path& path) {
   }
   std::size_t number = 1;
   while (std::getline(in, line)) {
-    ++number;
+    if (++number > RecordingLimits::max_track_lines + 1) {
+      return fail(ErrorCode::ParseError,
+                  fmt::format("{}:{}: more than {} lines after the header, the limit for a track", path.string(),
+                              number, RecordingLimits::max_track_lines));
+    }
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (trim(line).empty()) continue;
     std::vector<std::string> cells;
@@ -418,9 +496,12 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
       if (!path) reader.error("track", fmt::format("trial '{}': {}", trial.id, path.error().message), search_from);
       auto track = read_track(*path);
       if (!track) throw ManifestError{track.error().message};
-      const auto wrong = r.test == LabTest::Drop   ? wrong_drop_track(*track, r.release_height)
-                         : r.test == LabTest::Roll ? wrong_roll_track(*track, r.start_distance, r.incline_deg)
-                                                   : std::nullopt;
+      auto wrong = r.test == LabTest::Drop   ? wrong_drop_track(*track, r.release_height)
+                   : r.test == LabTest::Roll ? wrong_roll_track(*track, r.start_distance, r.incline_deg)
+                                             : std::nullopt;
+      if (!wrong && r.frame_rate_hz) wrong = wrong_frame_spacing(*track, *r.frame_rate_hz);
+      if (!wrong && r.test == LabTest::Drop) wrong = wrong_drop_timing(*track, r.release_height);
+      if (!wrong && r.tilt_rate_deg_per_s) wrong = wrong_tilt_rate(*track, *r.tilt_rate_deg_per_s);
       if (wrong) throw ManifestError{fmt::format("{}: {}", path->string(), *wrong)};
       trial.track = std::move(*track);
     }
@@ -463,6 +544,8 @@ Result<Recording> read_recording(const fs::path& path) {
   std::error_code ec;
   const fs::path manifest_path = fs::is_directory(path, ec) ? path / "recording.json" : path;
   if (auto ok = regular_or_missing(manifest_path, "the recording manifest", manifest_path.string()); !ok)
+    return std::unexpected(ok.error());
+  if (auto ok = within_size(manifest_path, kMaxJsonBytes, "a recording manifest"); !ok)
     return std::unexpected(ok.error());
   const auto read = read_file_bytes(manifest_path);
   if (!read) return fail(ErrorCode::NotFound, fmt::format("{}: no recording manifest", manifest_path.string()));

@@ -22,6 +22,8 @@ Result<void> check_file(const fs::path& path) {
   if (fs::is_directory(path, ec)) {
     return fail(ErrorCode::InvalidArgument, fmt::format("'{}' is a directory, not a mesh file", path.string()));
   }
+  if (const auto kind = not_a_regular_file(path))
+    return fail(ErrorCode::InvalidArgument, fmt::format("'{}' is not a mesh file: {}", path.string(), *kind));
   if (fs::file_size(path, ec) == 0 || ec) {
     return fail(ErrorCode::ParseError, fmt::format("'{}' is empty", path.string()));
   }

@@ -115,6 +115,33 @@ TEST(CalibrateCli, BadInputIsAClearError) {
 }  // namespace clumpforge
 
 namespace clumpforge {
+TEST(MaterialsCli, AFileFromAPipeIsReadAndAnEndlessOneRefused) {
+  // --materials and --calibration from a pipe (bash's process substitution) are read; from
+  // /dev/zero they filled the memory before the commit after 556479e and are now refused at
+  // 64 MiB. A mesh that is a named pipe was called "empty": it is named for what it is (the mesh
+  // reader opens its file twice, which a pipe cannot serve).
+  test::ScratchDir dir("materials-pipe");
+  test::write_text(dir / "m.json", R"({"materials": [{"name": "rubber", "youngs_modulus_pa": 5e6,
+    "poisson_ratio": 0.45, "density_kg_m3": 1100}]})");
+  const auto piped = test::run_command(
+      fmt::format("bash -c \"'{}' materials --materials <(cat '{}')\"", CLUMPFORGE_BINARY, (dir / "m.json").string()));
+  ASSERT_EQ(piped.exit_code, 0) << piped.err;
+  EXPECT_NE(piped.out.find("\"rubber\""), std::string::npos);
+  for (const char* option : {"--materials", "--calibration"}) {
+    const auto run =
+        test::run_command(fmt::format("timeout 60 '{}' materials {} /dev/zero", CLUMPFORGE_BINARY, option));
+    EXPECT_EQ(run.exit_code, 1) << option << "\n" << run.err;
+    EXPECT_NE(run.err.find("'/dev/zero': more than 67108864 bytes, beyond the limit of 64 MiB"), std::string::npos)
+        << run.err;
+  }
+  const auto pipe = dir / "p.stl";
+  ASSERT_EQ(test::run_command(fmt::format("mkfifo '{}'", pipe.string())).exit_code, 0);
+  const auto mesh =
+      test::run_command(fmt::format("timeout 20 '{}' props '{}' --density 1000", CLUMPFORGE_BINARY, pipe.string()));
+  EXPECT_EQ(mesh.exit_code, 1) << mesh.err;
+  EXPECT_NE(mesh.err.find(pipe.string() + "' is not a mesh file: a named pipe"), std::string::npos) << mesh.err;
+}
+
 TEST(MaterialsCli, ShippedFileIsTheBuiltInTableAndOverridesWork) {
   const auto printed = test::run_clumpforge("materials");
   ASSERT_EQ(printed.exit_code, 0) << printed.err;

@@ -1,6 +1,11 @@
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <fstream>
+#include <thread>
 
 #include "core/text.hpp"
 #include "core/units.hpp"
@@ -50,6 +55,51 @@ TEST(Text, ReadFileBytesReadsWholeOrUpToALimitAndRefusesWhatIsNotAFile) {
   EXPECT_EQ(read_file_bytes(dir / "empty.txt"), std::string{});
   EXPECT_EQ(read_file_bytes(dir / "missing.txt"), std::nullopt);
   EXPECT_EQ(read_file_bytes(dir.path()), std::nullopt);  // a folder is not a file
+}
+
+TEST(Text, AWholeFileReaderReadsAPipeAndRefusesWhatIsTooLargeOrNotAFile) {
+  // A named pipe the user names is read as a pipe (`--materials <(ssh host cat m.json)`); a
+  // device is read up to the limit and no further (`--materials /dev/zero` filled the memory
+  // before the commit after 556479e); a regular file over the limit is refused by its size,
+  // unread. The writer gives up after 5 s, so a reader that never opened the pipe fails the test.
+  test::ScratchDir dir("whole-file");
+  const auto pipe = dir / "m.json";
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  std::thread writer([&] {
+    for (int k = 0; k < 500; ++k) {
+      const int fd = ::open(pipe.c_str(), O_WRONLY | O_NONBLOCK);
+      if (fd >= 0) {
+        EXPECT_EQ(::write(fd, "{}", 2), 2);
+        ::close(fd);
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  });
+  const auto piped = read_whole_file(pipe, "materials file", kMaxJsonBytes);
+  writer.join();
+  ASSERT_TRUE(piped) << piped.error().message;
+  EXPECT_EQ(*piped, "{}");
+  EXPECT_EQ(not_a_regular_file(pipe), "a named pipe");
+  EXPECT_EQ(not_a_regular_file("/dev/null"), "a device");
+  EXPECT_EQ(not_a_regular_file(dir / "missing"), std::nullopt);
+
+  const auto zeros = read_whole_file("/dev/zero", "materials file", 1 << 20);
+  ASSERT_FALSE(zeros);
+  EXPECT_EQ(zeros.error().message,
+            "'/dev/zero': more than 1048576 bytes, beyond the limit of 1 MiB for a materials file");
+  EXPECT_EQ(read_whole_file(dir.path(), "calibration").error().message,
+            "'" + dir.path().string() + "' is not a file: a folder");
+  std::ofstream(dir / "big.json") << "{}";
+  std::filesystem::resize_file(dir / "big.json", kMaxJsonBytes + 1);  // sparse: made in no time
+  const auto big = read_whole_file(dir / "big.json", "calibration", kMaxJsonBytes);
+  ASSERT_FALSE(big);
+  EXPECT_EQ(big.error().message,
+            "'" + (dir / "big.json").string() + "': 67108865 bytes, beyond the limit of 64 MiB for a calibration");
+  EXPECT_EQ(read_whole_file(dir / "missing.json", "calibration").error().message,
+            "'" + (dir / "missing.json").string() + "': no such calibration");
+  std::filesystem::resize_file(dir / "big.json", 2);
+  EXPECT_EQ(read_whole_file(dir / "big.json", "calibration", kMaxJsonBytes).value(), "{}");
 }
 
 }  // namespace clumpforge

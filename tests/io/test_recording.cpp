@@ -436,6 +436,118 @@ TEST(RecordingLimits, ATrackInOtherUnitsThanMetresIsRefused) {
   EXPECT_EQ(refusal(dir / "e", roll, roll_in(1.0)), "(accepted)");
 }
 
+TEST(RecordingLimits, ATrackInOtherTimeUnitsThanSecondsIsRefused) {
+  // A drop filmed at 1000 fps with t_s written in milliseconds ran for 7 min 45 s to
+  // `unexplained` before the commit after 556479e (its particle fell a million times too slowly).
+  // Where the manifest states the frame rate the rows are its frames; where it does not, a drop's
+  // fall is a fall under gravity. A video's slowed playback time (240 fps shown at 30) is refused
+  // too. A right track is accepted with a pre-roll, lost frames, or from after the release.
+  test::ScratchDir dir("rec");
+  const auto drop_at = [](double frame_rate, double time_scale, double still_s, double from_s, bool lost) {
+    std::string out = "t_s,x_m,z_m\n";
+    for (int i = 0; i < static_cast<int>(0.6 * frame_rate); ++i) {
+      const double t = i / frame_rate, after = std::max(0.0, t - still_s);
+      if (after < from_s) continue;
+      const double fall = std::min(0.2, 0.5 * 9.81 * after * after);
+      if (lost && i % 3 == 1)
+        out += fmt::format("{:.6f},,\n", t * time_scale);
+      else
+        out += fmt::format("{:.6f},0.001,{:.5f}\n", t * time_scale, 0.21 - fall);
+    }
+    return out;
+  };
+  const std::string filmed = R"({"format": "recording/1", "test": "drop", "surface": "Q235",
+    "setup": {"release_height_m": 0.2}, "camera": {"frame_rate_hz": 1000},
+    "trials": [{"id": "1", "track": "t.csv"}]})";
+  const std::string unstated = with_track("t.csv");
+  const std::string ms = refusal(dir / "a", filmed, drop_at(1000, 1000, 0.05, 0, false));
+  EXPECT_NE(ms.find("t.csv: its rows are 1 s apart (the median), where one row per frame of the camera's 1000 Hz "
+                    "(the manifest's camera.frame_rate_hz) is 0.001 s: t_s must be in seconds, one row per frame "
+                    "(about 1000 times: milliseconds?)"),
+            std::string::npos)
+      << ms;
+  const std::string fall = refusal(dir / "b", unstated, drop_at(1000, 1000, 0.05, 0, false));
+  EXPECT_NE(fall.find("t.csv: its tracked point falls with an acceleration of 9.81e-06 m/s^2"), std::string::npos)
+      << fall;
+  EXPECT_NE(fall.find("t_s must be in seconds (about 1000 times: milliseconds?)"), std::string::npos) << fall;
+  const std::string slowed = refusal(dir / "c", unstated, drop_at(240, 8, 0.05, 0, false));
+  EXPECT_NE(slowed.find("falls with an acceleration of 0.153 m/s^2"), std::string::npos) << slowed;
+  EXPECT_NE(refusal(dir / "d", filmed, drop_at(240, 1, 0.05, 0, false)).find("0.004167 s apart"), std::string::npos);
+  EXPECT_EQ(refusal(dir / "e", filmed, drop_at(1000, 1, 0.3, 0, false)), "(accepted)");
+  EXPECT_EQ(refusal(dir / "f", filmed, drop_at(1000, 1, 0.05, 0, true)), "(accepted)");
+  EXPECT_EQ(refusal(dir / "g", filmed, drop_at(1000, 1, 0.0, 0.08, false)), "(accepted)");
+  EXPECT_EQ(refusal(dir / "h", unstated, drop_at(240, 1, 0.05, 0, true)), "(accepted)");
+  const std::string roll = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+    "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "camera": {"frame_rate_hz": 250},
+    "trials": [{"id": "1", "track": "t.csv"}]})";
+  std::string roll_ms = "t_s,x_m,z_m\n", roll_s = roll_ms;
+  for (int i = 0; i < 100; ++i) {
+    const double t = 0.004 * i, x = std::min(0.1, 1.5 * t * t) - 0.03;
+    roll_ms += fmt::format("{:.3f},{:.5f},0.009\n", 1000 * t, x);
+    roll_s += fmt::format("{:.3f},{:.5f},0.009\n", t, x);
+  }
+  EXPECT_NE(refusal(dir / "i", roll, roll_ms).find("(about 1000 times: milliseconds?)"), std::string::npos);
+  EXPECT_EQ(refusal(dir / "j", roll, roll_s), "(accepted)");
+  // A tilt whose tilt_deg column rises at another rate than the set-up states; an encoder's
+  // 0.1 deg steps are read right.
+  const auto tilt = [](double stated) {
+    return fmt::format(R"({{"format": "recording/1", "test": "tilt", "surface": "Q235",
+      "setup": {{"tilt_rate_deg_per_s": {}}}, "trials": [{{"id": "1", "track": "t.csv"}}]}})",
+                       stated);
+  };
+  const auto plate = [](double time_scale, double step) {
+    std::string out = "t_s,x_m,z_m,tilt_deg\n";
+    for (int i = 0; i < 800; ++i) {
+      const double t = 0.01 * i, angle = std::min(30.0, 5.0 * std::max(0.0, t - 1.0));
+      out += fmt::format("{:.3f},0.001,0.007,{:.3f}\n", t * time_scale, step * std::floor(angle / step));
+    }
+    return out;
+  };
+  const std::string tilt_ms = refusal(dir / "k", tilt(5), plate(1000, 0.001));
+  EXPECT_NE(tilt_ms.find("t.csv: its plate tilts at 0.005 deg/s (tilt_deg from 3 to 27 deg), where the set-up's "
+                         "tilt_rate_deg_per_s is 5: t_s must be in seconds (about 1000 times: milliseconds?)"),
+            std::string::npos)
+      << tilt_ms;
+  EXPECT_NE(refusal(dir / "l", tilt(2), plate(1, 0.001)).find("its plate tilts at 5 deg/s"), std::string::npos);
+  EXPECT_EQ(refusal(dir / "m", tilt(5), plate(1, 0.001)), "(accepted)");
+  EXPECT_EQ(refusal(dir / "n", tilt(5), plate(1, 0.1)), "(accepted)");
+}
+
+TEST(RecordingLimits, AManifestOrTrackTooLargeToHoldIsRefusedUnread) {
+  // A manifest past 64 MiB and a track past 1 GiB are refused by their size, unread (sparse files
+  // here, made in no time); a track of more than 10 million lines by the line where it passes
+  // them (blank lines here, which count: a file of newlines must end too). Before the commit
+  // after 556479e each was read into memory whole.
+  test::ScratchDir dir("rec-size");
+  const std::string big = refusal(dir / "a", with_track("t.csv"));
+  ASSERT_EQ(big, "(accepted)");
+  fs::resize_file(dir / "a" / "t.csv", (1ull << 30) + 1);
+  auto r = read_recording(dir / "a");
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("t.csv: 1073741825 bytes, beyond the limit of 1024 MiB for a track"),
+            std::string::npos)
+      << r.error().message;
+  fs::resize_file(dir / "a" / "t.csv", 0);
+  {
+    std::ofstream manifest(dir / "a" / "recording.json", std::ios::app);
+    manifest << "\n";
+  }
+  fs::resize_file(dir / "a" / "recording.json", (64ull << 20) + 1);
+  r = read_recording(dir / "a");
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("recording.json: 67108865 bytes, beyond the limit of 64 MiB for a recording "
+                                   "manifest"),
+            std::string::npos)
+      << r.error().message;
+  const std::string lines = refusal(dir / "b", with_track("t.csv"), "t_s,x_m,z_m\n" + std::string(10'000'001, '\n'));
+  EXPECT_NE(lines.find("t.csv:10000002: more than 10000000 lines after the header, the limit for a track"),
+            std::string::npos)
+      << lines;
+  EXPECT_NE(refusal(dir / "c", with_track("t.csv"), "t_s,x_m,z_m\n" + std::string(10'000'000, '\n'))
+                .find("the track has no rows"),
+            std::string::npos);
+}
+
 TEST(RecordingLimits, RecordedOrientationIsATypedPrior) {
   test::ScratchDir dir("rec-limits");
   fs::create_directories(dir / "r");
