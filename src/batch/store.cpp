@@ -91,8 +91,9 @@ Result<void> store_item(const fs::path& dir, const ItemResult& r, const BatchOpt
 }
 
 std::optional<ItemResult> load_item(const fs::path& dir, const std::string& scan, const BatchOptions& options) {
-  auto text = read_file_bytes(item_json(dir, scan));
-  if (!text || json_nesting_beyond(*text)) return std::nullopt;  // not one this run wrote: run the item again
+  // Not one this run wrote (unreadable, over kMaxJsonBytes, nested too deep): run the item again.
+  auto text = read_whole_file(item_json(dir, scan), "batch item", kMaxJsonBytes);
+  if (!text || json_nesting_beyond(*text)) return std::nullopt;
   try {
     const json j = json::parse(*text);
     if (j.at("format") != kItemFormat || j.at("scan") != scan || j.at("options_sha256") != options_fingerprint(options))
