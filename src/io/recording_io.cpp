@@ -17,6 +17,7 @@
 #include "core/atomic_file.hpp"
 #include "core/sha256.hpp"
 #include "core/text.hpp"
+#include "dem/world.hpp"
 #include "numerics/statistics.hpp"
 
 namespace clumpforge {
@@ -287,7 +288,7 @@ std::optional<std::string> wrong_drop_timing(const Track& track, double height) 
     if (z[i] <= start - 0.2 * fall) ts.push_back(t[i] - t.front()), zs.push_back(z[i]);
   }
   if (zs.size() < 6) return std::nullopt;
-  constexpr double g = 9.81;
+  constexpr double g = kStandardGravity;
   const QuadraticFit fit = fit_quadratic(ts, zs);
   const double acceleration = -2.0 * fit.a;
   // Its standard error from the scatter about the parabola (the quadratic term's, the times
