@@ -57,10 +57,11 @@ std::string did_you_mean(std::string_view input, std::span<const std::string> ca
   return closest(input, candidates);
 }
 
-std::optional<std::string_view> not_a_regular_file(const std::filesystem::path& path) {
+namespace {
+/// What an entry of `type` is when it is there but not a regular file, in words.
+std::optional<std::string_view> irregular_kind(std::filesystem::file_type type) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  switch (fs::status(path, ec).type()) {
+  switch (type) {
     case fs::file_type::regular:
     case fs::file_type::not_found:
       return std::nullopt;
@@ -76,6 +77,12 @@ std::optional<std::string_view> not_a_regular_file(const std::filesystem::path& 
     default:
       return "its kind cannot be told (a loop of links, or no permission to look)";
   }
+}
+}  // namespace
+
+std::optional<std::string_view> not_a_regular_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  return irregular_kind(std::filesystem::status(path, ec).type());
 }
 
 std::optional<std::uintmax_t> size_beyond(const std::filesystem::path& path, std::uintmax_t max_bytes) {
@@ -97,7 +104,7 @@ Result<std::string> read_whole_file(const std::filesystem::path& path, std::stri
   const fs::file_type type = fs::status(path, ec).type();
   if (type == fs::file_type::not_found) return fail(ErrorCode::NotFound, name + ": no such " + kind);
   if (type != fs::file_type::regular && type != fs::file_type::fifo && type != fs::file_type::character)
-    return fail(ErrorCode::InvalidArgument, name + " is not a file: " + std::string(*not_a_regular_file(path)));
+    return fail(ErrorCode::InvalidArgument, name + " is not a file: " + std::string(*irregular_kind(type)));
   if (const auto size = size_beyond(path, max_bytes)) return beyond(std::to_string(*size));
   const std::size_t limit = static_cast<std::size_t>(std::min<std::uintmax_t>(max_bytes, SIZE_MAX - 1));
   auto bytes = read_file_bytes(path, limit + 1);

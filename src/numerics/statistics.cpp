@@ -28,6 +28,10 @@ QuadraticFit fit_quadratic(const std::vector<double>& x, const std::vector<doubl
     sst += std::pow(values(i) - mean, 2);
   }
   fit.r_squared = sst > 0.0 ? 1.0 - sse / sst : 1.0;
+  if (n > 3) {
+    const Eigen::Matrix3d normal = design.transpose() * design;
+    fit.a_standard_error = std::sqrt(sse / static_cast<double>(n - 3) * normal.inverse()(0, 0));
+  }
   if (n > 3 && sse > 0.0) {
     fit.f_statistic = ((sst - sse) / 2.0) / (sse / static_cast<double>(n - 3));
     fit.p_value = f_distribution_upper_tail(fit.f_statistic, 2.0, static_cast<double>(n - 3));

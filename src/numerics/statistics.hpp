@@ -2,6 +2,7 @@
 /// The statistics calibrate and diagnose share: quadratic least squares with R^2 and the
 /// regression F-test, the roots of the fitted curve at a measured value, sample spreads and
 /// medians, and the upper tails of the F and chi^2 distributions.
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -12,6 +13,8 @@ struct QuadraticFit {
   double r_squared = 0.0;
   double f_statistic = 0.0;  ///< (SSR / 2) / (SSE / (n - 3))
   double p_value = 1.0;      ///< of the F-test that the regression explains nothing
+  /// The standard error of `a` from the scatter about the fit (s^2 (X^T X)^-1); NaN below 4 points.
+  double a_standard_error = NAN;
   double operator()(double x) const { return (a * x + b) * x + c; }
 };
 

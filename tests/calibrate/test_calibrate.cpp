@@ -45,6 +45,28 @@ TEST(Statistics, FTestAgainstKnownQuantiles) {
   EXPECT_LT(fit.p_value, 1e-4);
 }
 
+TEST(Statistics, QuadraticFitsStandardErrorOfItsSquareTerm) {
+  // For x symmetric about 0 the x^2 column is orthogonal to x, and a's standard error is the
+  // closed form s / sqrt(sum (x^2 - mean x^2)^2), s^2 = SSE / (n - 3); a scatter four times as
+  // wide gives four times the error, and an exact quadratic none.
+  std::vector<double> x, y, wide, exact;
+  const double scatter[] = {0.3, -0.1, -0.4, 0.2, 0.5, -0.3, 0.1, -0.2, 0.4};
+  for (int i = 0; i < 9; ++i) {
+    x.push_back(i - 4.0);
+    exact.push_back(2.0 * x.back() * x.back() - x.back() + 1.0);
+    y.push_back(exact.back() + scatter[i]);
+    wide.push_back(exact.back() + 4.0 * scatter[i]);
+  }
+  const auto fit = fit_quadratic(x, y);
+  double sse = 0.0, mean_square = 0.0, spread = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) sse += std::pow(y[i] - fit(x[i]), 2), mean_square += x[i] * x[i] / 9.0;
+  for (double v : x) spread += std::pow(v * v - mean_square, 2);
+  EXPECT_NEAR(fit.a_standard_error, std::sqrt(sse / 6.0 / spread), 1e-12);
+  EXPECT_NEAR(fit_quadratic(x, wide).a_standard_error, 4.0 * fit.a_standard_error, 1e-12);
+  EXPECT_NEAR(fit_quadratic(x, exact).a_standard_error, 0.0, 1e-9);
+  EXPECT_TRUE(std::isnan(fit_quadratic({0, 1, 2}, {0, 1, 4}).a_standard_error));
+}
+
 TEST(PaperCalibration, RecoversTheRestitutionThatMadeTheRecording) {
   // A recording made by the DEM with e = 0.55, calibrated by the study's sweep (same seed,
   // so the same orientations: common random numbers) comes back within 0.05.
