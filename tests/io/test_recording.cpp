@@ -512,6 +512,28 @@ TEST(RecordingLimits, ATrackInOtherTimeUnitsThanSecondsIsRefused) {
   }
   EXPECT_NE(refusal(dir / "i", roll, roll_ms).find("(about 1000 times: milliseconds?)"), std::string::npos);
   EXPECT_EQ(refusal(dir / "j", roll, roll_s), "(accepted)");
+  // Where no frame rate is stated, a roll comes down its incline at most a few times slower than
+  // a frictionless slide (1.12 times here; 0.97-2.02 on 1842 stored tracks): in milliseconds,
+  // about 1000 times. Accepted from the release on too, with no still rows before it.
+  const std::string roll_unstated = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+    "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  const std::string unstated_ms = refusal(dir / "p", roll_unstated, roll_ms);
+  EXPECT_NE(unstated_ms.find("t.csv: its tracked point takes 60 s to come from a fifth to four fifths of the way "
+                             "down the 30 deg incline (-23.8 to -5.7 mm), where sliding without friction takes "
+                             "0.0534 s and a roll at most a few times that: t_s must be in seconds (about 1000 "
+                             "times: milliseconds?)"),
+            std::string::npos)
+      << unstated_ms;
+  EXPECT_EQ(refusal(dir / "q", roll_unstated, roll_s), "(accepted)");
+  std::string rolling = "t_s,x_m,z_m\n";
+  for (int i = 5; i < 100; ++i)
+    rolling += fmt::format("{:.3f},{:.5f},0.009\n", 0.004 * i, std::min(0.1, 1.5 * 0.000016 * i * i) - 0.03);
+  EXPECT_EQ(refusal(dir / "r", roll_unstated, rolling), "(accepted)");
+  std::string slow = "t_s,x_m,z_m\n";  // 28 times a slide's time: a creep no roll shows
+  for (int i = 0; i < 100; ++i)
+    slow += fmt::format("{:.3f},{:.5f},0.009\n", 0.1 * i, std::min(0.1, 1.5 * 0.000016 * i * i) - 0.03);
+  const std::string creep = refusal(dir / "s", roll_unstated, slow);
+  EXPECT_NE(creep.find("takes 1.5 s"), std::string::npos) << creep;
   // A tilt whose tilt_deg column rises at another rate than the set-up states; an encoder's
   // 0.1 deg steps are read right.
   const auto tilt = [](double stated) {

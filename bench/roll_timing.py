@@ -1,0 +1,100 @@
+#!/usr/bin/env python3
+"""How long roll tracks take to come down their incline, against a frictionless slide's time.
+
+The recording reader refuses a roll whose tracked point comes from a fifth to four fifths of the
+start distance down the slope in more than 20 times a frictionless slide's time,
+sqrt(2 / (g sin(incline))) (sqrt(0.8 d) - sqrt(0.2 d)) (src/io/recording_io.cpp,
+wrong_roll_timing): a track whose t_s is in milliseconds takes about 1000 times it. This reads
+every roll recording under the folders given (any depth, each a recording.json with its
+tracks), times each track as the reader does (from the median of its first five tracked x
+positions; tracks that do not pass both marks are counted apart) and prints how many, and the
+ratios' least, median, 99th percentile and largest, with the slowest tracks.
+
+  bench/roll_timing.py ../shared/data/lab-like OUT-of-bench_diagnose ...
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import statistics
+
+G = 9.80665  # dem's kStandardGravity
+
+
+def track_xt(path):
+    """The tracked (t, x) of a track file, lost cells left out."""
+    with open(path, newline="", encoding="utf-8-sig") as f:
+        rows = csv.DictReader(f)
+        out = []
+        for row in rows:
+            try:
+                out.append((float(row["t_s"]), float(row["x_m"])))
+            except (TypeError, ValueError):
+                continue
+        return out
+
+
+def ratio(points, incline_deg, start_distance):
+    """The track's time from a fifth to four fifths of the way down, over a slide's; None if not passed."""
+    if len(points) < 10 or incline_deg < 1.0:
+        return None
+    angle = math.radians(incline_deg)
+    run = start_distance * math.cos(angle)
+    start = statistics.median(x for _, x in points[:5])
+    first = next((t for t, x in points if x >= start + 0.2 * run), None)
+    last = next((t for t, x in points if x >= start + 0.8 * run), None)
+    if first is None or last is None:
+        return None
+    slide = math.sqrt(2.0 / (G * math.sin(angle))) * (math.sqrt(0.8 * start_distance) - math.sqrt(0.2 * start_distance))
+    return (last - first) / slide
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("folders", nargs="+")
+    parser.add_argument("--slowest", type=int, default=5, help="how many of the slowest tracks to list")
+    args = parser.parse_args()
+    timed, unpassed, unread = [], 0, 0
+    for folder in args.folders:
+        for root, _, files in os.walk(folder):
+            if "recording.json" not in files:
+                continue
+            try:
+                with open(os.path.join(root, "recording.json"), encoding="utf-8") as f:
+                    manifest = json.load(f)
+                if manifest.get("test") != "roll":
+                    continue
+                setup = manifest["setup"]
+                float(setup["incline_deg"]), float(setup["start_distance_m"])
+            except (OSError, ValueError, RecursionError, KeyError, TypeError, AttributeError):
+                unread += 1  # a damaged manifest (the fuzz cases of a hostile-input test)
+                continue
+            for trial in manifest.get("trials", []):
+                if "track" not in trial:
+                    continue
+                path = os.path.join(root, trial["track"])
+                try:
+                    points = track_xt(path)
+                except (OSError, ValueError, KeyError, csv.Error):
+                    unread += 1
+                    continue
+                r = ratio(points, setup["incline_deg"], setup["start_distance_m"])
+                if r is None:
+                    unpassed += 1
+                else:
+                    timed.append((r, path))
+    if not timed:
+        raise SystemExit("no roll track passes both marks under " + ", ".join(args.folders))
+    values = sorted(r for r, _ in timed)
+    p99 = values[min(len(values) - 1, int(math.ceil(0.99 * len(values))) - 1)]
+    print(f"roll tracks: {len(timed) + unpassed}, timed {len(timed)}, not past four fifths {unpassed}"
+          f" (manifests or tracks not read: {unread})")
+    print(f"time over a frictionless slide's: least {values[0]:.3f}, median {statistics.median(values):.3f}, "
+          f"99th percentile {p99:.3f}, largest {values[-1]:.3f} (the reader refuses beyond 20)")
+    for r, path in sorted(timed, reverse=True)[: args.slowest]:
+        print(f"  {r:8.3f}  {path}")
+
+
+if __name__ == "__main__":
+    main()
