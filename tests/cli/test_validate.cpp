@@ -142,6 +142,33 @@ TEST(MaterialsCli, AFileFromAPipeIsReadAndAnEndlessOneRefused) {
   EXPECT_NE(mesh.err.find(pipe.string() + "' is not a mesh file: a named pipe"), std::string::npos) << mesh.err;
 }
 
+TEST(MaterialsCli, AnEndlessLibraryIsRefusedWithinAFourGigabyteCap) {
+  // /dev/zero named as a clump library is read to the library's 2 GiB limit and refused. Before
+  // stop 100 the bytes' string doubled as it grew (4.2 GB resident), and under a 4 GB cap on
+  // the address space the command ended "internal error: std::bad_alloc"; it now holds at most
+  // 1 GiB and the 2 GiB it moves into. Under a cap too small even for that the refusal still
+  // names the file. (Not in the sanitizer preset: its shadow memory does not fit such a cap.)
+  test::ScratchDir dir("endless-library");
+  const auto export_under = [&](int cap_kb) {
+    return test::run_command(
+        fmt::format("bash -c \"ulimit -v {} && timeout 120 '{}' export /dev/zero --all --format "
+                    "csv -o '{}'\"",
+                    cap_kb, CLUMPFORGE_BINARY, (dir / "out").string()));
+  };
+  const auto capped = export_under(4000000);
+  EXPECT_EQ(capped.exit_code, 1) << capped.err;
+  EXPECT_NE(
+      capped.err.find("'/dev/zero': more than 2147483648 bytes, beyond the limit of 2048 MiB for a clump library"),
+      std::string::npos)
+      << capped.err;
+  const auto small = export_under(2500000);
+  EXPECT_EQ(small.exit_code, 1) << small.err;
+  EXPECT_NE(small.err.find("'/dev/zero': too large to hold in this process's memory, for a clump library"),
+            std::string::npos)
+      << small.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
 TEST(MaterialsCli, ShippedFileIsTheBuiltInTableAndOverridesWork) {
   const auto printed = test::run_clumpforge("materials");
   ASSERT_EQ(printed.exit_code, 0) << printed.err;

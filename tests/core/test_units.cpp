@@ -84,6 +84,12 @@ TEST(Text, AWholeFileReaderReadsAPipeAndRefusesWhatIsTooLargeOrNotAFile) {
   EXPECT_EQ(not_a_regular_file("/dev/null"), "a device");
   EXPECT_EQ(not_a_regular_file(dir / "missing"), std::nullopt);
 
+  // Grown by doubling up to half the limit, then straight to it: /dev/zero read to a 2 GiB
+  // library limit held a 4 GiB string (and the 2 GiB it was copied from) before stop 100.
+  const auto capped = read_file_bytes("/dev/zero", 3 << 20);
+  ASSERT_TRUE(capped);
+  EXPECT_EQ(capped->size(), 3u << 20);
+  EXPECT_LE(capped->capacity(), 3u << 20);
   const auto zeros = read_whole_file("/dev/zero", "materials file", 1 << 20);
   ASSERT_FALSE(zeros);
   EXPECT_EQ(zeros.error().message,
