@@ -27,6 +27,12 @@ Result<void> check_file(const fs::path& path) {
   if (fs::file_size(path, ec) == 0 || ec) {
     return fail(ErrorCode::ParseError, fmt::format("'{}' is empty", path.string()));
   }
+  if (const auto size = size_beyond(path, kMaxMeshBytes)) {
+    return fail(ErrorCode::InvalidArgument,
+                fmt::format("'{}': {} bytes, beyond the limit of {} MiB for a mesh: a particle's scan needs a "
+                            "hundredth of that (decimate it)",
+                            path.string(), *size, kMaxMeshBytes >> 20));
+  }
   return {};
 }
 

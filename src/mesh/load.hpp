@@ -1,6 +1,7 @@
 #pragma once
 /// Reading scans: PLY by clumpforge's own reader (ply.hpp), every other format assimp reads (STL
 /// ascii and binary, OBJ, OFF, ...).
+#include <cstdint>
 #include <filesystem>
 
 #include "core/error.hpp"
@@ -8,6 +9,12 @@
 #include "mesh/triangle_mesh.hpp"
 
 namespace clumpforge {
+
+/// The largest mesh file clumpforge reads: 2 GiB is 43 million triangles of binary STL, a
+/// hundred times a fine particle scan's (the Stanford bunny's 70k triangles are 3 MB of PLY), and
+/// a mesh a recording names is read only from inside its folder, so this bounds what such a file
+/// can make the reader hold.
+inline constexpr std::uintmax_t kMaxMeshBytes = 2ull << 30;
 
 struct LoadOptions {
   LengthUnit unit = LengthUnit::Millimetre;  ///< the file's length unit (STL carries none)
@@ -26,7 +33,8 @@ struct LoadResult {
 
 /// Loads `path`, converts it to metres and welds vertices by position. Fails with a
 /// message naming the file for: a missing file or directory, an empty or unreadable
-/// file, no triangles, non-finite coordinates, coordinates beyond 1 km.
+/// file, one over kMaxMeshBytes (by its size, unread), no triangles, non-finite coordinates,
+/// coordinates beyond 1 km.
 Result<LoadResult> load_mesh(const std::filesystem::path& path, const LoadOptions& options = {});
 
 /// A warning when the body's largest extent is implausible for a particle in `unit`

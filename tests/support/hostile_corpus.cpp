@@ -68,6 +68,9 @@ std::vector<HostileCase> make_hostile_corpus(const fs::path& dir) {
   write_text(dir / "damaged.ply",
              "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\npropert\x82 float y\nproperty float z\n"
              "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n10 0 0\n0 10 0\n3 0 1 2\n");
+  // Past the 2 GiB a mesh may be, refused by its size unread (sparse: made in no time).
+  write_text(dir / "oversized.stl", "solid big\n");
+  fs::resize_file(dir / "oversized.stl", (2ull << 30) + 1);
   fs::create_directories(dir / "folder.stl");
   return {{"empty.stl", "empty"},
           {"truncated.stl", "could not be read"},
@@ -78,6 +81,7 @@ std::vector<HostileCase> make_hostile_corpus(const fs::path& dir) {
           {"triangle.stl", ""},
           {"sheet.stl", ""},
           {"damaged.ply", "line 5: 'propert\\x82' is not a PLY header keyword"},
+          {"oversized.stl", "2147483649 bytes, beyond the limit of 2048 MiB for a mesh"},
           {"folder.stl", "is a directory"},
           {"missing.stl", "no such file"}};
 }
