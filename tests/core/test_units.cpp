@@ -4,9 +4,13 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
+#include <cstdlib>
 #include <fstream>
+#include <stdexcept>
 #include <thread>
 
+#include "core/isolated.hpp"
 #include "core/text.hpp"
 #include "core/units.hpp"
 #include "support/test_support.hpp"
@@ -108,4 +112,33 @@ TEST(Text, AWholeFileReaderReadsAPipeAndRefusesWhatIsTooLargeOrNotAFile) {
   EXPECT_EQ(read_whole_file(dir / "big.json", "calibration", kMaxJsonBytes).value(), "{}");
 }
 
+}  // namespace clumpforge
+
+namespace clumpforge {
+TEST(Isolated, AChildsEndIsToldApartAndItsCrashIsNotTheCallers) {
+  // Work in a child of its own: how it ended, and nothing else, reaches the caller; a crash or a
+  // hang ends the child only. (The clump library reads an unsealed file so: libhdf5 crashed on
+  // some damaged ones.)
+  using std::chrono::milliseconds;
+  int touched = 0;
+  EXPECT_EQ(run_isolated([&] { return ++touched == 1; }, milliseconds(20000)).end, IsolatedEnd::Succeeded);
+  EXPECT_EQ(touched, 0);  // the child's change stays in the child
+  EXPECT_EQ(run_isolated([] { return false; }, milliseconds(20000)).end, IsolatedEnd::Failed);
+  EXPECT_EQ(run_isolated([]() -> bool { throw std::runtime_error("no"); }, milliseconds(20000)).end,
+            IsolatedEnd::Failed);
+  const IsolatedResult aborted = run_isolated([]() -> bool { std::abort(); }, milliseconds(20000));
+  EXPECT_EQ(aborted.end, IsolatedEnd::Crashed);
+  EXPECT_EQ(signal_name(aborted.signal), "SIGABRT");
+  const auto start = std::chrono::steady_clock::now();
+  const IsolatedResult hung = run_isolated(
+      [] {
+        std::this_thread::sleep_for(std::chrono::seconds(30));
+        return true;
+      },
+      milliseconds(300));
+  EXPECT_EQ(hung.end, IsolatedEnd::TimedOut);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+  EXPECT_EQ(signal_name(SIGSEGV), "SIGSEGV");
+  EXPECT_EQ(signal_name(64), "signal 64");
+}
 }  // namespace clumpforge

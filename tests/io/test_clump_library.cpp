@@ -179,6 +179,36 @@ TEST(ClumpLibrary, AnUnsealedLibraryIsStillRead) {
   for (std::size_t i = 0; i < clumps.size(); ++i) expect_identical(clumps[i], (*read)[i]);
 }
 
+TEST(ClumpLibrary, AnUnsealedLibraryThatCrashesLibhdf5IsRefusedNotACrash) {
+  // Unsealed, 11 of the bundled library's HDF5 bytes 1000-1999 changed one at a time (XOR 0x5A)
+  // crashed libhdf5 inside its own calls, and with it the program (bench/damaged_library.py at
+  // stop 99: "crashed 11"). An unsealed library is now read first in a process of its own: each
+  // is refused naming the file, and this test's process lives on to read the next.
+  const std::string sealed =
+      test::read_text(std::filesystem::path(CLUMPFORGE_SOURCE_DIR) / "clumps" / "tuber-default-diagnosis.h5");
+  ASSERT_GT(sealed.size(), 2000u + 512u);
+  test::ScratchDir dir("h5");
+  const auto path = dir / "damaged.h5";
+  for (std::size_t at : {1042, 1043, 1044, 1045, 1046, 1047, 1048, 1049, 1096, 1097, 1106}) {
+    SCOPED_TRACE(at);
+    std::string unsealed = sealed.substr(512);
+    unsealed[at] = static_cast<char>(unsealed[at] ^ 0x5A);
+    test::write_text(path, unsealed);
+    const auto read = read_clump_library(path);
+    ASSERT_FALSE(read);
+    EXPECT_NE(read.error().message.find("'" + path.string() + "' is a damaged HDF5 file: libhdf5 crashed reading it"),
+              std::string::npos)
+        << read.error().message;
+    EXPECT_NE(read.error().message.find("it has no clumpforge seal to be checked by"), std::string::npos);
+  }
+  test::write_text(path, sealed.substr(512));  // the same bytes undamaged: read as they were
+  const auto undamaged = read_clump_library(path);
+  ASSERT_TRUE(undamaged) << undamaged.error().message;
+  EXPECT_EQ(undamaged->size(),
+            read_clump_library(std::filesystem::path(CLUMPFORGE_SOURCE_DIR) / "clumps" / "tuber-default-diagnosis.h5")
+                ->size());
+}
+
 TEST(ClumpLibrary, IsReadFromDiskOnceSoAPipeServes) {
   // The seal is checked on the bytes read, and libhdf5 opens those same bytes from memory: a
   // library that can be read only once (a named pipe; `clumpforge export <(ssh host cat L.h5)`)
