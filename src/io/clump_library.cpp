@@ -436,6 +436,7 @@ Result<void> write_library_file(const fs::path& path, Body&& body) {
     return seal(temporary, path);
   });
 }
+
 // The clumps in a library's bytes, read by libhdf5 from memory (open_image); `bytes` is freed
 // once libhdf5 holds its own copy.
 Result<std::vector<Clump>> clumps_in_image(std::string& bytes, const fs::path& path) {
