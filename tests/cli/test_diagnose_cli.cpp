@@ -174,8 +174,16 @@ TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
     const double t = 0.001 * i, fall = std::min(0.2, 0.5 * 9.81 * std::pow(std::max(0.0, t - 0.05), 2));
     milliseconds += fmt::format("{:.3f},0.001,{:.5f}\n", 1000 * t, 0.21 - fall);
   }
+  // A roll down 30 deg in milliseconds, no frame rate stated: it had no check before stop 100.
+  std::string roll_ms = "t_s,x_m,z_m\n";
+  for (int i = 0; i < 100; ++i) roll_ms += fmt::format("{:.3f},{:.5f},0.009\n", 4.0 * i, 1.5e-6 * 16 * i * i - 0.03);
   const std::vector<std::tuple<std::string, std::string, std::string>> cases{
       {manifest("0.2", "trial-01.csv"), milliseconds, "t_s must be in seconds (about 1000 times: milliseconds?)"},
+      {R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+          "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "trials": [{"id": "01", "track": "trial-01.csv"}]})",
+       roll_ms,
+       "where sliding without friction takes 0.0534 s and a roll at most a few times that: t_s must be in "
+       "seconds (about 1000 times: milliseconds?)"},
       {manifest("0.2", "../outside.csv"), "t_s,x_m,z_m\n0,0,0.2\n", "leaves the recording's folder"},
       {manifest("0.2", "/etc/passwd"), "t_s,x_m,z_m\n0,0,0.2\n", "is absolute"},
       {manifest("1e9", "trial-01.csv"), "t_s,x_m,z_m\n0,0,0.2\n", "must lie in (0, 100] m"},
