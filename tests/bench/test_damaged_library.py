@@ -32,6 +32,17 @@ def test_every_changed_byte_of_a_sealed_library_is_refused(tmp_path):
     assert "sealed: 96 copies" in done.stdout
 
 
+def test_no_changed_byte_of_an_unsealed_library_crashes_clumpforge(tmp_path):
+    # HDF5 bytes 1040-1049 hold eight that crashed libhdf5 unsealed, and with it clumpforge
+    # (SIGSEGV, before stop 100); an unsealed library is now read first in a process of its own.
+    done = run("--library", LIBRARY, "--from", 1040, "--to", 1050, "--json", tmp_path / "out.json")
+    assert done.returncode == 0, done.stderr
+    counts = json.loads((tmp_path / "out.json").read_text())["counts"]
+    assert counts["unsealed"]["crashed"] == 0 and counts["unsealed"]["hung"] == 0
+    assert counts["unsealed"]["refused"] >= 8
+    assert counts["sealed"]["refused"] == 10
+
+
 def test_a_library_without_a_seal_or_with_absurd_options_is_refused(tmp_path):
     unsealed = tmp_path / "unsealed.h5"
     unsealed.write_bytes(LIBRARY.read_bytes()[512:])
