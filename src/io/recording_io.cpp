@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <fstream>
 #include <limits>
@@ -363,6 +364,17 @@ std::optional<std::string> wrong_roll_timing(const Track& track, double start_di
       units_hint(taken / slide, kTimeUnits));
 }
 
+/// Whether a track cell is what tracking software writes where it lost the particle (NaN, NA,
+/// null, ...): the spec's lost cell is empty, so such a cell is refused with that said.
+bool marks_lost_tracking(std::string_view cell) {
+  std::string lower(cell);
+  std::ranges::transform(lower, lower.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (std::string_view word : {"nan", "-nan", "na", "n/a", "null", "none", "-", "--", "?"}) {
+    if (lower == word) return true;
+  }
+  return false;
+}
+
 Result<Track> read_track(const fs::path& path) {
   if (auto ok = within_size(path, RecordingLimits::max_track_bytes, "a track"); !ok) return std::unexpected(ok.error());
   std::ifstream in(path);
@@ -426,8 +438,12 @@ Result<Track> read_track(const fs::path& path) {
         const char* end = begin + cells[k].size();
         auto [ptr, ec] = std::from_chars(begin, end, value);
         if (ec != std::errc{} || ptr != end || !std::isfinite(value)) {
-          return fail(ErrorCode::ParseError, fmt::format("{}:{}: '{}' in column {} is not a number", path.string(),
-                                                         number, cells[k], columns[k]));
+          return fail(
+              ErrorCode::ParseError,
+              fmt::format("{}:{}: '{}' in column {} is not a number{}", path.string(), number, cells[k], columns[k],
+                          marks_lost_tracking(cells[k]) && columns[k] != "t_s"
+                              ? " (where tracking was lost, the spec leaves the cell empty)"
+                              : ""));
         }
       } else if (columns[k] == "t_s") {
         return fail(ErrorCode::ParseError, fmt::format("{}:{}: the time cell is empty", path.string(), number));

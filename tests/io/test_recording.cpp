@@ -132,6 +132,10 @@ TEST(Recording, BadInputNamesFileAndLine) {
        "t_s,x_m,z_m\n0.0,0,0.2\n0.002,0,0.2\n0.001,0,0.2\n", "t.csv:4: time 0.001 does not increase"},
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
        "t_s,x_m,z_m\n0.0,0,abc\n", "t.csv:2: 'abc' in column z_m is not a number"},
+      // Tracking software writes NaN where it lost the particle; the spec's lost cell is empty.
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "t_s,x_m,z_m\n0.0,0,0.2\n0.001,NaN,NaN\n",
+       "t.csv:3: 'NaN' in column x_m is not a number (where tracking was lost, the spec leaves the cell empty)"},
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
        "t_s,x_m,z_m,speed\n0.0,0,0.2,1\n", "t.csv:1: unknown column 'speed'"},
       {"{\"format\": \"recording/1\",\n \"test\": \"drop\" \"surface\": 1}", "", "recording.json:2: not valid JSON"},
