@@ -364,6 +364,20 @@ std::optional<std::string> wrong_roll_timing(const Track& track, double start_di
       units_hint(taken / slide, kTimeUnits));
 }
 
+/// Why a header cell holds several column names, if it does: a spreadsheet saved in a locale
+/// with decimal commas separates its cells with ';', and some tools with tabs.
+std::string separator_hint(std::string_view cell) {
+  const auto hint = [](std::string_view by) {
+    return fmt::format(
+        "; its columns are separated by {}, where the spec's are commas (a spreadsheet's export in a locale "
+        "with decimal commas? the spec's numbers have a decimal point)",
+        by);
+  };
+  if (cell.find(';') != std::string_view::npos) return hint("';'");
+  if (cell.find('\t') != std::string_view::npos) return hint("tabs");
+  return {};
+}
+
 /// Whether a track cell is what tracking software writes where it lost the particle (NaN, NA,
 /// null, ...): the spec's lost cell is empty, so such a cell is refused with that said.
 bool marks_lost_tracking(std::string_view cell) {
@@ -406,8 +420,8 @@ Result<Track> read_track(const fs::path& path) {
       targets.push_back(&track.tilt);
     else {
       return fail(ErrorCode::ParseError,
-                  fmt::format("{}:1: unknown column '{}'{} (t_s, x_m, z_m, angle_rad, tilt_deg)", path.string(), c,
-                              did_you_mean(c, {"t_s", "x_m", "z_m", "angle_rad", "tilt_deg"})));
+                  fmt::format("{}:1: unknown column '{}'{} (t_s, x_m, z_m, angle_rad, tilt_deg){}", path.string(), c,
+                              did_you_mean(c, {"t_s", "x_m", "z_m", "angle_rad", "tilt_deg"}), separator_hint(c)));
     }
   }
   if (!has_t || !has_x || !has_z) {
@@ -428,8 +442,11 @@ Result<Track> read_track(const fs::path& path) {
     while (std::getline(row, cell, ',')) cells.push_back(std::string(trim(cell)));
     if (!line.empty() && line.back() == ',') cells.emplace_back();
     if (cells.size() != columns.size()) {
-      return fail(ErrorCode::ParseError, fmt::format("{}:{}: {} cells where the header has {}", path.string(), number,
-                                                     cells.size(), columns.size()));
+      const bool decimal_commas = cells.size() > columns.size() && line.find('.') == std::string::npos;
+      return fail(
+          ErrorCode::ParseError,
+          fmt::format("{}:{}: {} cells where the header has {}{}", path.string(), number, cells.size(), columns.size(),
+                      decimal_commas ? " (numbers with a decimal comma? the spec's have a decimal point)" : ""));
     }
     for (std::size_t k = 0; k < cells.size(); ++k) {
       double value = std::numeric_limits<double>::quiet_NaN();

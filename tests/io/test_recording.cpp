@@ -132,6 +132,18 @@ TEST(Recording, BadInputNamesFileAndLine) {
        "t_s,x_m,z_m\n0.0,0,0.2\n0.002,0,0.2\n0.001,0,0.2\n", "t.csv:4: time 0.001 does not increase"},
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
        "t_s,x_m,z_m\n0.0,0,abc\n", "t.csv:2: 'abc' in column z_m is not a number"},
+      // A spreadsheet saved where the decimal mark is a comma: ';' between cells, or commas both
+      // between cells and in numbers.
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "t_s;x_m;z_m\n0,0;0;0,2\n",
+       "t.csv:1: unknown column 't_s;x_m;z_m' (t_s, x_m, z_m, angle_rad, tilt_deg); its columns are separated by "
+       "';', where the spec's are commas (a spreadsheet's export in a locale with decimal commas? the spec's numbers "
+       "have a decimal point)"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "t_s\tx_m\tz_m\n0.0\t0\t0.2\n", "its columns are separated by tabs"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "t_s,x_m,z_m\n24,155863,0,007633133,0,2071849\n",
+       "t.csv:2: 6 cells where the header has 3 (numbers with a decimal comma? the spec's have a decimal point)"},
       // Tracking software writes NaN where it lost the particle; the spec's lost cell is empty.
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
        "t_s,x_m,z_m\n0.0,0,0.2\n0.001,NaN,NaN\n",
