@@ -467,8 +467,11 @@ Result<Track> read_track(const fs::path& path) {
       }
       if (const double limit = column_limit(columns[k]); std::abs(value) > limit) {
         return fail(ErrorCode::ParseError,
-                    fmt::format("{}:{}: {:g} in column {} is beyond the limit of +-{:g} {}", path.string(), number,
-                                value, columns[k], limit, column_unit(columns[k])));
+                    fmt::format("{}:{}: {:g} in column {} is beyond the limit of +-{:g} {}{}", path.string(), number,
+                                value, columns[k], limit, column_unit(columns[k]),
+                                columns[k] == "t_s" ? " (its origin is arbitrary: count from the recording's start, "
+                                                      "not from a clock's epoch)"
+                                                    : ""));
       }
       targets[k]->push_back(value);
     }

@@ -309,6 +309,13 @@ TEST(RecordingLimits, TimeBeyond1e9SecondsIsRefused) {
   const std::string m = refusal(dir / "r", with_track("t.csv"), "t_s,x_m,z_m\n0,0,0.2\n2e9,0,0.2\n");
   EXPECT_NE(m.find("t.csv:3"), std::string::npos) << m;
   EXPECT_NE(m.find("+-1e+09 s"), std::string::npos) << m;
+  // A data logger's clock time (seconds since 1970) is a time origin the spec leaves free, but
+  // beyond the limit: the message says to count from the recording's start.
+  const std::string clock = refusal(dir / "r", with_track("t.csv"), "t_s,x_m,z_m\n1733580000.001,0,0.2\n");
+  EXPECT_NE(clock.find("t.csv:2: 1.73358e+09 in column t_s is beyond the limit of +-1e+09 s (its origin is arbitrary: "
+                       "count from the recording's start, not from a clock's epoch)"),
+            std::string::npos)
+      << clock;
 }
 
 TEST(RecordingLimits, ReleaseHeightOutside0To100MetresIsRefused) {
