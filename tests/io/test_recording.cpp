@@ -415,6 +415,40 @@ TEST(RecordingLimits, ARollWhoseTrackEndsUphillIsRefused) {
   EXPECT_EQ(refusal(dir / "c", roll, still), "(accepted)");
 }
 
+TEST(RecordingLimits, ARollSetFarFromWhereItStartsIsRefused) {
+  // x_m is 0 at the foot: a start distance written in millimetres or centimetres under the
+  // spec's metre key (35 for 35 mm) passed every check and ran to `unexplained` before stop 100.
+  // A start nearer the foot than its run by less than 5 cm (a centroid forward of its contact
+  // point, a short incline) and a track filmed on the flat only are read.
+  test::ScratchDir dir("rec");
+  const auto roll_from = [](double start_distance) {
+    return fmt::format(R"({{"format": "recording/1", "test": "roll", "surface": "Q235",
+      "setup": {{"incline_deg": 30, "start_distance_m": {}}}, "trials": [{{"id": "1", "track": "t.csv"}}]}})",
+                       start_distance);
+  };
+  const auto track_from = [](double x0) {
+    std::string out = "t_s,x_m,z_m\n";
+    for (int i = 0; i < 100; ++i) {
+      const double t = 0.004 * i;
+      out += fmt::format("{:.3f},{:.5f},0.009\n", t, x0 + std::min(0.1, 1.5 * t * t));
+    }
+    return out;
+  };
+  const std::string mm = refusal(dir / "a", roll_from(35), track_from(-0.0262));
+  EXPECT_NE(mm.find("t.csv: its tracked point starts 26.1 mm from the foot and reaches it, where a particle set 35 m "
+                    "up a 30 deg incline starts about 30.3 m from the foot: start_distance_m must be in metres, and "
+                    "x_m count from the foot (about 1000 times: millimetres?)"),
+            std::string::npos)
+      << mm;
+  EXPECT_NE(refusal(dir / "b", roll_from(3.5), track_from(-0.0262)).find("(about 100 times: centimetres?)"),
+            std::string::npos);
+  EXPECT_NE(refusal(dir / "c", roll_from(0.2), track_from(-0.01)).find("x_m count from the foot"), std::string::npos);
+  EXPECT_EQ(refusal(dir / "d", roll_from(0.035), track_from(-0.0203)), "(accepted)");  // the tuber on its rim
+  EXPECT_EQ(refusal(dir / "e", roll_from(0.035), track_from(-0.002)), "(accepted)");   // within 5 cm of its run
+  EXPECT_EQ(refusal(dir / "f", roll_from(0.2), track_from(0.01)), "(accepted)");       // filmed on the flat only
+  EXPECT_EQ(refusal(dir / "g", roll_from(0.2), track_from(-0.16)), "(accepted)");
+}
+
 TEST(RecordingLimits, ATrackInOtherUnitsThanMetresIsRefused) {
   // A drop from 0.2 m and a 35 mm roll down 30 deg written in centimetres (or a 0.05 m drop in
   // millimetres) under the spec's metre header stay within the coordinates' 100 m limit: before
