@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""How long roll tracks take to come down their incline, against a frictionless slide's time.
+"""How long roll tracks take to come down their incline, against a frictionless slide's time,
+and how far from the foot they start, against the incline's run.
 
 The recording reader refuses a roll whose tracked point comes from a fifth to four fifths of the
 start distance down the slope in more than 20 times a frictionless slide's time,
@@ -8,7 +9,10 @@ wrong_roll_timing): a track whose t_s is in milliseconds takes about 1000 times 
 every roll recording under the folders given (any depth, each a recording.json with its
 tracks), times each track as the reader does (from the median of its first five tracked x
 positions; tracks that do not pass both marks are counted apart) and prints how many, and the
-ratios' least, median, 99th percentile and largest, with the slowest tracks.
+ratios' least, median, 99th percentile and largest, with the slowest tracks. It also prints how
+far from the foot (x_m is 0 there) each track that starts on the slope and reaches the foot
+starts, over the incline's run: the reader refuses one under 0.25 that is 5 cm or more short of
+the run (a start distance in millimetres).
 
   bench/roll_timing.py ../shared/data/lab-like OUT-of-bench_diagnose ...
 """
@@ -50,12 +54,23 @@ def ratio(points, incline_deg, start_distance):
     return (last - first) / slide
 
 
+def start_fraction(points, incline_deg, start_distance):
+    """How far from the foot the track starts, over the run; None if it does not start on the slope
+    and reach the foot."""
+    if len(points) < 10:
+        return None
+    first = statistics.median(x for _, x in points[:5])
+    if first >= 0.0 or max(x for _, x in points) <= 0.0:
+        return None
+    return -first / (start_distance * math.cos(math.radians(incline_deg)))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--slowest", type=int, default=5, help="how many of the slowest tracks to list")
     args = parser.parse_args()
-    timed, unpassed, unread = [], 0, 0
+    timed, unpassed, unread, starts = [], 0, 0, []
     for folder in args.folders:
         for root, _, files in os.walk(folder):
             if "recording.json" not in files:
@@ -80,6 +95,9 @@ def main():
                     unread += 1
                     continue
                 r = ratio(points, setup["incline_deg"], setup["start_distance_m"])
+                start = start_fraction(points, setup["incline_deg"], setup["start_distance_m"])
+                if start is not None:
+                    starts.append(start)
                 if r is None:
                     unpassed += 1
                 else:
@@ -92,6 +110,10 @@ def main():
           f" (manifests or tracks not read: {unread})")
     print(f"time over a frictionless slide's: least {values[0]:.3f}, median {statistics.median(values):.3f}, "
           f"99th percentile {p99:.3f}, largest {values[-1]:.3f} (the reader refuses beyond 20)")
+    if starts:
+        print(f"start from the foot over the run, {len(starts)} tracks from the slope to the flat: least "
+              f"{min(starts):.3f}, median {statistics.median(starts):.3f}, largest {max(starts):.3f} (the reader "
+              f"refuses under 0.25 when 5 cm short)")
     for r, path in sorted(timed, reverse=True)[: args.slowest]:
         print(f"  {r:8.3f}  {path}")
 

@@ -243,10 +243,10 @@ std::optional<std::string> wrong_roll_track(const Track& track, double start_dis
         descent, start_distance, incline_deg, rise, units_hint(descent / std::max(rise, 1e-3), kLengthUnits));
   }
   // x_m is 0 at the foot (the spec): a particle set start_distance up the slope starts about
-  // its run from the foot (0.67-0.98 of it on 2226 stored tracks: the centroid sits forward of
-  // the contact point). One that starts on the slope within a quarter of that and reaches the
-  // foot, 5 cm or more short of the run, had its start distance written in other units (35 for
-  // 35 mm ran to `unexplained`, every check passed) or its x counted from elsewhere.
+  // its run from the foot (0.67-0.98 of it on 1842 stored tracks, bench/roll_timing.py: the
+  // centroid sits forward of the contact point). One that starts on the slope within a quarter
+  // of that and reaches the foot, 5 cm or more short of the run, had its start distance written
+  // in other units (100 for 100 mm passed every check) or its x counted from elsewhere.
   const double first = median({x.begin(), x.begin() + 5});
   if (first < 0.0 && std::ranges::max(x) > 0.0 && -first < 0.25 * run && run + first > 0.05) {
     return fmt::format(

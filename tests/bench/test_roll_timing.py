@@ -27,9 +27,14 @@ def figures(text):
 
 
 def test_lab_likes_rolls_lie_within_the_readers_bound():
-    total, timed, (least, median, _, largest) = figures(run(LAB_LIKE))
+    out = run(LAB_LIKE)
+    total, timed, (least, median, _, largest) = figures(out)
     assert total == timed == 26 * 3 * 6  # 26 cases, three roll set-ups, six trials
     assert 0.9 < least <= median < largest < 20.0
+    starts = re.search(r"start from the foot over the run, (\d+) tracks .*: least ([\d.]+), median ([\d.]+), "
+                       r"largest ([\d.]+)", out)
+    assert int(starts[1]) == total
+    assert 0.25 < float(starts[2]) <= float(starts[3]) <= float(starts[4]) < 1.0
 
 
 def test_a_roll_in_milliseconds_takes_a_thousand_times_as_long(tmp_path):

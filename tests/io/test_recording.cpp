@@ -417,7 +417,8 @@ TEST(RecordingLimits, ARollWhoseTrackEndsUphillIsRefused) {
 
 TEST(RecordingLimits, ARollSetFarFromWhereItStartsIsRefused) {
   // x_m is 0 at the foot: a start distance written in millimetres or centimetres under the
-  // spec's metre key (35 for 35 mm) passed every check and ran to `unexplained` before stop 100.
+  // spec's metre key passed every check before stop 100 (the bundled 100 mm roll as 100 or 10
+  // ended in "rolling friction -nan must be in [0, 10]", naming neither file nor key).
   // A start nearer the foot than its run by less than 5 cm (a centroid forward of its contact
   // point, a short incline) and a track filmed on the flat only are read.
   test::ScratchDir dir("rec");
