@@ -346,21 +346,25 @@ std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
       rate, track.tilt[*first], track.tilt[*upper], stated, units_hint(stated / rate, kTimeUnits));
 }
 
-/// What is wrong with a roll's track that comes down its incline far more slowly than any roll
-/// does, or nothing. Released from rest, the particle's centroid gains speed along the slope at
-/// most at g sin(incline) (the plate pushes at right angles to it and friction holds back), so
-/// coming from a fifth to four fifths of the start distance down the slope takes at least
-/// sqrt(2 / (g sin)) (sqrt(0.8 d) - sqrt(0.2 d)), a frictionless slide's time. The 1842 roll
-/// tracks of the development machine (lab-like and its 250 fps filming, the generated sets of the
-/// tuber and the sphere with every effect) take 0.97-2.02 times that; one that takes more than 20 times it is a track
-/// in other time units (in milliseconds: about 1000 times). This holds where the manifest states no frame rate. Judged
-/// on inclines of 1 deg or more whose tracked point passes both marks, 10 or more positions.
+/// What is wrong with a roll's track that comes down its incline far faster or far more slowly
+/// than any roll does, or nothing. Released from rest, the particle's centroid gains speed along
+/// the slope at most at g sin(incline) (the plate pushes at right angles to it and friction
+/// holds back; by energy, a body tipping over lowers its centroid a few millimetres more), so
+/// coming from a fifth to four fifths of the start distance down the slope takes about
+/// sqrt(2 / (g sin)) (sqrt(0.8 d) - sqrt(0.2 d)) at least, a frictionless slide's time. The 1842
+/// roll tracks of the development machine (lab-like and its 250 fps filming, the generated sets
+/// of the tuber and the sphere with every effect; bench/roll_timing.py) take 0.97-2.02 times
+/// that. One that takes more than 20 times it is a track in other time units (in milliseconds:
+/// about 1000 times), where the manifest states no frame rate too (judged on inclines of 1 deg or
+/// more); one that takes less than 0.4 of it came down a steeper incline than the set-up states
+/// (an incline_deg in radians: about 0.16). Judged where the tracked point passes both marks,
+/// 10 or more positions.
 std::optional<std::string> wrong_roll_timing(const Track& track, double start_distance, double incline_deg) {
   std::vector<double> t, x;
   for (std::size_t i = 0; i < track.size(); ++i) {
     if (std::isfinite(track.x[i])) t.push_back(track.t[i]), x.push_back(track.x[i]);
   }
-  if (x.size() < 10 || incline_deg < 1.0) return std::nullopt;
+  if (x.size() < 10) return std::nullopt;
   const double angle = incline_deg * std::numbers::pi / 180.0, run = start_distance * std::cos(angle);
   const double start = median({x.begin(), x.begin() + 5});
   const auto from = std::ranges::find_if(x, [&](double v) { return v >= start + 0.2 * run; });
@@ -369,13 +373,22 @@ std::optional<std::string> wrong_roll_timing(const Track& track, double start_di
   const double taken = t[static_cast<std::size_t>(to - x.begin())] - t[static_cast<std::size_t>(from - x.begin())];
   const double slide = std::sqrt(2.0 / (kStandardGravity * std::sin(angle))) *
                        (std::sqrt(0.8 * start_distance) - std::sqrt(0.2 * start_distance));
-  if (taken <= 20.0 * slide) return std::nullopt;
-  return fmt::format(
+  const std::string stretch = fmt::format(
       "its tracked point takes {:.4g} s to come from a fifth to four fifths of the way down the {:g} deg incline "
-      "({:.1f} to {:.1f} mm), where sliding without friction takes {:.3g} s and a roll at most a few times that: t_s "
-      "must be in seconds{}",
-      taken, incline_deg, (start + 0.2 * run) * 1e3, (start + 0.8 * run) * 1e3, slide,
-      units_hint(taken / slide, kTimeUnits));
+      "({:.1f} to {:.1f} mm), where sliding without friction takes {:.3g} s",
+      taken, incline_deg, (start + 0.2 * run) * 1e3, (start + 0.8 * run) * 1e3, slide);
+  if (taken < 0.4 * slide) {
+    return fmt::format(
+        "{} and nothing released from rest comes down faster: incline_deg must be the incline in "
+        "degrees{}",
+        stretch,
+        incline_deg < 1.6
+            ? fmt::format(" ({:g} rad is {:.3g} deg?)", incline_deg, incline_deg * 180.0 / std::numbers::pi)
+            : std::string());
+  }
+  if (incline_deg < 1.0 || taken <= 20.0 * slide) return std::nullopt;
+  return fmt::format("{} and a roll at most a few times that: t_s must be in seconds{}", stretch,
+                     units_hint(taken / slide, kTimeUnits));
 }
 
 /// Why a header cell holds several column names, if it does: a spreadsheet saved in a locale

@@ -450,6 +450,37 @@ TEST(RecordingLimits, ARollSetFarFromWhereItStartsIsRefused) {
   EXPECT_EQ(refusal(dir / "g", roll_from(0.2), track_from(-0.16)), "(accepted)");
 }
 
+TEST(RecordingLimits, ARollFasterThanAFrictionlessSlideIsRefused) {
+  // Released from rest, nothing comes down an incline faster than a frictionless slide: a roll
+  // whose set-up gives its 30 deg incline in radians (0.5236) comes down 6 times too fast for
+  // it. Before stop 100 it was read. The same roll stated in degrees is read, and so is one 0.45
+  // of a slide's time (a body tipping over lowers its centroid further).
+  test::ScratchDir dir("rec");
+  const auto roll_down = [](double incline) {
+    return fmt::format(R"({{"format": "recording/1", "test": "roll", "surface": "Q235",
+      "setup": {{"incline_deg": {}, "start_distance_m": 0.035}}, "trials": [{{"id": "1", "track": "t.csv"}}]}})",
+                       incline);
+  };
+  const auto track_at = [](double acceleration) {
+    std::string out = "t_s,x_m,z_m\n";
+    for (int i = 0; i < 200; ++i) {
+      const double t = 0.002 * i;
+      out += fmt::format("{:.3f},{:.5f},0.009\n", t, std::min(0.1, 0.5 * acceleration * t * t) - 0.03);
+    }
+    return out;
+  };
+  const double slide_x = 9.80665 * std::sin(std::numbers::pi / 6) * std::cos(std::numbers::pi / 6);  // along x
+  const std::string radians = refusal(dir / "a", roll_down(0.5236), track_at(3.0));
+  EXPECT_NE(radians.find("where sliding without friction takes 0.395 s and nothing released from rest comes down "
+                         "faster: incline_deg must be the incline in degrees (0.5236 rad is 30 deg?)"),
+            std::string::npos)
+      << radians;
+  EXPECT_EQ(refusal(dir / "b", roll_down(30), track_at(3.0)), "(accepted)");
+  EXPECT_EQ(refusal(dir / "c", roll_down(30), track_at(slide_x / (0.45 * 0.45))), "(accepted)");
+  EXPECT_NE(refusal(dir / "d", roll_down(30), track_at(slide_x / (0.35 * 0.35))).find("nothing released from rest"),
+            std::string::npos);
+}
+
 TEST(RecordingLimits, ATrackInOtherUnitsThanMetresIsRefused) {
   // A drop from 0.2 m and a 35 mm roll down 30 deg written in centimetres (or a 0.05 m drop in
   // millimetres) under the spec's metre header stay within the coordinates' 100 m limit: before
