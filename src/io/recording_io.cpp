@@ -216,6 +216,13 @@ std::optional<std::string> wrong_drop_track(const Track& track, double height) {
         "z_m must be the height, up positive",
         rise * 1e3, fall * 1e3, height);
   }
+  const std::string hint = fall > 0.0 ? units_hint(height / fall, kLengthUnits) : std::string();
+  if (!hint.empty() && fall >= 0.02) {  // it fell, by the release height in other units
+    return fmt::format(
+        "its tracked point falls {:.1f} mm, where a drop from {:g} m falls about that far: the set-up's "
+        "release_height_m must be in metres{}",
+        fall * 1e3, height, hint);
+  }
   return fmt::format(
       "its tracked point falls only {:.1f} mm, where a drop from {:g} m falls about that far: not this drop's track "
       "(a still frame, the wrong file, or other units)",

@@ -394,6 +394,14 @@ TEST(RecordingLimits, ADropWhoseTrackDoesNotFallIsRefused) {
   EXPECT_NE(refusal(dir / "b", with_track("t.csv"), rising).find("z_m must be the height, up positive"),
             std::string::npos);
   EXPECT_EQ(refusal(dir / "c", with_track("t.csv"), falling), "(accepted)");
+  // The set-up's height in centimetres (20 for 0.2 m): the track falls, a hundredth as far.
+  const std::string in_cm = R"({"format": "recording/1", "test": "drop", "surface": "Q235",
+    "setup": {"release_height_m": 20}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  const std::string cm = refusal(dir / "d", in_cm, falling);
+  EXPECT_NE(cm.find("t.csv: its tracked point falls 194.2 mm, where a drop from 20 m falls about that far: the "
+                    "set-up's release_height_m must be in metres (about 100 times: centimetres?)"),
+            std::string::npos)
+      << cm;
 }
 
 TEST(RecordingLimits, ARollWhoseTrackEndsUphillIsRefused) {
