@@ -461,8 +461,8 @@ TEST(RecordingLimits, ARollSetFarFromWhereItStartsIsRefused) {
 TEST(RecordingLimits, ARollFasterThanAFrictionlessSlideIsRefused) {
   // Released from rest, nothing comes down an incline faster than a frictionless slide: a roll
   // whose set-up gives its 30 deg incline in radians (0.5236) comes down 6 times too fast for
-  // it. Before stop 100 it was read. The same roll stated in degrees is read, and so is one 0.45
-  // of a slide's time (a body tipping over lowers its centroid further).
+  // it. Before stop 100 lab-like's roll so stated ran 40 s to `unexplained`. The same roll stated in degrees is read,
+  // and so is one 0.45 of a slide's time (a body tipping over lowers its centroid further).
   test::ScratchDir dir("rec");
   const auto roll_down = [](double incline) {
     return fmt::format(R"({{"format": "recording/1", "test": "roll", "surface": "Q235",
