@@ -347,6 +347,13 @@ std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
   if (first == rows.end() || upper == rows.end() || *upper <= *first) return std::nullopt;
   const double rate = (track.tilt[*upper] - track.tilt[*first]) / (track.t[*upper] - track.t[*first]);
   if (rate >= 0.5 * stated && rate <= 2.0 * stated) return std::nullopt;
+  const double per_radian = 180.0 / std::numbers::pi;
+  if (rate >= 0.5 * per_radian * stated && rate <= 2.0 * per_radian * stated) {
+    return fmt::format(
+        "its plate tilts at {:.4g} deg/s (tilt_deg from {:.3g} to {:.3g} deg), where the set-up's "
+        "tilt_rate_deg_per_s is {:g}: the rate must be in deg/s ({:g} rad/s is {:.3g} deg/s?)",
+        rate, track.tilt[*first], track.tilt[*upper], stated, stated, stated * per_radian);
+  }
   return fmt::format(
       "its plate tilts at {:.4g} deg/s (tilt_deg from {:.3g} to {:.3g} deg), where the set-up's "
       "tilt_rate_deg_per_s is {:g}: t_s must be in seconds{}",

@@ -652,6 +652,12 @@ TEST(RecordingLimits, ATrackInOtherTimeUnitsThanSecondsIsRefused) {
             std::string::npos)
       << tilt_ms;
   EXPECT_NE(refusal(dir / "l", tilt(2), plate(1, 0.001)).find("its plate tilts at 5 deg/s"), std::string::npos);
+  // The rate stated in rad/s (5 deg/s is 0.0873 rad/s): the units named, not the time column.
+  const std::string radians = refusal(dir / "l2", tilt(0.0873), plate(1, 0.001));
+  EXPECT_NE(radians.find("where the set-up's tilt_rate_deg_per_s is 0.0873: the rate must be in deg/s (0.0873 rad/s "
+                         "is 5 deg/s?)"),
+            std::string::npos)
+      << radians;
   EXPECT_EQ(refusal(dir / "m", tilt(5), plate(1, 0.001)), "(accepted)");
   EXPECT_EQ(refusal(dir / "n", tilt(5), plate(1, 0.1)), "(accepted)");
 }
