@@ -4,8 +4,8 @@ and how far from the foot they start, against the incline's run.
 
 The recording reader refuses a roll whose tracked point comes from a fifth to four fifths of the
 start distance down the slope in more than 20 times a frictionless slide's time,
-sqrt(2 / (g sin(incline))) (sqrt(0.8 d) - sqrt(0.2 d)), or in less than 0.4 of it
-(src/io/recording_io.cpp, wrong_roll_timing): a track whose t_s is in milliseconds takes about
+sqrt(2 / (g sin(incline))) (sqrt(0.8 d) - sqrt(0.2 d)), or, starting in the slope's upper half,
+in less than 0.4 of it (src/io/recording_io.cpp, wrong_roll_timing): a track whose t_s is in milliseconds takes about
 1000 times it, and one whose incline_deg is in radians about 0.16. This reads
 every roll recording under the folders given (any depth, each a recording.json with its
 tracks), times each track as the reader does (from the median of its first five tracked x
@@ -110,7 +110,7 @@ def main():
     print(f"roll tracks: {len(timed) + unpassed}, timed {len(timed)}, not past four fifths {unpassed}"
           f" (manifests or tracks not read: {unread})")
     print(f"time over a frictionless slide's: least {values[0]:.3f}, median {statistics.median(values):.3f}, "
-          f"99th percentile {p99:.3f}, largest {values[-1]:.3f} (the reader refuses below 0.4 and beyond 20)")
+          f"99th percentile {p99:.3f}, largest {values[-1]:.3f} (the reader refuses below 0.4 from the upper half of the slope, and beyond 20)")
     if starts:
         print(f"start from the foot over the run, {len(starts)} tracks from the slope to the flat: least "
               f"{min(starts):.3f}, median {statistics.median(starts):.3f}, largest {max(starts):.3f} (the reader "

@@ -487,6 +487,13 @@ TEST(RecordingLimits, ARollFasterThanAFrictionlessSlideIsRefused) {
   EXPECT_EQ(refusal(dir / "c", roll_down(30), track_at(slide_x / (0.45 * 0.45))), "(accepted)");
   EXPECT_NE(refusal(dir / "d", roll_down(30), track_at(slide_x / (0.35 * 0.35))).find("nothing released from rest"),
             std::string::npos);
+  // A track filmed from the foot on, down a 60 deg incline: it starts at the speed the slope gave,
+  // 2.4 m/s after a 0.35 m start, and covers the marks in 0.34 of a slide's time from rest.
+  std::string flat = "t_s,x_m,z_m\n";
+  for (int i = 0; i < 200; ++i) flat += fmt::format("{:.3f},{:.5f},0.009\n", 0.002 * i, 0.001 + 2.4 * 0.002 * i);
+  const std::string steep = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+    "setup": {"incline_deg": 60, "start_distance_m": 0.35}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  EXPECT_EQ(refusal(dir / "e", steep, flat), "(accepted)");
 }
 
 TEST(RecordingLimits, ATrackInOtherUnitsThanMetresIsRefused) {
