@@ -60,8 +60,9 @@ class ManifestReader {
             fmt::format("'{}' is {}: it must lie in {}{}, {}] {}", key, v, closed_low ? "[" : "(", low, high, unit));
     }
     if (v > high)
-      error(key, fmt::format("'{}' is {}: it must lie in {}{}, {}] {} (no experiment exceeds that)", key, v,
-                             closed_low ? "[" : "(", low, high, unit));
+      error(key, fmt::format("'{}' is {}: it must lie in {}{}, {}] {} (no experiment exceeds that{})", key, v,
+                             closed_low ? "[" : "(", low, high, unit,
+                             unit == "m" && v <= 1000.0 * high ? "; a length in millimetres?" : ""));
     return v;
   }
   std::string string(const json& object, const char* key) const {

@@ -324,7 +324,15 @@ TEST(RecordingLimits, ReleaseHeightOutside0To100MetresIsRefused) {
   m.replace(m.find("0.2}"), 3, "1e9");
   const std::string message = refusal(dir / "r", m);
   EXPECT_NE(message.find("recording.json:1"), std::string::npos) << message;
-  EXPECT_NE(message.find("must lie in (0, 100] m"), std::string::npos) << message;
+  EXPECT_NE(message.find("must lie in (0, 100] m (no experiment exceeds that)"), std::string::npos) << message;
+  // 200 for a 0.2 m drop: millimetres under the metre key, named as such.
+  m = with_track("t.csv");
+  m.replace(m.find("0.2}"), 3, "200");
+  const std::string mm = refusal(dir / "r", m);
+  EXPECT_NE(mm.find("'release_height_m' is 200: it must lie in (0, 100] m (no experiment exceeds that; a length in "
+                    "millimetres?)"),
+            std::string::npos)
+      << mm;
   m = with_track("t.csv");
   m.replace(m.find("0.2}"), 3, "0");
   EXPECT_NE(refusal(dir / "r", m).find("must be positive"), std::string::npos);
