@@ -1137,6 +1137,9 @@ Result<CalibratedModel> calibrate_outcomes(const Evaluator& ev, const std::vecto
       r(j) = target(j) - s(j, 0);
     }
     Eigen::VectorXd step = solve_coefficients(s.rightCols(k), r, w);
+    // Outcomes a replay could not give (a roll set far beyond any lab's start) leave the surrogate
+    // without a finite step: the fit ends where it stands, not at a coefficient that is NaN.
+    if (!step.allFinite()) break;
     double shrink = 1.0;
     for (Eigen::Index q = 0; q < k; ++q)
       if (std::abs(step(q)) > radius(q)) shrink = std::min(shrink, radius(q) / std::abs(step(q)));

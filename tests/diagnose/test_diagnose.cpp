@@ -95,6 +95,21 @@ TEST(DiagnoseInputs, ARecordingOfAnotherDensityThanTheClumpIsRefusedBeforeAnyRep
   EXPECT_TRUE(within->summaries_only);
 }
 
+TEST(DiagnoseInputs, ARollSetFarBeyondAnyLabsStartEndsInAVerdictNotANaN) {
+  // The bundled 100 mm roll with its start distance 10 m (the reader refuses that since stop
+  // 100; a program calling the library need not read one): the outcomes' calibration took a
+  // surrogate step that was not finite, and the diagnosis ended "tuber on Q235: rolling friction
+  // -nan must be in [0, 10]". The fit now ends where it stands, and the diagnosis gives a verdict.
+  auto roll = read_recording(test::source_dir() / "clumps" / "tuber-default-diagnosis" / "recordings" / "roll-100mm");
+  ASSERT_TRUE(roll) << roll.error().message;
+  roll->start_distance = 10.0;
+  auto result = diagnose(diagnosis_clump(), default_material_table(), {*roll}, {"roll-100mm"}, DiagnoseOptions{});
+  ASSERT_TRUE(result) << result.error().message;
+  for (const auto& base : result->improved) {
+    EXPECT_TRUE(std::isfinite(base.interaction.rolling_friction)) << base.surface;
+  }
+}
+
 TEST(DiagnoseMeasurement, NoiseLevelFromThirdDifferences) {
   // The median absolute third difference recovers sigma within 5 % (600 differences).
   for (double sigma : {2e-5, 1e-4, 5e-4}) {
