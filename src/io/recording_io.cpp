@@ -176,6 +176,16 @@ std::vector<double> tracked(const std::vector<double>& column) {
   return out;
 }
 
+/// A track column's tracked values and their times (lost cells left out).
+std::pair<std::vector<double>, std::vector<double>> tracked_with_times(const Track& track,
+                                                                       const std::vector<double>& column) {
+  std::pair<std::vector<double>, std::vector<double>> out;
+  for (std::size_t i = 0; i < track.size(); ++i) {
+    if (std::isfinite(column[i])) out.first.push_back(track.t[i]), out.second.push_back(column[i]);
+  }
+  return out;
+}
+
 /// How far a track's tracked point falls or rises beyond what a test allows, as a factor
 /// between units, in words: "(x100: centimetres?)". A track written in centimetres or millimetres
 /// under a metre header moves 100 or 1000 times as far; one within the coordinates' limit (100 m)
@@ -298,10 +308,7 @@ std::optional<std::string> wrong_frame_spacing(const Track& track, double frame_
 /// fall's last fifth can hold the first contact) with 6 or more heights in that stretch.
 std::optional<std::string> wrong_drop_timing(const Track& track, double height) {
   if (height < 0.05) return std::nullopt;
-  std::vector<double> t, z;
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    if (std::isfinite(track.z[i])) t.push_back(track.t[i]), z.push_back(track.z[i]);
-  }
+  const auto [t, z] = tracked_with_times(track, track.z);
   if (z.size() < 10) return std::nullopt;
   const double start = median({z.begin(), z.begin() + 5});
   const double fall = start - std::ranges::min(z);
@@ -375,10 +382,7 @@ std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
 /// incline than the set-up states (an incline_deg in radians: about 0.16). Judged where the
 /// tracked point passes both marks, 10 or more positions.
 std::optional<std::string> wrong_roll_timing(const Track& track, double start_distance, double incline_deg) {
-  std::vector<double> t, x;
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    if (std::isfinite(track.x[i])) t.push_back(track.t[i]), x.push_back(track.x[i]);
-  }
+  const auto [t, x] = tracked_with_times(track, track.x);
   if (x.size() < 10) return std::nullopt;
   const double angle = incline_deg * std::numbers::pi / 180.0, run = start_distance * std::cos(angle);
   const double start = median({x.begin(), x.begin() + 5});
