@@ -186,6 +186,22 @@ std::pair<std::vector<double>, std::vector<double>> tracked_with_times(const Tra
   return out;
 }
 
+/// Where a tracked column starts, camera noise aside: the median of its first five values.
+double start_of(const std::vector<double>& tracked_values) {
+  return median({tracked_values.begin(), tracked_values.begin() + 5});
+}
+
+/// A roll set-up's start distance along its incline, in its horizontal run and its rise.
+struct InclineLegs {
+  double angle;  // rad
+  double run;    // m
+  double rise;   // m
+};
+InclineLegs incline_legs(double start_distance, double incline_deg) {
+  const double angle = incline_deg * std::numbers::pi / 180.0;
+  return {angle, start_distance * std::cos(angle), start_distance * std::sin(angle)};
+}
+
 /// How far a track's tracked point falls or rises beyond what a test allows, as a factor
 /// between units, in words: "(x100: centimetres?)". A track written in centimetres or millimetres
 /// under a metre header moves 100 or 1000 times as far; one within the coordinates' limit (100 m)
@@ -211,7 +227,7 @@ constexpr std::array<std::pair<double, const char*>, 2> kTimeUnits{{{1000.0, "mi
 std::optional<std::string> wrong_drop_track(const Track& track, double height) {
   const std::vector<double> z = tracked(track.z);
   if (z.size() < 10) return std::nullopt;
-  const double start = median({z.begin(), z.begin() + 5});
+  const double start = start_of(z);
   const auto [low, high] = std::ranges::minmax(z);
   const double fall = start - low, rise = high - start;
   if (fall > 2.0 * height + 0.05) {
@@ -251,9 +267,8 @@ std::optional<std::string> wrong_drop_track(const Track& track, double height) {
 std::optional<std::string> wrong_roll_track(const Track& track, double start_distance, double incline_deg) {
   const std::vector<double> x = tracked(track.x), z = tracked(track.z);
   if (x.size() < 10 || z.size() < 10) return std::nullopt;
-  const double angle = incline_deg * std::numbers::pi / 180.0;
-  const double run = start_distance * std::cos(angle), rise = start_distance * std::sin(angle);
-  const double descent = median({z.begin(), z.begin() + 5}) - std::ranges::min(z);
+  const auto [angle, run, rise] = incline_legs(start_distance, incline_deg);
+  const double descent = start_of(z) - std::ranges::min(z);
   if (descent > 2.0 * rise + 0.05) {
     return fmt::format(
         "its tracked point comes down {:.4g} m, where a roll from {:g} m along a {:g} deg incline comes down about "
@@ -265,7 +280,7 @@ std::optional<std::string> wrong_roll_track(const Track& track, double start_dis
   // centroid sits forward of the contact point). One that starts on the slope within a quarter
   // of that and reaches the foot, 5 cm or more short of the run, had its start distance written
   // in other units (100 for 100 mm passed every check) or its x counted from elsewhere.
-  const double first = median({x.begin(), x.begin() + 5});
+  const double first = start_of(x);
   if (first < 0.0 && std::ranges::max(x) > 0.0 && -first < 0.25 * run && run + first > 0.05) {
     return fmt::format(
         "its tracked point starts {:.1f} mm from the foot and reaches it, where a particle set {:g} m up a {:g} deg "
@@ -310,7 +325,7 @@ std::optional<std::string> wrong_drop_timing(const Track& track, double height) 
   if (height < 0.05) return std::nullopt;
   const auto [t, z] = tracked_with_times(track, track.z);
   if (z.size() < 10) return std::nullopt;
-  const double start = median({z.begin(), z.begin() + 5});
+  const double start = start_of(z);
   const double fall = start - std::ranges::min(z);
   std::vector<double> ts, zs;
   for (std::size_t i = 0; i < z.size() && z[i] >= start - 0.8 * fall; ++i) {
@@ -384,8 +399,8 @@ std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
 std::optional<std::string> wrong_roll_timing(const Track& track, double start_distance, double incline_deg) {
   const auto [t, x] = tracked_with_times(track, track.x);
   if (x.size() < 10) return std::nullopt;
-  const double angle = incline_deg * std::numbers::pi / 180.0, run = start_distance * std::cos(angle);
-  const double start = median({x.begin(), x.begin() + 5});
+  const auto [angle, run, rise] = incline_legs(start_distance, incline_deg);
+  const double start = start_of(x);
   const auto from = std::ranges::find_if(x, [&](double v) { return v >= start + 0.2 * run; });
   const auto to = std::ranges::find_if(x, [&](double v) { return v >= start + 0.8 * run; });
   if (to == x.end()) return std::nullopt;
