@@ -314,19 +314,48 @@ std::optional<std::string> wrong_frame_spacing(const Track& track, double frame_
       ratio / frame_rate, frame_rate, 1.0 / frame_rate, units_hint(ratio, kTimeUnits));
 }
 
+/// What is wrong with the timing of a drop from under 5 cm, or nothing. Its fall can end in the
+/// first contact (a flattened body landing on its edge tips over and lowers its centroid a few
+/// millimetres more), so its heights are not held to a parabola; the time they take to come from
+/// a fifth to four fifths of the fall is held to a free fall's across the same stretch. Tipping
+/// takes a fraction of a second, a free fall across a 1 cm stretch 20 ms: more than 100 times a
+/// free fall's time and 1 s is a track in other time units (in milliseconds about 1000 times, or
+/// more where it tips), stated frame rate or not. Judged on falls of 1 cm or more.
+std::optional<std::string> wrong_short_fall_timing(const std::vector<double>& t, const std::vector<double>& z,
+                                                   double start, double fall) {
+  if (fall < 0.01) return std::nullopt;
+  // From the last height above a fifth of the fall before the first below four fifths: a noisy
+  // height in a long still stretch before the release does not stretch it.
+  const auto to = std::ranges::find_if(z, [&](double v) { return v < start - 0.8 * fall; });
+  if (to == z.end()) return std::nullopt;
+  const auto above =
+      std::find_if(std::make_reverse_iterator(to), z.rend(), [&](double v) { return v > start - 0.2 * fall; });
+  if (above == z.rend()) return std::nullopt;
+  const auto from = static_cast<std::size_t>(std::distance(z.begin(), above.base()) - 1);
+  const double taken = t[static_cast<std::size_t>(to - z.begin())] - t[from];
+  const double free_fall = std::sqrt(2.0 / kStandardGravity) * (std::sqrt(0.8 * fall) - std::sqrt(0.2 * fall));
+  if (taken <= std::max(100.0 * free_fall, 1.0)) return std::nullopt;
+  return fmt::format(
+      "its tracked point takes {:.4g} s to come from a fifth to four fifths of its {:.1f} mm fall, where a free "
+      "fall takes {:.3g} s and a body tipping over after it lands a fraction of a second: t_s must be in "
+      "seconds{}",
+      taken, fall * 1e3, free_fall, units_hint(taken / free_fall, kTimeUnits));
+}
+
 /// What is wrong with a drop's track whose fall is not a fall under gravity, or nothing. Released
 /// from rest, the particle falls freely to the plate (air drag takes a few per cent of g from a
 /// tuber at 1 m), so its tracked heights between a fifth and four fifths of the fall lie on a
 /// parabola whose acceleration is g. One outside [g / 3, 3 g] is a track in other time units (a
 /// video's slowed playback time among them) by more than four standard errors of the fit; this
 /// holds where the manifest states no frame rate. Judged on drops of 5 cm or more (a shorter
-/// fall's last fifth can hold the first contact) with 6 or more heights in that stretch.
+/// fall's last fifth can hold the first contact: wrong_short_fall_timing judges those) with 6 or
+/// more heights in that stretch.
 std::optional<std::string> wrong_drop_timing(const Track& track, double height) {
-  if (height < 0.05) return std::nullopt;
   const auto [t, z] = tracked_with_times(track, track.z);
   if (z.size() < 10) return std::nullopt;
   const double start = start_of(z);
   const double fall = start - std::ranges::min(z);
+  if (height < 0.05) return wrong_short_fall_timing(t, z, start, fall);
   std::vector<double> ts, zs;
   for (std::size_t i = 0; i < z.size() && z[i] >= start - 0.8 * fall; ++i) {
     if (z[i] <= start - 0.2 * fall) ts.push_back(t[i] - t.front()), zs.push_back(z[i]);

@@ -613,6 +613,34 @@ TEST(RecordingLimits, ATrackInOtherTimeUnitsThanSecondsIsRefused) {
   }
   EXPECT_EQ(accepted, 200);
   EXPECT_EQ(refused_ms, 200);
+  // A drop from under 5 cm is not held to a parabola (its fall can end in the first contact),
+  // but its time is: a 2 cm drop of a body that lands on its edge and tips over, lowering its
+  // centroid 6 mm more in 0.3 s, filmed at 240 fps with 0.5 mm of noise after 2 s still, is
+  // accepted 200 times in seconds and refused 200 times in milliseconds (before the commit after
+  // 066f65b it was read in milliseconds too).
+  const std::string short_drop = R"({"format": "recording/1", "test": "drop", "surface": "Q235",
+    "setup": {"release_height_m": 0.02}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  std::normal_distribution<double> camera(0.0, 5e-4);
+  int short_accepted = 0, short_refused_ms = 0;
+  std::string short_ms_refusal;
+  for (int trial = 0; trial < 200; ++trial) {
+    std::string seconds = "t_s,x_m,z_m\n", milliseconds = seconds;
+    for (int i = 0; i < 2.6 * 240; ++i) {
+      const double t = i / 240.0, after = std::max(0.0, t - 2.0), free = 0.5 * 9.81 * after * after;
+      const double landed = std::sqrt(2.0 * 0.02 / 9.81), tipped = std::clamp((after - landed) / 0.3, 0.0, 1.0);
+      const double z = 0.03 - std::min(0.02, free) - 0.006 * tipped + camera(rng);
+      seconds += fmt::format("{:.6f},0.001,{:.6f}\n", t, z);
+      milliseconds += fmt::format("{:.6f},0.001,{:.6f}\n", 1000 * t, z);
+    }
+    const std::string verdict = refusal(dir / "s", short_drop, seconds);
+    short_accepted += verdict == "(accepted)";
+    if (verdict != "(accepted)") ADD_FAILURE() << verdict;
+    short_ms_refusal = refusal(dir / "s", short_drop, milliseconds);
+    short_refused_ms += short_ms_refusal.find("t_s must be in seconds") != std::string::npos;
+  }
+  EXPECT_EQ(short_accepted, 200);
+  EXPECT_EQ(short_refused_ms, 200) << short_ms_refusal;
+  EXPECT_NE(short_ms_refusal.find("t.csv: its tracked point takes "), std::string::npos) << short_ms_refusal;
   const std::string roll = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
     "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "camera": {"frame_rate_hz": 250},
     "trials": [{"id": "1", "track": "t.csv"}]})";
