@@ -13,7 +13,10 @@ positions; tracks that do not pass both marks are counted apart) and prints how 
 ratios' least, median, 99th percentile and largest, with the slowest tracks. It also prints how
 far from the foot (x_m is 0 there) each track that starts on the slope and reaches the foot
 starts, over the incline's run: the reader refuses one under 0.25 that is 5 cm or more short of
-the run (a start distance in millimetres).
+the run (a start distance in millimetres). And where each track that comes down 0.8 of the
+incline's rise or more has come half its way down, x over the run, as read and as if x were
+counted from where the particle was released: the reader refuses one beyond +0.25 (x_m not
+counted from the foot; x_not_from_the_foot).
 
   bench/roll_timing.py ../shared/data/lab-like OUT-of-bench_diagnose ...
 """
@@ -27,14 +30,14 @@ import statistics
 G = 9.80665  # dem's kStandardGravity
 
 
-def track_xt(path):
-    """The tracked (t, x) of a track file, lost cells left out."""
+def track_xz(path):
+    """The tracked (t, x, z) of a track file, rows with a lost cell left out."""
     with open(path, newline="", encoding="utf-8-sig") as f:
         rows = csv.DictReader(f)
         out = []
         for row in rows:
             try:
-                out.append((float(row["t_s"]), float(row["x_m"])))
+                out.append((float(row["t_s"]), float(row["x_m"]), float(row["z_m"])))
             except (TypeError, ValueError):
                 continue
         return out
@@ -66,12 +69,28 @@ def start_fraction(points, incline_deg, start_distance):
     return -first / (start_distance * math.cos(math.radians(incline_deg)))
 
 
+def half_way_x(points, incline_deg, start_distance):
+    """Where the track has come half its way down, x over the run, as read and counted from its
+    start; None if it comes down less than 0.8 of the incline's rise."""
+    if len(points) < 10:
+        return None
+    angle = math.radians(incline_deg)
+    run, rise = start_distance * math.cos(angle), start_distance * math.sin(angle)
+    z0 = statistics.median(z for _, _, z in points[:5])
+    x0 = statistics.median(x for _, x, _ in points[:5])
+    descent = z0 - min(z for _, _, z in points)
+    if descent < 0.8 * rise:
+        return None
+    x = next(x for _, x, z in points if z <= z0 - 0.5 * descent)
+    return x / run, (x - x0) / run
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--slowest", type=int, default=5, help="how many of the slowest tracks to list")
     args = parser.parse_args()
-    timed, unpassed, unread, starts = [], 0, 0, []
+    timed, unpassed, unread, starts, halves = [], 0, 0, [], []
     for folder in args.folders:
         for root, _, files in os.walk(folder):
             if "recording.json" not in files:
@@ -91,12 +110,16 @@ def main():
                     continue
                 path = os.path.join(root, trial["track"])
                 try:
-                    points = track_xt(path)
+                    points = track_xz(path)
                 except (OSError, ValueError, KeyError, csv.Error):
                     unread += 1
                     continue
-                r = ratio(points, setup["incline_deg"], setup["start_distance_m"])
-                start = start_fraction(points, setup["incline_deg"], setup["start_distance_m"])
+                xt = [(t, x) for t, x, _ in points]
+                r = ratio(xt, setup["incline_deg"], setup["start_distance_m"])
+                half = half_way_x(points, setup["incline_deg"], setup["start_distance_m"])
+                if half is not None:
+                    halves.append(half)
+                start = start_fraction(xt, setup["incline_deg"], setup["start_distance_m"])
                 if start is not None:
                     starts.append(start)
                 if r is None:
@@ -115,6 +138,12 @@ def main():
         print(f"start from the foot over the run, {len(starts)} tracks from the slope to the flat: least "
               f"{min(starts):.3f}, median {statistics.median(starts):.3f}, largest {max(starts):.3f} (the reader "
               f"refuses under 0.25 when 5 cm short)")
+    if halves:
+        read, released = [h for h, _ in halves], [h for _, h in halves]
+        print(f"half way down at x over the run, {len(halves)} tracks down 0.8 of the rise or more: least "
+              f"{min(read):.3f}, median {statistics.median(read):.3f}, largest {max(read):.3f}; counted from the "
+              f"release: least {min(released):.3f}, median {statistics.median(released):.3f}, largest "
+              f"{max(released):.3f} (the reader refuses beyond 0.25)")
     for r, path in sorted(timed, reverse=True)[: args.slowest]:
         print(f"  {r:8.3f}  {path}")
 

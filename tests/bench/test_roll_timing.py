@@ -1,6 +1,7 @@
 """bench/roll_timing.py (run by ctest, label fast): the independent simulator's roll tracks come
 down their incline within the recording reader's bound (20 times a frictionless slide's time),
-and the same tracks written in milliseconds take 1000 times as long."""
+and the same tracks written in milliseconds take 1000 times as long; half way down each is at
+negative x, and would be far past the foot were x counted from the release."""
 
 import csv
 import pathlib
@@ -35,6 +36,12 @@ def test_lab_likes_rolls_lie_within_the_readers_bound():
                        r"largest ([\d.]+)", out)
     assert int(starts[1]) == total
     assert 0.25 < float(starts[2]) <= float(starts[3]) <= float(starts[4]) < 1.0
+    # Half way down each roll is at negative x, or hardly past the foot; counted from the release,
+    # each is well past it: the reader's bound (0.25 of the run) lies between the two.
+    halves = re.search(r"half way down at x over the run, (\d+) tracks .*: least (-?[\d.]+), median (-?[\d.]+), "
+                       r"largest (-?[\d.]+); counted from the release: least (-?[\d.]+)", out)
+    assert int(halves[1]) == total
+    assert float(halves[2]) <= float(halves[3]) <= float(halves[4]) < 0.25 < float(halves[5])
 
 
 def test_a_roll_in_milliseconds_takes_a_thousand_times_as_long(tmp_path):

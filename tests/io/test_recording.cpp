@@ -14,6 +14,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <sstream>
 #include <thread>
 
 #include "io/recording_io.hpp"
@@ -464,6 +465,53 @@ TEST(RecordingLimits, ARollSetFarFromWhereItStartsIsRefused) {
   EXPECT_EQ(refusal(dir / "e", roll_from(0.035), track_from(-0.002)), "(accepted)");   // within 5 cm of its run
   EXPECT_EQ(refusal(dir / "f", roll_from(0.2), track_from(0.01)), "(accepted)");       // filmed on the flat only
   EXPECT_EQ(refusal(dir / "g", roll_from(0.2), track_from(-0.16)), "(accepted)");
+}
+
+TEST(RecordingLimits, ARollWhoseXDoesNotCountFromTheFootIsRefused) {
+  // x_m is 0 at the foot and negative up the slope: half way down a roll from near the top is at
+  // negative x (-0.47 to +0.07 of the run on 2458 stored tracks, bench/roll_timing.py). The
+  // independent simulator's 35 and 70 mm rolls counted from where the particle was released, or
+  // from the frame's edge, are refused; before the commit after 31de189 the 35 mm roll so counted
+  // was read, and the 70 mm one refused as a start distance in millimetres. As recorded, and
+  // filmed from half way down, both are read.
+  test::ScratchDir dir("rec");
+  const fs::path lab = test::shared_dir() / "data" / "lab-like" / "case-01";
+  // The track with `shift` added to each x, from its `from`-th row on.
+  const auto moved = [](const std::string& track, double shift, std::size_t from) {
+    std::istringstream in(track);
+    std::string line, out;
+    std::getline(in, line);
+    out = line + "\n";
+    for (std::size_t row = 0; std::getline(in, line); ++row) {
+      if (row < from) continue;
+      const auto a = line.find(','), b = line.find(',', a + 1);
+      const std::string x = line.substr(a + 1, b - a - 1);
+      out +=
+          line.substr(0, a + 1) + (x.empty() ? x : fmt::format("{:.6f}", std::stod(x) + shift)) + line.substr(b) + "\n";
+    }
+    return out;
+  };
+  for (const char* setup : {"roll-Q235-35mm", "roll-Q235-70mm"}) {
+    const std::string manifest = fmt::format(R"({{"format": "recording/1", "test": "roll", "surface": "Q235",
+      "setup": {{"incline_deg": 30, "start_distance_m": {}}}, "trials": [{{"id": "1", "track": "t.csv"}}]}})",
+                                             setup[10] == '3' ? 0.035 : 0.07);
+    const std::string track = test::read_text(lab / setup / "trial-01.csv");
+    std::istringstream rows(track);
+    std::string header, first;
+    std::getline(rows, header), std::getline(rows, first);
+    const double x0 = std::stod(first.substr(first.find(',') + 1));
+    const std::string released = refusal(dir / "a", manifest, moved(track, -x0, 0));
+    EXPECT_NE(released.find("t.csv: its tracked point has come half its way down"), std::string::npos) << released;
+    EXPECT_NE(released.find("x_m must count from the foot, 0 there and negative up the slope (counted from where the "
+                            "particle was released?)"),
+              std::string::npos)
+        << released;
+    const std::string edge = refusal(dir / "b", manifest, moved(track, 0.5, 0));
+    EXPECT_NE(edge.find("x_m must count from the foot, 0 there and negative up the slope"), std::string::npos) << edge;
+    EXPECT_EQ(edge.find("released?"), std::string::npos) << edge;
+    EXPECT_EQ(refusal(dir / "c", manifest, track), "(accepted)") << setup;
+    EXPECT_EQ(refusal(dir / "d", manifest, moved(track, 0.0, 150)), "(accepted)") << setup;  // filmed from later on
+  }
 }
 
 TEST(RecordingLimits, ARollFasterThanAFrictionlessSlideIsRefused) {
