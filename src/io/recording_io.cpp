@@ -265,8 +265,10 @@ std::optional<std::string> wrong_drop_track(const Track& track, double height) {
 /// (bench/roll_timing.py); the same tracks counted from where the particle was released at
 /// +0.41 to +0.87. One half way down beyond +0.25 of the run counts x from elsewhere (lab-like
 /// case-01's 70 mm roll counted from its release was refused as a start distance in
-/// millimetres; with its first x a hair above 0 it was read). Judged on tracks that come down
-/// 0.8 of the rise or more, 10 or more rows with both x and z.
+/// millimetres; its 35 mm roll, its first x a hair above 0, was read, and diagnose, which fits
+/// each trial's x origin, took it as from the foot). The start check of wrong_roll_track needs x
+/// from the foot, as the spec says. Judged on tracks that come down 0.8 of the rise or more, 10
+/// or more rows with both x and z.
 std::optional<std::string> x_not_from_the_foot(const Track& track, double run, double rise) {
   std::vector<std::pair<double, double>> xz;
   for (std::size_t i = 0; i < track.size(); ++i) {
