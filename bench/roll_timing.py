@@ -14,9 +14,11 @@ ratios' least, median, 99th percentile and largest, with the slowest tracks. It 
 far from the foot (x_m is 0 there) each track that starts on the slope and reaches the foot
 starts, over the incline's run: the reader refuses one under 0.25 that is 5 cm or more short of
 the run (a start distance in millimetres). And where each track that comes down 0.8 of the
-incline's rise or more has come half its way down, x over the run, as read and as if x were
-counted from where the particle was released: the reader refuses one beyond +0.25 (x_m not
-counted from the foot; x_not_from_the_foot).
+incline's rise or more has come half its way down, against the reader's bound there: a quarter
+of the incline's run plus 1.5 times the track's resting height (the median of its last five
+heights) times sin(incline). It prints how far inside the bound the tracks lie as read (the
+reader refuses one past it: x_m not counted from the foot; x_not_from_the_foot), and how many
+lie past it were their x counted from where the particle was released.
 
   bench/roll_timing.py ../shared/data/lab-like OUT-of-bench_diagnose ...
 """
@@ -70,19 +72,21 @@ def start_fraction(points, incline_deg, start_distance):
 
 
 def half_way_x(points, incline_deg, start_distance):
-    """Where the track has come half its way down, x over the run, as read and counted from its
-    start; None if it comes down less than 0.8 of the incline's rise."""
+    """How far past the reader's bound the track is half way down, in metres, as read and counted
+    from its start (negative: inside it); None if it comes down less than 0.8 of the incline's rise."""
     if len(points) < 10:
         return None
     angle = math.radians(incline_deg)
     run, rise = start_distance * math.cos(angle), start_distance * math.sin(angle)
     z0 = statistics.median(z for _, _, z in points[:5])
     x0 = statistics.median(x for _, x, _ in points[:5])
+    resting = statistics.median(z for _, _, z in points[-5:])
     descent = z0 - min(z for _, _, z in points)
     if descent < 0.8 * rise:
         return None
     x = next(x for _, x, z in points if z <= z0 - 0.5 * descent)
-    return x / run, (x - x0) / run
+    bound = 0.25 * run + 1.5 * max(resting, 0.0) * math.sin(angle)
+    return x - bound, x - x0 - bound
 
 
 def main():
@@ -139,11 +143,12 @@ def main():
               f"{min(starts):.3f}, median {statistics.median(starts):.3f}, largest {max(starts):.3f} (the reader "
               f"refuses under 0.25 when 5 cm short)")
     if halves:
-        read, released = [h for h, _ in halves], [h for _, h in halves]
-        print(f"half way down at x over the run, {len(halves)} tracks down 0.8 of the rise or more: least "
-              f"{min(read):.3f}, median {statistics.median(read):.3f}, largest {max(read):.3f}; counted from the "
-              f"release: least {min(released):.3f}, median {statistics.median(released):.3f}, largest "
-              f"{max(released):.3f} (the reader refuses beyond 0.25)")
+        inside = sorted(-h for h, _ in halves)
+        past = sum(1 for _, h in halves if h > 0.0)
+        print(f"half way down, {len(halves)} tracks down 0.8 of the rise or more: inside the reader's bound by "
+              f"{1e3 * inside[0]:.2f} mm at least, {1e3 * statistics.median(inside):.2f} mm median, "
+              f"{1e3 * inside[-1]:.2f} mm at most (the reader refuses a track past it); counted from the release, "
+              f"{past} of {len(halves)} past it")
     for r, path in sorted(timed, reverse=True)[: args.slowest]:
         print(f"  {r:8.3f}  {path}")
 

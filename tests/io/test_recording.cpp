@@ -512,6 +512,25 @@ TEST(RecordingLimits, ARollWhoseXDoesNotCountFromTheFootIsRefused) {
     EXPECT_EQ(refusal(dir / "c", manifest, track), "(accepted)") << setup;
     EXPECT_EQ(refusal(dir / "d", manifest, moved(track, 0.0, 150)), "(accepted)") << setup;  // filmed from later on
   }
+  // A 30 mm ball set 20 mm up a 60 deg incline is half way down at x = +8.1 mm, past a quarter of
+  // the run (2.5 mm): its centroid sits 13 mm forward of its contact, and its resting height
+  // (15 mm) says so. Read; counted from a mark 10 cm up the slope from the foot, refused. (Counted
+  // from its release, its centroid then 3 mm past the foot, it would read nearly as from the foot:
+  // no reader could tell the two apart.)
+  const double r = 0.015, beta = std::numbers::pi / 3.0, d = 0.02, a = 5.0 / 7.0 * 9.81 * std::sin(beta);
+  std::string ball = "t_s,x_m,z_m\n", marked = ball;
+  for (int i = 0; i < 300; ++i) {
+    const double t = 0.001 * i, s = d - 0.5 * a * t * t;  // the contact's distance up the slope
+    const double x = s > 0.0 ? -s * std::cos(beta) + r * std::sin(beta)
+                             : r * std::sin(beta) + std::sqrt(2.0 * a * d) * (t - std::sqrt(2.0 * d / a));
+    const double z = s > 0.0 ? s * std::sin(beta) + r * std::cos(beta) : r;
+    ball += fmt::format("{:.4f},{:.6f},{:.6f}\n", t, std::min(x, 0.05), z);
+    marked += fmt::format("{:.4f},{:.6f},{:.6f}\n", t, std::min(x, 0.05) + 0.1, z);
+  }
+  const std::string steep = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+    "setup": {"incline_deg": 60, "start_distance_m": 0.02}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  EXPECT_EQ(refusal(dir / "e", steep, ball), "(accepted)");
+  EXPECT_NE(refusal(dir / "f", steep, marked).find("x_m must count from the foot"), std::string::npos);
 }
 
 TEST(RecordingLimits, ARollFasterThanAFrictionlessSlideIsRefused) {
