@@ -2,14 +2,15 @@
 """How long roll tracks take to come down their incline, against a frictionless slide's time,
 and how far from the foot they start, against the incline's run.
 
-The recording reader refuses a roll whose tracked point comes from a fifth to four fifths of the
-start distance down the slope in more than 20 times a frictionless slide's time,
-sqrt(2 / (g sin(incline))) (sqrt(0.8 d) - sqrt(0.2 d)), or, starting in the slope's upper half,
-in less than 0.4 of it (src/io/recording_io.cpp, wrong_roll_timing): a track whose t_s is in milliseconds takes about
-1000 times it, and one whose incline_deg is in radians about 0.16. This reads
-every roll recording under the folders given (any depth, each a recording.json with its
+The recording reader refuses a roll that starts in the slope's upper half and whose tracked point
+comes from a fifth to four fifths of the start distance down the slope in more than 20 times a
+frictionless slide's time, sqrt(2 / (g sin(incline))) (sqrt(0.8 d) - sqrt(0.2 d)), or in less
+than 0.4 of it (src/io/recording_io.cpp, wrong_roll_timing): a track whose t_s is in
+milliseconds takes about 1000 times it, and one whose incline_deg is in radians about 0.16. This
+reads every roll recording under the folders given (any depth, each a recording.json with its
 tracks), times each track as the reader does (from the median of its first five tracked x
-positions; tracks that do not pass both marks are counted apart) and prints how many, and the
+positions; tracks that start further down or do not pass both marks are counted apart) and
+prints how many, and the
 ratios' least, median, 99th percentile and largest, with the slowest tracks. It also prints how
 far from the foot (x_m is 0 there) each track that starts on the slope and reaches the foot
 starts, over the incline's run: the reader refuses one under 0.25 that is 5 cm or more short of
@@ -46,12 +47,15 @@ def track_xz(path):
 
 
 def ratio(points, incline_deg, start_distance):
-    """The track's time from a fifth to four fifths of the way down, over a slide's; None if not passed."""
+    """The track's time from a fifth to four fifths of the way down, over a slide's; None if not passed
+    or not from the slope's upper half (the reader judges no other)."""
     if len(points) < 10:
         return None
     angle = math.radians(incline_deg)
     run = start_distance * math.cos(angle)
     start = statistics.median(x for _, x in points[:5])
+    if -start < 0.5 * run:
+        return None
     first = next((t for t, x in points if x >= start + 0.2 * run), None)
     last = next((t for t, x in points if x >= start + 0.8 * run), None)
     if first is None or last is None:
@@ -134,10 +138,11 @@ def main():
         raise SystemExit("no roll track passes both marks under " + ", ".join(args.folders))
     values = sorted(r for r, _ in timed)
     p99 = values[min(len(values) - 1, int(math.ceil(0.99 * len(values))) - 1)]
-    print(f"roll tracks: {len(timed) + unpassed}, timed {len(timed)}, not past four fifths {unpassed}"
+    print(f"roll tracks: {len(timed) + unpassed}, timed {len(timed)}, not from the slope's upper half or not past "
+          f"four fifths {unpassed}"
           f" (manifests or tracks not read: {unread})")
     print(f"time over a frictionless slide's: least {values[0]:.3f}, median {statistics.median(values):.3f}, "
-          f"99th percentile {p99:.3f}, largest {values[-1]:.3f} (the reader refuses below 0.4 from the upper half of the slope, and beyond 20)")
+          f"99th percentile {p99:.3f}, largest {values[-1]:.3f} (the reader refuses below 0.4 and beyond 20)")
     if starts:
         print(f"start from the foot over the run, {len(starts)} tracks from the slope to the flat: least "
               f"{min(starts):.3f}, median {statistics.median(starts):.3f}, largest {max(starts):.3f} (the reader "

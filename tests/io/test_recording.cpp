@@ -720,7 +720,7 @@ TEST(RecordingLimits, ATrackInOtherTimeUnitsThanSecondsIsRefused) {
   EXPECT_NE(refusal(dir / "i", roll, roll_ms).find("(about 1000 times: milliseconds?)"), std::string::npos);
   EXPECT_EQ(refusal(dir / "j", roll, roll_s), "(accepted)");
   // Where no frame rate is stated, a roll comes down its incline at most a few times slower than
-  // a frictionless slide (1.12 times here; 0.97-2.02 on 1842 stored tracks): in milliseconds,
+  // a frictionless slide (1.12 times here; 0.88-2.67 on 2570 stored tracks): in milliseconds,
   // about 1000 times. Accepted from the release on too, with no still rows before it.
   const std::string roll_unstated = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
     "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "trials": [{"id": "1", "track": "t.csv"}]})";
@@ -741,6 +741,19 @@ TEST(RecordingLimits, ATrackInOtherTimeUnitsThanSecondsIsRefused) {
     slow += fmt::format("{:.3f},{:.5f},0.009\n", 0.1 * i, std::min(0.1, 1.5 * 0.000016 * i * i) - 0.03);
   const std::string creep = refusal(dir / "s", roll_unstated, slow);
   EXPECT_NE(creep.find("takes 1.5 s"), std::string::npos) << creep;
+  // A track that starts in the slope's lower half is not timed: a tuber set 20 mm up a 60 deg
+  // incline starts 2 mm from the foot and may creep across both marks on the flat (the 340-sphere
+  // tuber took 10.3 times a slide's time; here 2.45 s, 80 times). Before the commit after 6a9213d
+  // it was refused as t_s in milliseconds.
+  const std::string steep = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+    "setup": {"incline_deg": 60, "start_distance_m": 0.02}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  std::string near_foot = "t_s,x_m,z_m\n";
+  for (int i = 0; i < 1600; ++i) {
+    const double t = 0.002 * i, moving = std::clamp(t - 0.05, 0.0, 0.068);
+    const double x = -0.0018 + 0.1 * moving + 0.0015 * std::clamp((t - 0.118) / 3.0, 0.0, 1.0);
+    near_foot += fmt::format("{:.3f},{:.6f},{:.6f}\n", t, x, 0.0228 - 0.22 * moving);
+  }
+  EXPECT_EQ(refusal(dir / "t", steep, near_foot), "(accepted)");
   // A tilt whose tilt_deg column rises at another rate than the set-up states; an encoder's
   // 0.1 deg steps are read right.
   const auto tilt = [](double stated) {
