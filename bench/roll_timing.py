@@ -77,7 +77,8 @@ def start_fraction(points, incline_deg, start_distance):
 
 def half_way_x(points, incline_deg, start_distance):
     """How far past the reader's bound the track is half way down, in metres, as read and counted
-    from its start (negative: inside it); None if it comes down less than 0.8 of the incline's rise."""
+    from its start (negative: inside it); None if the incline rises less than 5 mm or the track comes
+    down less than 0.8 of that."""
     if len(points) < 10:
         return None
     angle = math.radians(incline_deg)
@@ -86,7 +87,7 @@ def half_way_x(points, incline_deg, start_distance):
     x0 = statistics.median(x for _, x, _ in points[:5])
     resting = statistics.median(z for _, _, z in points[-5:])
     descent = z0 - min(z for _, _, z in points)
-    if descent < 0.8 * rise:
+    if rise < 5e-3 or descent < 0.8 * rise:
         return None
     x = next(x for _, x, z in points if z <= z0 - 0.5 * descent)
     bound = 0.25 * run + 1.5 * max(resting, 0.0) * math.sin(angle)

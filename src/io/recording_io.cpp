@@ -272,7 +272,8 @@ std::optional<std::string> wrong_drop_track(const Track& track, double height) {
 /// from its release was refused as a start distance in millimetres; its 35 mm roll, its first x
 /// a hair above 0, was read, and diagnose, which fits each trial's x origin, took it as from the
 /// foot. The start check of wrong_roll_track needs x from the foot, as the spec says. Judged on
-/// tracks that come down 0.8 of the rise or more, 10 or more rows with both x and z.
+/// inclines that rise 5 mm or more, on tracks that come down 0.8 of it or more, 10 or more rows
+/// with both x and z.
 std::optional<std::string> x_not_from_the_foot(const Track& track, double angle, double run, double rise) {
   std::vector<std::pair<double, double>> xz;
   for (std::size_t i = 0; i < track.size(); ++i) {
@@ -283,7 +284,7 @@ std::optional<std::string> x_not_from_the_foot(const Track& track, double angle,
   std::ranges::transform(xz, x.begin(), [](const auto& p) { return p.first; });
   std::ranges::transform(xz, z.begin(), [](const auto& p) { return p.second; });
   const double start = start_of(z), descent = start - std::ranges::min(z);
-  if (descent < 0.8 * rise) return std::nullopt;
+  if (rise < 5e-3 || descent < 0.8 * rise) return std::nullopt;  // a rise of a few noise levels says nothing
   const auto half = std::ranges::find_if(xz, [&](const auto& p) { return p.second <= start - 0.5 * descent; });
   const double resting = median({z.end() - 5, z.end()});
   const double bound = 0.25 * run + 1.5 * std::max(resting, 0.0) * std::sin(angle);

@@ -530,6 +530,21 @@ TEST(RecordingLimits, ARollWhoseXDoesNotCountFromTheFootIsRefused) {
   const std::string steep = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
     "setup": {"incline_deg": 60, "start_distance_m": 0.02}, "trials": [{"id": "1", "track": "t.csv"}]})";
   EXPECT_EQ(refusal(dir / "e", steep, ball), "(accepted)");
+  // Down a 1 deg incline a 35 mm start rises 0.6 mm, about the camera's noise: a tuber that
+  // tips onto its side on the flat, 20 mm past the foot, lowers its centroid 3 mm more, and was
+  // then "half way down" there (before the commit after 4e9a86c it was refused). An incline that
+  // rises under 5 mm is not judged.
+  const std::string shallow = R"({"format": "recording/1", "test": "roll", "surface": "Q235",
+    "setup": {"incline_deg": 1, "start_distance_m": 0.035}, "trials": [{"id": "1", "track": "t.csv"}]})";
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 1e-4);
+  std::string level = "t_s,x_m,z_m\n";
+  for (int i = 0; i < 400; ++i) {
+    const double t = 0.004 * i, tipped = t > 1.2 ? 0.003 : 0.0;
+    level += fmt::format("{:.3f},{:.6f},{:.6f}\n", t, std::min(0.05, 0.05 * t * t) - 0.03 + noise(rng),
+                         0.0098 - 0.0006 * std::min(1.0, t) - tipped + noise(rng));
+  }
+  EXPECT_EQ(refusal(dir / "g", shallow, level), "(accepted)");
   EXPECT_NE(refusal(dir / "f", steep, marked).find("x_m must count from the foot"), std::string::npos);
 }
 
