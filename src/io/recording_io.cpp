@@ -326,8 +326,9 @@ std::optional<std::string> wrong_roll_track(const Track& track, double start_dis
   }
   if (auto elsewhere = x_not_from_the_foot(track, angle, run, rise)) return elsewhere;
   // x_m is 0 at the foot (the spec): a particle set start_distance up the slope starts about
-  // its run from the foot (0.67-0.98 of it on 1842 stored tracks, bench/roll_timing.py: the
-  // centroid sits forward of the contact point). One that starts on the slope within a quarter
+  // its run from the foot (0.67-0.98 of it on the 1842 stored tracks, all down 30 deg,
+  // bench/roll_timing.py: the centroid sits forward of the contact point; down to 0.03 for a
+  // tuber set 20 mm up 60 deg, whose 10 mm run is far under 5 cm). One that starts on the slope within a quarter
   // of that and reaches the foot, 5 cm or more short of the run, had its start distance written
   // in other units (100 for 100 mm passed every check) or its x counted from elsewhere.
   if (first < 0.0 && std::ranges::max(x) > 0.0 && -first < 0.25 * run && run + first > 0.05) {
