@@ -176,12 +176,13 @@ std::vector<double> tracked(const std::vector<double>& column) {
   return out;
 }
 
-/// A track column's tracked values and their times (lost cells left out).
-std::pair<std::vector<double>, std::vector<double>> tracked_with_times(const Track& track,
-                                                                       const std::vector<double>& column) {
+/// Two track columns' values where both were tracked (a row with a lost cell in either left out):
+/// a column with its times, or x with z.
+std::pair<std::vector<double>, std::vector<double>> tracked_together(const std::vector<double>& a,
+                                                                     const std::vector<double>& b) {
   std::pair<std::vector<double>, std::vector<double>> out;
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    if (std::isfinite(column[i])) out.first.push_back(track.t[i]), out.second.push_back(column[i]);
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    if (std::isfinite(a[i]) && std::isfinite(b[i])) out.first.push_back(a[i]), out.second.push_back(b[i]);
   }
   return out;
 }
@@ -189,6 +190,17 @@ std::pair<std::vector<double>, std::vector<double>> tracked_with_times(const Tra
 /// Where a tracked column starts, camera noise aside: the median of its first five values.
 double start_of(const std::vector<double>& tracked_values) {
   return median({tracked_values.begin(), tracked_values.begin() + 5});
+}
+
+/// Where a tracked column ends, camera noise aside: the median of its last five values.
+double end_of(const std::vector<double>& tracked_values) {
+  return median({tracked_values.end() - 5, tracked_values.end()});
+}
+
+/// How long a body starting from rest at a steady acceleration takes to come from a fifth to four
+/// fifths of `distance`: a free fall's (g) or a frictionless slide's (g sin(incline)).
+double time_between_fifths(double distance, double acceleration) {
+  return std::sqrt(2.0 / acceleration) * (std::sqrt(0.8 * distance) - std::sqrt(0.2 * distance));
 }
 
 /// A roll set-up's start distance along its incline, in its horizontal run and its rise.
@@ -275,25 +287,19 @@ std::optional<std::string> wrong_drop_track(const Track& track, double height) {
 /// inclines that rise 5 mm or more, on tracks that come down 0.8 of it or more, 10 or more rows
 /// with both x and z.
 std::optional<std::string> x_not_from_the_foot(const Track& track, double angle, double run, double rise) {
-  std::vector<std::pair<double, double>> xz;
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    if (std::isfinite(track.x[i]) && std::isfinite(track.z[i])) xz.emplace_back(track.x[i], track.z[i]);
-  }
-  if (xz.size() < 10) return std::nullopt;
-  std::vector<double> x(xz.size()), z(xz.size());
-  std::ranges::transform(xz, x.begin(), [](const auto& p) { return p.first; });
-  std::ranges::transform(xz, z.begin(), [](const auto& p) { return p.second; });
+  const auto [x, z] = tracked_together(track.x, track.z);
+  if (z.size() < 10) return std::nullopt;
   const double start = start_of(z), descent = start - std::ranges::min(z);
   if (rise < 5e-3 || descent < 0.8 * rise) return std::nullopt;  // a rise of a few noise levels says nothing
-  const auto half = std::ranges::find_if(xz, [&](const auto& p) { return p.second <= start - 0.5 * descent; });
-  const double resting = median({z.end() - 5, z.end()});
-  const double bound = 0.25 * run + 1.5 * std::max(resting, 0.0) * std::sin(angle);
-  if (half->first <= bound) return std::nullopt;
+  const auto half = x[static_cast<std::size_t>(
+      std::ranges::find_if(z, [&](double v) { return v <= start - 0.5 * descent; }) - z.begin())];
+  const double bound = 0.25 * run + 1.5 * std::max(end_of(z), 0.0) * std::sin(angle);
+  if (half <= bound) return std::nullopt;
   return fmt::format(
       "its tracked point has come half its way down ({:.1f} mm of {:.1f} mm) at x = {:.1f} mm, where a roll comes "
       "down its incline at negative x, or within {:.1f} mm of the foot (a quarter of the incline's run and its "
       "centroid's reach): x_m must count from the foot, 0 there and negative up the slope{}",
-      0.5 * descent * 1e3, descent * 1e3, half->first * 1e3, bound * 1e3,
+      0.5 * descent * 1e3, descent * 1e3, half * 1e3, bound * 1e3,
       std::abs(start_of(x)) < 0.05 * run ? " (counted from where the particle was released?)" : "");
 }
 
@@ -317,7 +323,7 @@ std::optional<std::string> wrong_roll_track(const Track& track, double start_dis
         descent, start_distance, incline_deg, rise, units_hint(descent / std::max(rise, 1e-3), kLengthUnits));
   }
   const double first = start_of(x);
-  const double moved = median({x.end() - 5, x.end()}) - first;
+  const double moved = end_of(x) - first;
   if (moved < -std::max(0.25 * run, 5e-3)) {
     return fmt::format(
         "its tracked point ends {:.1f} mm on the negative side of where it started, where a roll runs down the "
@@ -378,7 +384,7 @@ std::optional<std::string> wrong_short_fall_timing(const std::vector<double>& t,
   if (above == z.rend()) return std::nullopt;
   const auto from = static_cast<std::size_t>(std::distance(z.begin(), above.base()) - 1);
   const double taken = t[static_cast<std::size_t>(to - z.begin())] - t[from];
-  const double free_fall = std::sqrt(2.0 / kStandardGravity) * (std::sqrt(0.8 * fall) - std::sqrt(0.2 * fall));
+  const double free_fall = time_between_fifths(fall, kStandardGravity);
   if (taken <= std::max(100.0 * free_fall, 1.0)) return std::nullopt;
   return fmt::format(
       "its tracked point takes {:.4g} s to come from a fifth to four fifths of its {:.1f} mm fall, where a free "
@@ -396,7 +402,7 @@ std::optional<std::string> wrong_short_fall_timing(const std::vector<double>& t,
 /// fall's last fifth can hold the first contact: wrong_short_fall_timing judges those) with 6 or
 /// more heights in that stretch.
 std::optional<std::string> wrong_drop_timing(const Track& track, double height) {
-  const auto [t, z] = tracked_with_times(track, track.z);
+  const auto [t, z] = tracked_together(track.t, track.z);
   if (z.size() < 10) return std::nullopt;
   const double start = start_of(z);
   const double fall = start - std::ranges::min(z);
@@ -475,7 +481,7 @@ std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
 /// than the set-up states (an incline_deg in radians: about 0.16). Judged where the tracked
 /// point passes both marks, 10 or more positions.
 std::optional<std::string> wrong_roll_timing(const Track& track, double start_distance, double incline_deg) {
-  const auto [t, x] = tracked_with_times(track, track.x);
+  const auto [t, x] = tracked_together(track.t, track.x);
   if (x.size() < 10) return std::nullopt;
   const auto [angle, run, rise] = incline_legs(start_distance, incline_deg);
   const double start = start_of(x);
@@ -484,8 +490,7 @@ std::optional<std::string> wrong_roll_timing(const Track& track, double start_di
   const auto to = std::ranges::find_if(x, [&](double v) { return v >= start + 0.8 * run; });
   if (to == x.end()) return std::nullopt;
   const double taken = t[static_cast<std::size_t>(to - x.begin())] - t[static_cast<std::size_t>(from - x.begin())];
-  const double slide = std::sqrt(2.0 / (kStandardGravity * std::sin(angle))) *
-                       (std::sqrt(0.8 * start_distance) - std::sqrt(0.2 * start_distance));
+  const double slide = time_between_fifths(start_distance, kStandardGravity * std::sin(angle));
   const std::string stretch = fmt::format(
       "its tracked point takes {:.4g} s to come from a fifth to four fifths of the way down the {:g} deg incline "
       "({:.1f} to {:.1f} mm), where sliding without friction takes {:.3g} s",
