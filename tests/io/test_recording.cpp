@@ -798,6 +798,35 @@ TEST(RecordingLimits, ATrackInOtherTimeUnitsThanSecondsIsRefused) {
       << radians;
   EXPECT_EQ(refusal(dir / "m", tilt(5), plate(1, 0.001)), "(accepted)");
   EXPECT_EQ(refusal(dir / "n", tilt(5), plate(1, 0.1)), "(accepted)");
+  // The tilt_deg column in radians: the plate rises 0.52 "deg" at 0.087 deg/s. So does a sphere's,
+  // which rolls off at 2.1 deg (lab-like case-14): 0.037 rad at 2 deg/s. Before the commit after
+  // 648d084 both were read, the sphere's because its column rose less than 2, and diagnose timed
+  // the plate's start from them.
+  const auto in_radians = [](double rate, double top, double step) {
+    std::string out = "t_s,x_m,z_m,tilt_deg\n";
+    for (int i = 0; i < 800; ++i) {
+      const double t = 0.01 * i, angle = std::min(top, rate * std::max(0.0, t - 1.0)) * std::numbers::pi / 180.0;
+      out += fmt::format("{:.3f},0.001,0.007,{:.4f}\n", t, step * std::floor(angle / step));
+    }
+    return out;
+  };
+  const std::string tuber_rad = refusal(dir / "o", tilt(5), in_radians(5, 30, 0.0001));
+  EXPECT_NE(tuber_rad.find("t.csv: its plate tilts at 0.087"), std::string::npos) << tuber_rad;
+  EXPECT_NE(tuber_rad.find("tilt_rate_deg_per_s is 5: tilt_deg must be in degrees (0.523 rad is 30 deg?)"),
+            std::string::npos)
+      << tuber_rad;
+  const std::string sphere_rad = refusal(dir / "p", tilt(2), in_radians(2, 2.5, 0.0001));
+  EXPECT_NE(sphere_rad.find("tilt_deg must be in degrees (0.0436 rad is 2.5 deg?)"), std::string::npos) << sphere_rad;
+  // The same sphere's column in degrees is read, and so is a plate held at 10 deg whose encoder
+  // jitters by 0.02 deg (no steady rise to judge).
+  std::string sphere_deg = "t_s,x_m,z_m,tilt_deg\n", held = sphere_deg;
+  for (int i = 0; i < 800; ++i) {
+    const double t = 0.01 * i;
+    sphere_deg += fmt::format("{:.3f},0.001,0.007,{:.3f}\n", t, std::min(2.5, 2.0 * std::max(0.0, t - 1.0)));
+    held += fmt::format("{:.3f},0.001,0.007,{:.3f}\n", t, 10.0 + 0.02 * ((i * 7) % 3 - 1));
+  }
+  EXPECT_EQ(refusal(dir / "q", tilt(2), sphere_deg), "(accepted)");
+  EXPECT_EQ(refusal(dir / "r", tilt(2), held), "(accepted)");
 }
 
 TEST(RecordingLimits, AManifestOrTrackTooLargeToHoldIsRefusedUnread) {
