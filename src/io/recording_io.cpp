@@ -12,7 +12,6 @@
 #include <numbers>
 #include <optional>
 #include <span>
-#include <sstream>
 
 #include "core/atomic_file.hpp"
 #include "core/sha256.hpp"
@@ -549,6 +548,40 @@ bool marks_lost_tracking(std::string_view cell) {
   return false;
 }
 
+/// A track line's cells, each trimmed, as RFC 4180 reads them: a cell in double quotes (as R's
+/// write.csv and Python's csv module with quoting write them) is its text, "" being one quote, and
+/// may hold a comma. nullopt where a quote is left open.
+std::optional<std::vector<std::string>> csv_cells(std::string_view line) {
+  std::vector<std::string> cells(1);
+  bool quoted = false, was_quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char ch = line[i];
+    if (quoted && ch == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+      cells.back() += '"', ++i;
+    } else if (ch == '"' && (quoted || trim(cells.back()).empty())) {
+      if (!quoted) cells.back().clear();
+      quoted = !quoted, was_quoted = true;
+    } else if (ch == ',' && !quoted) {
+      cells.emplace_back(), was_quoted = false;
+    } else if (!(was_quoted && !quoted && (ch == ' ' || ch == '\t'))) {
+      cells.back() += ch;
+    }
+  }
+  if (quoted) return std::nullopt;
+  for (auto& cell : cells) cell = std::string(trim(cell));
+  return cells;
+}
+
+/// What a header cell with no name is, in words: the first a row index (pandas' to_csv and R's
+/// write.csv write one unless told not to).
+std::string unnamed_column(std::size_t k) {
+  if (k == 0) {
+    return "column 1 has no name: a row index (as pandas' to_csv writes without index=False and R's write.csv "
+           "without row.names=FALSE)? the spec's track has none";
+  }
+  return fmt::format("column {} has no name (t_s, x_m, z_m, angle_rad, tilt_deg)", k + 1);
+}
+
 Result<Track> read_track(const fs::path& path) {
   if (auto ok = within_size(path, RecordingLimits::max_track_bytes, "a track"); !ok) return std::unexpected(ok.error());
   std::ifstream in(path);
@@ -558,16 +591,19 @@ Result<Track> read_track(const fs::path& path) {
   if (!line.empty() && line.back() == '\r') line.pop_back();
   // A spreadsheet's "CSV UTF-8" export opens with a byte-order mark; the header is the same.
   if (line.starts_with("\xEF\xBB\xBF")) line.erase(0, 3);
-  std::vector<std::string> columns;
-  {
-    std::stringstream header(line);
-    std::string cell;
-    while (std::getline(header, cell, ',')) columns.emplace_back(trim(cell));
-  }
+  auto header = csv_cells(line);
+  if (!header) return fail(ErrorCode::ParseError, fmt::format("{}:1: a quote is left open", path.string()));
+  // A spreadsheet's export may end each line with a comma: an unnamed last column, left empty.
+  const bool trailing_comma = header->size() > 1 && header->back().empty();
+  if (trailing_comma) header->pop_back();
+  const std::vector<std::string> columns = std::move(*header);
   Track track;
   std::vector<std::vector<double>*> targets;
   bool has_t = false, has_x = false, has_z = false;
-  for (const auto& c : columns) {
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    const std::string& c = columns[k];
+    if (c.empty() && columns.size() > 1)
+      return fail(ErrorCode::ParseError, fmt::format("{}:1: {}", path.string(), unnamed_column(k)));
     if (c == "t_s")
       targets.push_back(&track.t), has_t = true;
     else if (c == "x_m")
@@ -596,11 +632,10 @@ Result<Track> read_track(const fs::path& path) {
     }
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (trim(line).empty()) continue;
-    std::vector<std::string> cells;
-    std::stringstream row(line);
-    std::string cell;
-    while (std::getline(row, cell, ',')) cells.push_back(std::string(trim(cell)));
-    if (!line.empty() && line.back() == ',') cells.emplace_back();
+    auto split = csv_cells(line);
+    if (!split) return fail(ErrorCode::ParseError, fmt::format("{}:{}: a quote is left open", path.string(), number));
+    if (trailing_comma && split->size() == columns.size() + 1 && split->back().empty()) split->pop_back();
+    const std::vector<std::string>& cells = *split;
     if (cells.size() != columns.size()) {
       const bool decimal_commas = cells.size() > columns.size() && line.find('.') == std::string::npos;
       return fail(
@@ -620,6 +655,8 @@ Result<Track> read_track(const fs::path& path) {
               fmt::format("{}:{}: '{}' in column {} is not a number{}", path.string(), number, cells[k], columns[k],
                           marks_lost_tracking(cells[k]) && columns[k] != "t_s"
                               ? " (where tracking was lost, the spec leaves the cell empty)"
+                          : cells[k].find(',') != std::string::npos
+                              ? " (a decimal comma? the spec's numbers have a decimal point)"
                               : ""));
         }
       } else if (columns[k] == "t_s") {

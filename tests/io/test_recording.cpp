@@ -115,6 +115,31 @@ TEST(Recording, ASpreadsheetsByteOrderMarkAndLineEndsAreRead) {
   EXPECT_EQ(r->trials[0].track->z[1], 0.19999);
 }
 
+TEST(Recording, ATrackAsRAndPythonQuoteItIsRead) {
+  // R's write.csv(row.names = FALSE) quotes the header; Python's csv module with QUOTE_ALL every
+  // cell; a spreadsheet may end each line with a comma. Read as the plain track is (before the
+  // commit after e93420a: "unknown column '"t_s"'").
+  test::ScratchDir dir("rec");
+  test::write_text(dir / "recording.json", R"({"format": "recording/1", "test": "drop", "surface": "Q235",
+  "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "r.csv"}, {"id": "2", "track": "py.csv"},
+  {"id": "3", "track": "sheet.csv"}]})");
+  test::write_text(dir / "r.csv", "\"t_s\",\"x_m\",\"z_m\"\n0.000,0.001,0.2\n0.001,0.001,0.19999\n");
+  test::write_text(dir / "py.csv",
+                   "\"t_s\", \"x_m\" ,\"z_m\"\n\"0.000\",\"0.001\",\"0.2\"\n\"0.001\",\"\",\"0.19999\"\n");
+  test::write_text(dir / "sheet.csv", "t_s,x_m,z_m,\n0.000,0.001,0.2,\n0.001,0.001,0.19999,\n");
+  const auto r = read_recording(dir.path());
+  ASSERT_TRUE(r) << r.error().message;
+  for (const auto& trial : r->trials) {
+    SCOPED_TRACE(trial.id);
+    ASSERT_TRUE(trial.track);
+    ASSERT_EQ(trial.track->size(), 2u);
+    EXPECT_EQ(trial.track->t[1], 0.001);
+    EXPECT_EQ(trial.track->x[0], 0.001);
+    EXPECT_EQ(trial.track->z[1], 0.19999);
+  }
+  EXPECT_TRUE(std::isnan(r->trials[1].track->x[1]));  // "": tracking lost
+}
+
 TEST(Recording, BadInputNamesFileAndLine) {
   test::ScratchDir dir("rec");
   struct Case {
@@ -151,6 +176,21 @@ TEST(Recording, BadInputNamesFileAndLine) {
        "t.csv:3: 'NaN' in column x_m is not a number (where tracking was lost, the spec leaves the cell empty)"},
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
        "t_s,x_m,z_m,speed\n0.0,0,0.2,1\n", "t.csv:1: unknown column 'speed'"},
+      // A row index, as pandas' to_csv and R's write.csv write by default; a column left unnamed;
+      // a quote left open; a decimal comma inside quotes.
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       ",t_s,x_m,z_m\n0,0.0,0,0.2\n",
+       "t.csv:1: column 1 has no name: a row index (as pandas' to_csv writes without index=False and R's write.csv "
+       "without row.names=FALSE)? the spec's track has none"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "\"\",\"t_s\",\"x_m\",\"z_m\"\n\"1\",0.0,0,0.2\n", "t.csv:1: column 1 has no name: a row index"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "t_s,,x_m,z_m\n0.0,,0,0.2\n", "t.csv:1: column 2 has no name (t_s, x_m, z_m, angle_rad, tilt_deg)"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "t_s,x_m,z_m\n0.0,0,0.2\n0.001,\"0,0.2\n", "t.csv:3: a quote is left open"},
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
+       "t_s,x_m,z_m\n0.0,\"0,001\",0.2\n",
+       "t.csv:2: '0,001' in column x_m is not a number (a decimal comma? the spec's numbers have a decimal point)"},
       {"{\"format\": \"recording/1\",\n \"test\": \"drop\" \"surface\": 1}", "", "recording.json:2: not valid JSON"},
       // Valid JSON, but beyond a double's range: not "internal error" (found by flipping bytes).
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 2e3083}, "trials": []})",
