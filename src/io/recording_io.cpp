@@ -228,6 +228,24 @@ constexpr std::array<std::pair<double, const char*>, 3> kLengthUnits{
 /// A t_s column written in milliseconds or microseconds, or a video's playback time.
 constexpr std::array<std::pair<double, const char*>, 2> kTimeUnits{{{1000.0, "milliseconds"}, {1e6, "microseconds"}}};
 
+/// The median time between a track's rows (times `t`, 2 rows or more).
+double median_step(const std::vector<double>& t) {
+  std::vector<double> steps(t.size() - 1);
+  for (std::size_t i = 0; i + 1 < t.size(); ++i) steps[i] = t[i + 1] - t[i];
+  return median(std::move(steps));
+}
+
+/// Why a track's t_s is not in seconds, in words, where a factor `ratio` too slow is what is
+/// known: frame numbers (whole numbers one apart, as tracking software numbers frames), a time
+/// unit (units_hint), or nothing.
+std::string time_hint(const std::vector<double>& t, double ratio) {
+  const std::string units = units_hint(ratio, kTimeUnits);
+  const auto whole = [](double t) { return std::abs(t - std::round(t)) < 1e-9; };
+  if (t.size() < 10 || !std::ranges::all_of(t, whole) || median_step(t) != 1.0) return units;
+  return fmt::format(" (frame numbers{}? divide them by the camera's frame rate)",
+                     units.find("milliseconds") != std::string::npos ? ", or milliseconds" : "");
+}
+
 /// What is wrong with a drop's track that does not fall as the drop does, or nothing. The
 /// particle is released from rest with its lowest point `height` above the plate, so its
 /// tracked point falls about `height` (the spec's z_m is up positive; a body's centroid lies at
@@ -354,14 +372,12 @@ std::optional<std::string> wrong_roll_track(const Track& track, double start_dis
 /// Within 5 % (a camera's nominal rate against its clock). Judged on 10 or more rows.
 std::optional<std::string> wrong_frame_spacing(const Track& track, double frame_rate) {
   if (track.t.size() < 10) return std::nullopt;
-  std::vector<double> steps(track.t.size() - 1);
-  for (std::size_t i = 0; i + 1 < track.t.size(); ++i) steps[i] = track.t[i + 1] - track.t[i];
-  const double ratio = median(std::move(steps)) * frame_rate;
+  const double ratio = median_step(track.t) * frame_rate;
   if (std::abs(ratio - 1.0) <= 0.05) return std::nullopt;
   return fmt::format(
       "its rows are {:.4g} s apart (the median), where one row per frame of the camera's {:g} Hz (the manifest's "
       "camera.frame_rate_hz) is {:.4g} s: t_s must be in seconds, one row per frame{}",
-      ratio / frame_rate, frame_rate, 1.0 / frame_rate, units_hint(ratio, kTimeUnits));
+      ratio / frame_rate, frame_rate, 1.0 / frame_rate, time_hint(track.t, ratio));
 }
 
 /// What is wrong with the timing of a drop from under 5 cm, or nothing. Its fall can end in the
@@ -389,7 +405,7 @@ std::optional<std::string> wrong_short_fall_timing(const std::vector<double>& t,
       "its tracked point takes {:.4g} s to come from a fifth to four fifths of its {:.1f} mm fall, where a free "
       "fall takes {:.3g} s and a body tipping over after it lands a fraction of a second: t_s must be in "
       "seconds{}",
-      taken, fall * 1e3, free_fall, units_hint(taken / free_fall, kTimeUnits));
+      taken, fall * 1e3, free_fall, time_hint(t, taken / free_fall));
 }
 
 /// What is wrong with a drop's track whose fall is not a fall under gravity, or nothing. Released
@@ -419,7 +435,7 @@ std::optional<std::string> wrong_drop_timing(const Track& track, double height) 
   // bounds; a bound is broken only beyond four standard errors (test: 200 such tracks).
   const double error = 2.0 * fit.a_standard_error;
   if (acceleration >= g / 3.0 - 4.0 * error && acceleration <= 3.0 * g + 4.0 * error) return std::nullopt;
-  const std::string hint = acceleration > 0.0 ? units_hint(std::sqrt(g / acceleration), kTimeUnits) : "";
+  const std::string hint = acceleration > 0.0 ? time_hint(track.t, std::sqrt(g / acceleration)) : "";
   return fmt::format(
       "its tracked point falls with an acceleration of {:.3g} m/s^2 (a parabola through its heights from {:.1f} to "
       "{:.1f} mm), where a dropped particle falls at about {:g}: t_s must be in seconds{}",
@@ -459,7 +475,8 @@ std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
   const double rate = (track.tilt[*upper] - track.tilt[*first]) / seconds;
   if (rate >= 0.5 * stated && rate <= 2.0 * stated) return std::nullopt;
   const double per_radian = 180.0 / std::numbers::pi;
-  if (rate >= 0.5 * stated / per_radian && rate <= 2.0 * stated / per_radian) {
+  // A column in radians, not frame numbers at about 57 fps: no plate tilts past 90 deg.
+  if (rate >= 0.5 * stated / per_radian && rate <= 2.0 * stated / per_radian && top <= 0.5 * std::numbers::pi) {
     return fmt::format(
         "its plate tilts at {:.4g} deg/s (tilt_deg from {:.3g} to {:.3g}), where the set-up's "
         "tilt_rate_deg_per_s is {:g}: tilt_deg must be in degrees ({:.3g} rad is {:.3g} deg?)",
@@ -474,7 +491,7 @@ std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
   return fmt::format(
       "its plate tilts at {:.4g} deg/s (tilt_deg from {:.3g} to {:.3g} deg), where the set-up's "
       "tilt_rate_deg_per_s is {:g}: t_s must be in seconds{}",
-      rate, track.tilt[*first], track.tilt[*upper], stated, units_hint(stated / rate, kTimeUnits));
+      rate, track.tilt[*first], track.tilt[*upper], stated, time_hint(track.t, stated / rate));
 }
 
 /// What is wrong with a roll's track that comes down its incline far faster or far more slowly
@@ -520,7 +537,7 @@ std::optional<std::string> wrong_roll_timing(const Track& track, double start_di
   }
   if (incline_deg < 1.0 || taken <= 20.0 * slide) return std::nullopt;
   return fmt::format("{} and a roll at most a few times that: t_s must be in seconds{}", stretch,
-                     units_hint(taken / slide, kTimeUnits));
+                     time_hint(track.t, taken / slide));
 }
 
 /// Why a header cell holds several column names, if it does: a spreadsheet saved in a locale

@@ -178,7 +178,8 @@ TEST(DiagnoseCli, HostileRecordingsAreRefusedAndNothingIsWritten) {
   std::string roll_ms = "t_s,x_m,z_m\n";
   for (int i = 0; i < 100; ++i) roll_ms += fmt::format("{:.3f},{:.5f},0.009\n", 4.0 * i, 1.5e-6 * 16 * i * i - 0.03);
   const std::vector<std::tuple<std::string, std::string, std::string>> cases{
-      {manifest("0.2", "trial-01.csv"), milliseconds, "t_s must be in seconds (about 1000 times: milliseconds?)"},
+      {manifest("0.2", "trial-01.csv"), milliseconds,
+       "t_s must be in seconds (frame numbers, or milliseconds? divide them by the camera's frame rate)"},
       {R"({"format": "recording/1", "test": "roll", "surface": "Q235",
           "setup": {"incline_deg": 30, "start_distance_m": 0.035}, "trials": [{"id": "01", "track": "trial-01.csv"}]})",
        roll_ms,

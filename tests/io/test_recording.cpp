@@ -697,13 +697,17 @@ TEST(RecordingLimits, ATrackInOtherTimeUnitsThanSecondsIsRefused) {
   const std::string ms = refusal(dir / "a", filmed, drop_at(1000, 1000, 0.05, 0, false));
   EXPECT_NE(ms.find("t.csv: its rows are 1 s apart (the median), where one row per frame of the camera's 1000 Hz "
                     "(the manifest's camera.frame_rate_hz) is 0.001 s: t_s must be in seconds, one row per frame "
-                    "(about 1000 times: milliseconds?)"),
+                    "(frame numbers, or milliseconds? divide them by the camera's frame rate)"),
             std::string::npos)
       << ms;
   const std::string fall = refusal(dir / "b", unstated, drop_at(1000, 1000, 0.05, 0, false));
   EXPECT_NE(fall.find("t.csv: its tracked point falls with an acceleration of 9.81e-06 m/s^2"), std::string::npos)
       << fall;
-  EXPECT_NE(fall.find("t_s must be in seconds (about 1000 times: milliseconds?)"), std::string::npos) << fall;
+  // Whole milliseconds one apart are frame numbers too, at 1000 fps: the hint names both.
+  EXPECT_NE(fall.find("t_s must be in seconds (frame numbers, or milliseconds? divide them by the camera's frame "
+                      "rate)"),
+            std::string::npos)
+      << fall;
   const std::string slowed = refusal(dir / "c", unstated, drop_at(240, 8, 0.05, 0, false));
   EXPECT_NE(slowed.find("falls with an acceleration of 0.153 m/s^2"), std::string::npos) << slowed;
   EXPECT_NE(refusal(dir / "d", filmed, drop_at(240, 1, 0.05, 0, false)).find("0.004167 s apart"), std::string::npos);
@@ -867,6 +871,31 @@ TEST(RecordingLimits, ATrackInOtherTimeUnitsThanSecondsIsRefused) {
   }
   EXPECT_EQ(refusal(dir / "q", tilt(2), sphere_deg), "(accepted)");
   EXPECT_EQ(refusal(dir / "r", tilt(2), held), "(accepted)");
+  // t_s holding frame numbers, as tracking software numbers frames: the 100 fps tilt's plate then
+  // rises 100 times too slowly, near what a column in radians does; the hint says frame numbers,
+  // not radians (its plate reaches 2.5 "rad", past 90 deg). Before the commit after 53000ba its
+  // message asked "2.5 rad is 143 deg?".
+  std::string tilt_frames = "t_s,x_m,z_m,tilt_deg\n";
+  for (int i = 0; i < 140; ++i) {
+    tilt_frames += fmt::format("{},0.001,0.007,{:.3f}\n", i, std::min(2.5, 2.0 * std::max(0.0, 0.01 * i - 0.1)));
+  }
+  const std::string frames = refusal(dir / "s", tilt(2), tilt_frames);
+  EXPECT_NE(frames.find("t_s must be in seconds (frame numbers? divide them by the camera's frame rate)"),
+            std::string::npos)
+      << frames;
+  // A 1000 fps drop so numbered: frame numbers, or milliseconds.
+  std::string drop_frames = "t_s,x_m,z_m\n";
+  for (int i = 0; i < 400; ++i) {
+    const double t = 0.001 * i;
+    drop_frames += fmt::format("{},0.001,{:.5f}\n", i, std::max(0.01, 0.51 - 0.5 * 9.81 * t * t));
+  }
+  const std::string dropped = refusal(dir / "u", R"({"format": "recording/1", "test": "drop", "surface": "Q235",
+    "setup": {"release_height_m": 0.5}, "trials": [{"id": "1", "track": "t.csv"}]})",
+                                      drop_frames);
+  EXPECT_NE(dropped.find("t_s must be in seconds (frame numbers, or milliseconds? divide them by the camera's "
+                         "frame rate)"),
+            std::string::npos)
+      << dropped;
 }
 
 TEST(RecordingLimits, AManifestOrTrackTooLargeToHoldIsRefusedUnread) {
