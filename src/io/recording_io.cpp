@@ -565,6 +565,43 @@ bool marks_lost_tracking(std::string_view cell) {
   return false;
 }
 
+/// What an unknown column's name most likely means, in words: how tracking software and
+/// spreadsheets name the spec's columns (a unit in brackets, "time", a camera's y for the
+/// vertical, millimetres or pixels, a frame number), else the nearest spec name.
+std::string column_hint(std::string_view name) {
+  std::string lower;
+  for (char ch : name) {
+    if (!std::isspace(static_cast<unsigned char>(ch))) lower += static_cast<char>(std::tolower(ch));
+  }
+  std::string base = lower, unit;
+  if (const auto open = lower.find_first_of("([");
+      open != std::string::npos && open > 0 && (lower.back() == ')' || lower.back() == ']')) {
+    base = lower.substr(0, open), unit = lower.substr(open + 1, lower.size() - open - 2);
+  } else if (const auto bar = lower.rfind('_'); bar != std::string::npos && bar > 0) {
+    base = lower.substr(0, bar), unit = lower.substr(bar + 1);
+  }
+  constexpr std::array<std::string_view, 6> kFrameNames{"frame", "frames", "frame_number", "frameno", "index", "idx"};
+  if (std::ranges::find(kFrameNames, lower) != kFrameNames.end()) {
+    return " (a frame number? the spec's track has no such column: t_s holds each frame's time in seconds)";
+  }
+  const bool position = base == "x" || base == "y" || base == "z";
+  if (position && (unit == "px" || unit == "pix" || unit == "pixel" || unit == "pixels")) {
+    return " (positions in pixels? x_m and z_m are metres in the camera plane: apply the camera's image scale)";
+  }
+  if (base == "y") return " (did you mean 'z_m'? the spec's vertical, in metres, up positive)";
+  // The spec's column for `base`, its unit and the unit in words; "not mm" where another is named.
+  const auto spec = [&](std::string_view column, std::string_view spec_unit, std::string_view words) {
+    return fmt::format(" (did you mean '{}'? in {}{})", column, words,
+                       unit.empty() || unit == spec_unit ? std::string() : fmt::format(", not {}", unit));
+  };
+  if (base == "t" || base == "time") return spec("t_s", "s", "seconds");
+  if (base == "x") return spec("x_m", "m", "metres");
+  if (base == "z") return spec("z_m", "m", "metres");
+  if (base == "tilt") return spec("tilt_deg", "deg", "degrees");
+  if (base == "angle" || base == "theta") return spec("angle_rad", "rad", "radians");
+  return did_you_mean(name, {"t_s", "x_m", "z_m", "angle_rad", "tilt_deg"});
+}
+
 /// A track line's cells, each trimmed, as RFC 4180 reads them: a cell in double quotes (as R's
 /// write.csv and Python's csv module with quoting write them) is its text, "" being one quote, and
 /// may hold a comma. nullopt where a quote is left open.
@@ -634,7 +671,7 @@ Result<Track> read_track(const fs::path& path) {
     else {
       return fail(ErrorCode::ParseError,
                   fmt::format("{}:1: unknown column '{}'{} (t_s, x_m, z_m, angle_rad, tilt_deg){}", path.string(), c,
-                              did_you_mean(c, {"t_s", "x_m", "z_m", "angle_rad", "tilt_deg"}), separator_hint(c)));
+                              column_hint(c), separator_hint(c)));
     }
   }
   if (!has_t || !has_x || !has_z) {

@@ -140,6 +140,33 @@ TEST(Recording, ATrackAsRAndPythonQuoteItIsRead) {
   EXPECT_TRUE(std::isnan(r->trials[1].track->x[1]));  // "": tracking lost
 }
 
+TEST(Recording, AColumnNamedAsTrackersNameItIsExplained) {
+  // Tracking software and spreadsheets name columns their own way; the refusal says which spec
+  // column is meant and in what unit (before the commit after c27f8ec a camera's 'y_m' was
+  // answered "did you mean 'x_m'?").
+  test::ScratchDir dir("rec");
+  test::write_text(dir / "recording.json", R"({"format": "recording/1", "test": "drop", "surface": "Q235",
+  "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})");
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"t (s),x (m),z (m)", "unknown column 't (s)' (did you mean 't_s'? in seconds)"},
+      {"time,x_m,z_m", "unknown column 'time' (did you mean 't_s'? in seconds)"},
+      {"t_ms,x_m,z_m", "unknown column 't_ms' (did you mean 't_s'? in seconds, not ms)"},
+      {"t_s,x_m,y_m", "unknown column 'y_m' (did you mean 'z_m'? the spec's vertical, in metres, up positive)"},
+      {"t_s,X [mm],z_m", "unknown column 'X [mm]' (did you mean 'x_m'? in metres, not mm)"},
+      {"t_s,x_px,z_px", "unknown column 'x_px' (positions in pixels? x_m and z_m are metres in the camera plane"},
+      {"frame,t_s,x_m,z_m", "unknown column 'frame' (a frame number? the spec's track has no such column"},
+      {"t_s,x_m,z_m,tilt_rad", "unknown column 'tilt_rad' (did you mean 'tilt_deg'? in degrees, not rad)"},
+      {"t_s,x_m,z_m,spin", "unknown column 'spin' (t_s, x_m, z_m, angle_rad, tilt_deg)"},
+  };
+  for (const auto& [header, expected] : cases) {
+    SCOPED_TRACE(header);
+    test::write_text(dir / "t.csv", header + "\n0,0,0.2,0\n");
+    const auto r = read_recording(dir.path());
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("t.csv:1: " + expected), std::string::npos) << r.error().message;
+  }
+}
+
 TEST(Recording, BadInputNamesFileAndLine) {
   test::ScratchDir dir("rec");
   struct Case {
