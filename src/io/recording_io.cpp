@@ -77,14 +77,29 @@ class ManifestReader {
   std::string text_;
 };
 
-std::string extras(const json& object, std::initializer_list<const char*> known) {
+/// The keys of `object` the spec does not name (`known`), and of each object the spec nests in it
+/// (`nested`), that one under its own key: kept when the tool rewrites the recording, as the spec
+/// asks of extra keys anywhere (a camera's "model", a set-up's "operator", a summary's "notes").
+json extra_keys(const json& object, std::initializer_list<const char*> known,
+                std::initializer_list<std::pair<const char*, std::initializer_list<const char*>>> nested = {}) {
   json rest = json::object();
   for (const auto& [key, value] : object.items()) {
-    bool is_known = false;
-    for (const char* k : known) is_known = is_known || key == k;
-    if (!is_known) rest[key] = value;
+    if (std::ranges::find_if(known, [&](const char* k) { return key == k; }) == known.end()) rest[key] = value;
   }
-  return rest.dump();
+  for (const auto& [key, inner] : nested) {
+    if (!object.contains(key) || !object[key].is_object()) continue;
+    json kept = extra_keys(object[key], inner);
+    if (!kept.empty()) rest[key] = std::move(kept);
+  }
+  return rest;
+}
+
+/// A spec object to write: the extra keys read with it (under `key` in `extras`), then `known`'s
+/// values over them.
+json with_extras(const json& extras, const char* key, json known) {
+  json out = extras.contains(key) ? extras[key] : json::object();
+  out.update(known);
+  return out;
 }
 
 /// The largest magnitude a track column can hold in any experiment.
@@ -843,10 +858,18 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
     }
     if (!trial.summary && !trial.track)
       reader.error("id", fmt::format("trial '{}' has neither a summary nor a track", trial.id), search_from);
-    trial.extra_json = extras(entry, {"id", "summary", "track", "orientation_wxyz"});
+    trial.extra_json =
+        extra_keys(entry, {"id", "summary", "track", "orientation_wxyz"}, {{"summary", {summary_key(r.test).data()}}})
+            .dump();
     r.trials.push_back(std::move(trial));
   }
-  r.extra_json = extras(manifest, {"format", "test", "surface", "setup", "particle", "camera", "trials"});
+  r.extra_json =
+      extra_keys(
+          manifest, {"format", "test", "surface", "setup", "particle", "camera", "trials"},
+          {{"setup", {"release_height_m", "incline_deg", "start_distance_m", "tilt_rate_deg_per_s", "composite"}},
+           {"particle", {"mesh", "mesh_units", "density_kg_m3"}},
+           {"camera", {"frame_rate_hz", "position_noise_m"}}})
+          .dump();
   return r;
 }
 
@@ -922,7 +945,8 @@ Result<void> names_are_text(const fs::path& dir, const Recording& r) {
 
 /// The manifest and track files of `r` in `dir`, built before anything is written.
 std::vector<std::pair<fs::path, std::string>> recording_files(const fs::path& dir, const Recording& r) {
-  json manifest = json::parse(r.extra_json);
+  const json extras = json::parse(r.extra_json);
+  json manifest = extras;
   manifest["format"] = "recording/1";
   manifest["test"] = std::string(to_string(r.test));
   manifest["surface"] = r.surface;
@@ -936,30 +960,31 @@ std::vector<std::pair<fs::path, std::string>> recording_files(const fs::path& di
     if (r.tilt_rate_deg_per_s) setup["tilt_rate_deg_per_s"] = *r.tilt_rate_deg_per_s;
     setup["composite"] = r.composite == Composite::FourSquare ? "four-square" : "single";
   }
-  manifest["setup"] = setup;
-  if (r.particle_mesh || r.particle_density) {
-    json particle = json::object();
-    if (r.particle_mesh) particle["mesh"] = *r.particle_mesh;
-    if (r.particle_mesh_units) particle["mesh_units"] = *r.particle_mesh_units;
-    if (r.particle_density) particle["density_kg_m3"] = *r.particle_density;
-    manifest["particle"] = particle;
-  }
-  if (r.frame_rate_hz || r.position_noise_m) {
-    json camera = json::object();
-    if (r.frame_rate_hz) camera["frame_rate_hz"] = *r.frame_rate_hz;
-    if (r.position_noise_m) camera["position_noise_m"] = *r.position_noise_m;
-    manifest["camera"] = camera;
-  }
+  manifest["setup"] = with_extras(extras, "setup", setup);
+  json particle = json::object();
+  if (r.particle_mesh) particle["mesh"] = *r.particle_mesh;
+  if (r.particle_mesh_units) particle["mesh_units"] = *r.particle_mesh_units;
+  if (r.particle_density) particle["density_kg_m3"] = *r.particle_density;
+  if (!particle.empty() || extras.contains("particle"))
+    manifest["particle"] = with_extras(extras, "particle", particle);
+  json camera = json::object();
+  if (r.frame_rate_hz) camera["frame_rate_hz"] = *r.frame_rate_hz;
+  if (r.position_noise_m) camera["position_noise_m"] = *r.position_noise_m;
+  if (!camera.empty() || extras.contains("camera")) manifest["camera"] = with_extras(extras, "camera", camera);
   std::vector<std::pair<fs::path, std::string>> files;
   manifest["trials"] = json::array();
   for (const auto& trial : r.trials) {
-    json entry = json::parse(trial.extra_json);
+    const json trial_extras = json::parse(trial.extra_json);
+    json entry = trial_extras;
     entry["id"] = trial.id;
     if (trial.release_orientation) {
       const auto& q = *trial.release_orientation;
       entry["orientation_wxyz"] = {q.w(), q.x(), q.y(), q.z()};
     }
-    if (trial.summary) entry["summary"] = {{std::string(summary_key(r.test)), *trial.summary}};
+    json summary = json::object();
+    if (trial.summary) summary[std::string(summary_key(r.test))] = *trial.summary;
+    if (!summary.empty() || trial_extras.contains("summary"))
+      entry["summary"] = with_extras(trial_extras, "summary", summary);
     if (trial.track) {
       const std::string name = trial.track_file.empty() ? fmt::format("trial-{}.csv", trial.id) : trial.track_file;
       entry["track"] = name;

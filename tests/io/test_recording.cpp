@@ -12,6 +12,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
 #include <sstream>
@@ -51,11 +52,12 @@ TEST(Recording, RoundTripKeepsTracksAndExtraKeys) {
   test::ScratchDir dir("rec");
   test::write_text(dir / "recording.json", R"({
   "format": "recording/1", "test": "drop", "surface": "Q235",
-  "setup": {"release_height_m": 0.5},
-  "camera": {"frame_rate_hz": 1000, "position_noise_m": 0.0001},
+  "setup": {"release_height_m": 0.5, "operator": "AB"},
+  "camera": {"frame_rate_hz": 1000, "position_noise_m": 0.0001, "model": "Phantom VEO 710"},
+  "particle": {"batch": 7},
   "notes": "kept", "trials": [
     {"id": "01", "track": "t1.csv", "orientation": [1, 0, 0, 0]},
-    {"id": "02", "summary": {"rebound_height_m": 0.03}}]})");
+    {"id": "02", "summary": {"rebound_height_m": 0.03, "read_by": "eye"}}]})");
   test::write_text(dir / "t1.csv", "t_s,x_m,z_m,angle_rad\n0.000,0.0,0.5,0.1\n0.001,0.0,0.49999,\n0.003,,0.4999,0.2\n");
   const auto r = read_recording(dir.path());
   ASSERT_TRUE(r) << r.error().message;
@@ -72,6 +74,19 @@ TEST(Recording, RoundTripKeepsTracksAndExtraKeys) {
   const std::string manifest = test::read_text(dir / "copy" / "recording.json");
   EXPECT_NE(manifest.find("\"notes\": \"kept\""), std::string::npos);
   EXPECT_NE(manifest.find("\"orientation\""), std::string::npos);
+  // Extra keys inside the spec's own objects too (the spec: "anywhere in the manifest"); before
+  // the commit after ced978c the set-up's, camera's, particle's and summary's were dropped.
+  auto kept = nlohmann::json::parse(manifest);  // not const: a missing key reads as null
+  EXPECT_EQ(kept["setup"]["operator"], "AB");
+  EXPECT_EQ(kept["setup"]["release_height_m"], 0.5);
+  EXPECT_EQ(kept["camera"]["model"], "Phantom VEO 710");
+  EXPECT_EQ(kept["camera"]["frame_rate_hz"], 1000.0);
+  EXPECT_EQ(kept["particle"]["batch"], 7);
+  EXPECT_EQ(kept["trials"][1]["summary"]["read_by"], "eye");
+  EXPECT_EQ(kept["trials"][1]["summary"]["rebound_height_m"], 0.03);
+  EXPECT_FALSE(kept["trials"][0].contains("summary"));
+  EXPECT_EQ(again->extra_json, r->extra_json);
+  EXPECT_EQ(again->trials[1].extra_json, r->trials[1].extra_json);
 }
 
 TEST(Recording, ANameThatIsNotUtf8IsRefusedWritingNothing) {
