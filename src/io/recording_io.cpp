@@ -36,6 +36,24 @@ std::size_t line_of(const std::string& text, const std::string& key, std::size_t
   return 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<long>(end), '\n'));
 }
 
+/// Which key of `object` names what the missing `key` does, in words: one spelled with another
+/// unit or none ('release_height_mm' or 'release_height' for 'release_height_m').
+std::string near_key(const json& object, std::string_view key) {
+  if (!object.is_object()) return {};
+  std::string_view stem = key;
+  for (std::string_view unit : {"_kg_m3", "_deg_per_s", "_deg", "_hz", "_m"}) {
+    if (key.ends_with(unit)) {
+      stem = key.substr(0, key.size() - unit.size());
+      break;
+    }
+  }
+  for (const auto& [name, value] : object.items()) {
+    if (name.starts_with(stem))
+      return fmt::format(" (it has '{}': the spec's key is '{}', its unit in the name)", name, key);
+  }
+  return {};
+}
+
 class ManifestReader {
  public:
   ManifestReader(std::string file, std::string text) : file_(std::move(file)), text_(std::move(text)) {}
@@ -49,7 +67,8 @@ class ManifestReader {
   /// A number in (low, high] (or [low, high] with `closed_low`); `unit` names the limit's unit.
   double bounded(const json& object, const char* key, const std::string& where, double low, double high,
                  std::string_view unit, bool closed_low = false) const {
-    if (!object.contains(key)) error(where, fmt::format("'{}' is missing its '{}'", where, key));
+    if (!object.contains(key))
+      error(where, fmt::format("'{}' is missing its '{}'{}", where, key, near_key(object, key)));
     const auto& value = object.at(key);
     if (!value.is_number()) error(key, fmt::format("'{}' must be a number", key));
     const double v = value.get<double>();

@@ -196,6 +196,11 @@ TEST(Recording, BadInputNamesFileAndLine) {
       {"{\n\"format\": \"recording/1\",\n\"test\": \"roll\",\n\"surface\": \"Q235\",\n\"setup\": {\"incline_deg\": "
        "30},\n\"trials\": []}",
        "", "is missing its 'start_distance_m'"},
+      // The key spelled with another unit: which one it has is said.
+      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_mm": 200}, "trials": []})",
+       "",
+       "recording.json:1: 'setup' is missing its 'release_height_m' (it has 'release_height_mm': the spec's key is "
+       "'release_height_m', its unit in the name)"},
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
        "t_s,x_m,z_m\n0.0,0,0.2\n0.002,0,0.2\n0.001,0,0.2\n", "t.csv:4: time 0.001 does not increase"},
       {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
