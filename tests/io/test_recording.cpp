@@ -183,6 +183,9 @@ TEST(Recording, AColumnNamedAsTrackersNameItIsExplained) {
 }
 
 TEST(Recording, BadInputNamesFileAndLine) {
+  // A drop with one tracked trial, its track t.csv.
+  const std::string drop_t =
+      R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})";
   test::ScratchDir dir("rec");
   struct Case {
     std::string manifest, track, expected;
@@ -201,42 +204,30 @@ TEST(Recording, BadInputNamesFileAndLine) {
        "",
        "recording.json:1: 'setup' is missing its 'release_height_m' (it has 'release_height_mm': the spec's key is "
        "'release_height_m', its unit in the name)"},
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s,x_m,z_m\n0.0,0,0.2\n0.002,0,0.2\n0.001,0,0.2\n", "t.csv:4: time 0.001 does not increase"},
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s,x_m,z_m\n0.0,0,abc\n", "t.csv:2: 'abc' in column z_m is not a number"},
+      {drop_t, "t_s,x_m,z_m\n0.0,0,0.2\n0.002,0,0.2\n0.001,0,0.2\n", "t.csv:4: time 0.001 does not increase"},
+      {drop_t, "t_s,x_m,z_m\n0.0,0,abc\n", "t.csv:2: 'abc' in column z_m is not a number"},
       // A spreadsheet saved where the decimal mark is a comma: ';' between cells, or commas both
       // between cells and in numbers.
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s;x_m;z_m\n0,0;0;0,2\n",
+      {drop_t, "t_s;x_m;z_m\n0,0;0;0,2\n",
        "t.csv:1: unknown column 't_s;x_m;z_m' (t_s, x_m, z_m, angle_rad, tilt_deg); its columns are separated by "
        "';', where the spec's are commas (a spreadsheet's export in a locale with decimal commas? the spec's numbers "
        "have a decimal point)"},
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s\tx_m\tz_m\n0.0\t0\t0.2\n", "its columns are separated by tabs"},
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s,x_m,z_m\n24,155863,0,007633133,0,2071849\n",
+      {drop_t, "t_s\tx_m\tz_m\n0.0\t0\t0.2\n", "its columns are separated by tabs"},
+      {drop_t, "t_s,x_m,z_m\n24,155863,0,007633133,0,2071849\n",
        "t.csv:2: 6 cells where the header has 3 (numbers with a decimal comma? the spec's have a decimal point)"},
       // Tracking software writes NaN where it lost the particle; the spec's lost cell is empty.
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s,x_m,z_m\n0.0,0,0.2\n0.001,NaN,NaN\n",
+      {drop_t, "t_s,x_m,z_m\n0.0,0,0.2\n0.001,NaN,NaN\n",
        "t.csv:3: 'NaN' in column x_m is not a number (where tracking was lost, the spec leaves the cell empty)"},
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s,x_m,z_m,speed\n0.0,0,0.2,1\n", "t.csv:1: unknown column 'speed'"},
+      {drop_t, "t_s,x_m,z_m,speed\n0.0,0,0.2,1\n", "t.csv:1: unknown column 'speed'"},
       // A row index, as pandas' to_csv and R's write.csv write by default; a column left unnamed;
       // a quote left open; a decimal comma inside quotes.
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       ",t_s,x_m,z_m\n0,0.0,0,0.2\n",
+      {drop_t, ",t_s,x_m,z_m\n0,0.0,0,0.2\n",
        "t.csv:1: column 1 has no name: a row index (as pandas' to_csv writes without index=False and R's write.csv "
        "without row.names=FALSE)? the spec's track has none"},
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "\"\",\"t_s\",\"x_m\",\"z_m\"\n\"1\",0.0,0,0.2\n", "t.csv:1: column 1 has no name: a row index"},
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s,,x_m,z_m\n0.0,,0,0.2\n", "t.csv:1: column 2 has no name (t_s, x_m, z_m, angle_rad, tilt_deg)"},
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s,x_m,z_m\n0.0,0,0.2\n0.001,\"0,0.2\n", "t.csv:3: a quote is left open"},
-      {R"({"format": "recording/1", "test": "drop", "surface": "Q235", "setup": {"release_height_m": 0.2}, "trials": [{"id": "1", "track": "t.csv"}]})",
-       "t_s,x_m,z_m\n0.0,\"0,001\",0.2\n",
+      {drop_t, "\"\",\"t_s\",\"x_m\",\"z_m\"\n\"1\",0.0,0,0.2\n", "t.csv:1: column 1 has no name: a row index"},
+      {drop_t, "t_s,,x_m,z_m\n0.0,,0,0.2\n", "t.csv:1: column 2 has no name (t_s, x_m, z_m, angle_rad, tilt_deg)"},
+      {drop_t, "t_s,x_m,z_m\n0.0,0,0.2\n0.001,\"0,0.2\n", "t.csv:3: a quote is left open"},
+      {drop_t, "t_s,x_m,z_m\n0.0,\"0,001\",0.2\n",
        "t.csv:2: '0,001' in column x_m is not a number (a decimal comma? the spec's numbers have a decimal point)"},
       {"{\"format\": \"recording/1\",\n \"test\": \"drop\" \"surface\": 1}", "", "recording.json:2: not valid JSON"},
       // Valid JSON, but beyond a double's range: not "internal error" (found by flipping bytes).
