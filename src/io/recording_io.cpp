@@ -99,11 +99,11 @@ class ManifestReader {
 /// The keys of `object` the spec does not name (`known`), and of each object the spec nests in it
 /// (`nested`), that one under its own key: kept when the tool rewrites the recording, as the spec
 /// asks of extra keys anywhere (a camera's "model", a set-up's "operator", a summary's "notes").
-json extra_keys(const json& object, std::initializer_list<const char*> known,
-                std::initializer_list<std::pair<const char*, std::initializer_list<const char*>>> nested = {}) {
+json extra_keys(const json& object, std::initializer_list<std::string_view> known,
+                std::initializer_list<std::pair<const char*, std::initializer_list<std::string_view>>> nested = {}) {
   json rest = json::object();
   for (const auto& [key, value] : object.items()) {
-    if (std::ranges::find_if(known, [&](const char* k) { return key == k; }) == known.end()) rest[key] = value;
+    if (std::ranges::find(known, std::string_view(key)) == known.end()) rest[key] = value;
   }
   for (const auto& [key, inner] : nested) {
     if (!object.contains(key) || !object[key].is_object()) continue;
@@ -274,7 +274,7 @@ double median_step(const std::vector<double>& t) {
 /// unit (units_hint), or nothing.
 std::string time_hint(const std::vector<double>& t, double ratio) {
   const std::string units = units_hint(ratio, kTimeUnits);
-  const auto whole = [](double t) { return std::abs(t - std::round(t)) < 1e-9; };
+  const auto whole = [](double time) { return std::abs(time - std::round(time)) < 1e-9; };
   if (t.size() < 10 || !std::ranges::all_of(t, whole) || median_step(t) != 1.0) return units;
   return fmt::format(" (frame numbers{}? divide them by the camera's frame rate)",
                      units.find("milliseconds") != std::string::npos ? ", or milliseconds" : "");
@@ -485,28 +485,25 @@ std::optional<std::string> wrong_drop_timing(const Track& track, double height) 
 /// less than the rate says (diagnose reads the column only with a stated rate, to time the plate's
 /// start; without one a column in radians cannot be told from a slow plate's).
 std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
-  if (track.tilt.size() != track.t.size()) return std::nullopt;
-  std::vector<std::size_t> rows;
-  for (std::size_t i = 0; i < track.size(); ++i) {
-    if (std::isfinite(track.tilt[i])) rows.push_back(i);
-  }
-  if (rows.size() < 10) return std::nullopt;
-  const double start = track.tilt[rows.front()];
-  double top = start;
-  for (std::size_t i : rows) top = std::max(top, track.tilt[i]);
+  const auto [t, tilt] = tracked_together(track.t, track.tilt);
+  if (tilt.size() < 10) return std::nullopt;
+  const double start = tilt.front(), top = std::ranges::max(tilt);
   if (top <= start) return std::nullopt;
   const double low = start + 0.1 * (top - start), high = start + 0.9 * (top - start);
-  const auto first = std::ranges::find_if(rows, [&](std::size_t i) { return track.tilt[i] >= low; });
-  const auto upper = std::ranges::find_if(rows, [&](std::size_t i) { return track.tilt[i] >= high; });
-  if (first == rows.end() || upper == rows.end() || *upper <= *first) return std::nullopt;
-  const double seconds = track.t[*upper] - track.t[*first];
+  const auto first =
+      static_cast<std::size_t>(std::ranges::find_if(tilt, [&](double v) { return v >= low; }) - tilt.begin());
+  const auto upper =
+      static_cast<std::size_t>(std::ranges::find_if(tilt, [&](double v) { return v >= high; }) - tilt.begin());
+  if (upper == tilt.size() || upper <= first) return std::nullopt;
+  const double seconds = t[upper] - t[first];
   if (top - start < 2.0) {
     // A small rise is judged only where the plate rises steadily through it: not an encoder's
     // jitter about a held angle (a fifth or more of the stretch's rows back below its start).
-    const auto below = std::count_if(first, upper, [&](std::size_t i) { return track.tilt[i] < low; });
-    if (stated * seconds < 1.0 || 5 * below >= upper - first) return std::nullopt;
+    const auto stretch = std::span(tilt).subspan(first, upper - first);
+    const auto below = static_cast<std::size_t>(std::ranges::count_if(stretch, [&](double v) { return v < low; }));
+    if (stated * seconds < 1.0 || 5 * below >= stretch.size()) return std::nullopt;
   }
-  const double rate = (track.tilt[*upper] - track.tilt[*first]) / seconds;
+  const double rate = (tilt[upper] - tilt[first]) / seconds;
   if (rate >= 0.5 * stated && rate <= 2.0 * stated) return std::nullopt;
   const double per_radian = 180.0 / std::numbers::pi;
   // A column in radians, not frame numbers at about 57 fps: no plate tilts past 90 deg.
@@ -514,18 +511,18 @@ std::optional<std::string> wrong_tilt_rate(const Track& track, double stated) {
     return fmt::format(
         "its plate tilts at {:.4g} deg/s (tilt_deg from {:.3g} to {:.3g}), where the set-up's "
         "tilt_rate_deg_per_s is {:g}: tilt_deg must be in degrees ({:.3g} rad is {:.3g} deg?)",
-        rate, track.tilt[*first], track.tilt[*upper], stated, top, top * per_radian);
+        rate, tilt[first], tilt[upper], stated, top, top * per_radian);
   }
   if (rate >= 0.5 * per_radian * stated && rate <= 2.0 * per_radian * stated) {
     return fmt::format(
         "its plate tilts at {:.4g} deg/s (tilt_deg from {:.3g} to {:.3g} deg), where the set-up's "
         "tilt_rate_deg_per_s is {:g}: the rate must be in deg/s ({:g} rad/s is {:.3g} deg/s?)",
-        rate, track.tilt[*first], track.tilt[*upper], stated, stated, stated * per_radian);
+        rate, tilt[first], tilt[upper], stated, stated, stated * per_radian);
   }
   return fmt::format(
       "its plate tilts at {:.4g} deg/s (tilt_deg from {:.3g} to {:.3g} deg), where the set-up's "
       "tilt_rate_deg_per_s is {:g}: t_s must be in seconds{}",
-      rate, track.tilt[*first], track.tilt[*upper], stated, time_hint(track.t, stated / rate));
+      rate, tilt[first], tilt[upper], stated, time_hint(track.t, stated / rate));
 }
 
 /// What is wrong with a roll's track that comes down its incline far faster or far more slowly
@@ -878,8 +875,7 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
     if (!trial.summary && !trial.track)
       reader.error("id", fmt::format("trial '{}' has neither a summary nor a track", trial.id), search_from);
     trial.extra_json =
-        extra_keys(entry, {"id", "summary", "track", "orientation_wxyz"}, {{"summary", {summary_key(r.test).data()}}})
-            .dump();
+        extra_keys(entry, {"id", "summary", "track", "orientation_wxyz"}, {{"summary", {summary_key(r.test)}}}).dump();
     r.trials.push_back(std::move(trial));
   }
   r.extra_json =
