@@ -19,6 +19,8 @@
 #include "core/sha256.hpp"
 #include "core/text.hpp"
 #include "core/units.hpp"
+#include "dem/lab.hpp"
+#include "io/recording_io.hpp"
 #include "mesh/load.hpp"
 
 namespace clumpforge::cli {
@@ -235,6 +237,56 @@ Result<std::vector<double>> parse_diameter_list(const std::string& text) {
 
 std::string density_source(bool given) {
   return given ? "given" : "not given: the study's Corydalis tuber density (--density to set)";
+}
+
+nlohmann::json keys_not_read_json(const std::vector<Recording>& recordings,
+                                  const std::vector<std::filesystem::path>& manifests) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t i = 0; i < recordings.size(); ++i) {
+    for (const auto& k : keys_not_read(recordings[i])) {
+      auto seen = std::ranges::find_if(out, [&](const nlohmann::json& e) {
+        return e["section"] == k.section && e["key"] == k.key && e["spec_key"] == k.spec_key;
+      });
+      if (seen != out.end()) {
+        (*seen)["recordings"] = (*seen)["recordings"].get<std::size_t>() + 1;
+        continue;
+      }
+      out.push_back({{"section", k.section},
+                     {"key", k.key},
+                     {"value", nlohmann::json::parse(k.value)},
+                     {"spec_key", k.spec_key},
+                     {"recordings", 1},
+                     {"of", recordings.size()},
+                     {"first", i < manifests.size() ? manifests[i].string() : std::string()}});
+    }
+  }
+  return out;
+}
+
+namespace {
+// What the commands do without a spec key, in words.
+std::string without(std::string_view spec_key) {
+  if (spec_key == "density_kg_m3")
+    return fmt::format("the density is --density's or the library clump's, else {:g} kg/m^3 (the Corydalis tuber's)",
+                       kStudyDensity);
+  if (spec_key == "tilt_rate_deg_per_s")
+    return fmt::format("the plate is tilted at {:g} deg/s", LabOptions{}.tilt_rate_deg_per_s);
+  if (spec_key == "composite") return "the tilt is of a single particle";
+  if (spec_key == "frame_rate_hz") return "the tracks' frame spacing is not checked against a rate";
+  if (spec_key == "position_noise_m") return "the camera noise is measured from the tracks alone";
+  if (spec_key == "mesh" || spec_key == "mesh_units") return "the mesh is --mesh's, at --units (mm by default)";
+  return "the tool takes its default";
+}
+}  // namespace
+
+std::string key_not_read_note(const nlohmann::json& entry) {
+  const auto n = entry["recordings"].get<std::size_t>(), of = entry["of"].get<std::size_t>();
+  const std::string spec_key = entry["spec_key"].get<std::string>();
+  return fmt::format("{} '{}' ({}) is kept but not read: the spec's key is '{}' ({}{}); until it is named so, {}",
+                     entry["section"].get<std::string>(), entry["key"].get<std::string>(), entry["value"].dump(),
+                     spec_key,
+                     n == of && of == 1 ? std::string("in ") : fmt::format("in {} of {} recordings, the first ", n, of),
+                     entry["first"].get<std::string>(), without(spec_key));
 }
 
 RunContext progress_context(bool json) {

@@ -2,11 +2,13 @@
 /// Helpers shared by the subcommands: exit codes, error printing, JSON of library types.
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/recording.hpp"
 #include "dem/world.hpp"
 #include "fill/body.hpp"
 #include "mesh/mass_properties.hpp"
@@ -87,6 +89,14 @@ inline constexpr double kStudyDensity = 1085.0;
 /// How a density came to be used, for the output and the report: "given" or the default said
 /// in full, never silent.
 std::string density_source(bool given);
+
+/// The recordings' keys that look like spec keys they do not state (keys_not_read), once per key:
+/// section, key, its first value, the spec's key, how many of the recordings hold it and the first
+/// one's manifest (`manifests` parallel to `recordings`). A report's `keys_not_read`.
+nlohmann::json keys_not_read_json(const std::vector<Recording>& recordings,
+                                  const std::vector<std::filesystem::path>& manifests);
+/// One entry of keys_not_read_json in words, for a report's notes.
+std::string key_not_read_note(const nlohmann::json& entry);
 
 /// Progress on stderr after the first second, when stderr is a terminal and not --json.
 RunContext progress_context(bool json);

@@ -153,8 +153,15 @@ std::string joint_markdown(const std::vector<JointSurfaceResult>& results) {
   return text + "\n";
 }
 
+// The recordings' keys that look like spec keys they do not state, as notes below a report.
+std::string unread_notes(const nlohmann::json& keys_not_read) {
+  std::string text;
+  for (const auto& k : keys_not_read) text += fmt::format("note: {}\n", key_not_read_note(k));
+  return text;
+}
+
 int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<Recording>& recordings,
-              const MaterialTable& table, const Team& team) {
+              const nlohmann::json& keys_not_read, const MaterialTable& table, const Team& team) {
   constexpr std::string_view kCommand = "calibrate";
   JointOptions options;
   options.lab.contact = contact_settings(conventions_of(args));
@@ -170,6 +177,7 @@ int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<R
                         {"trials", options.trials},
                         {"seed", args.seed},
                         {"conventions", args.conventions},
+                        {"keys_not_read", keys_not_read},
                         {"surfaces", nlohmann::json::array()}};
   std::map<std::string, Interaction> calibrated;
   for (const auto& r : *results) {
@@ -196,7 +204,7 @@ int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<R
                                   {"dem_evaluations", r.evaluations},
                                   {"notes", r.notes}});
   }
-  const std::string text = joint_markdown(*results);
+  const std::string text = joint_markdown(*results) + unread_notes(keys_not_read);
   if (!args.out.empty()) {
     std::error_code ec;
     fs::create_directories(args.out, ec);
@@ -238,11 +246,14 @@ int run_calibrate(const CalibrateArgs& args) {
     return report_error(kCommand, {ErrorCode::InvalidArgument, "--trials-per-level must be between 1 and 1000"});
   }
   std::vector<Recording> recordings;
+  std::vector<fs::path> manifests;
   for (const auto& path : args.recordings) {
     auto r = read_recording(path);
     if (!r) return report_error(kCommand, r.error());
     recordings.push_back(std::move(*r));
+    manifests.push_back(fs::is_directory(path) ? fs::path(path) / "recording.json" : fs::path(path));
   }
+  const nlohmann::json unread = keys_not_read_json(recordings, manifests);
   auto clumps = read_clump_library(args.clump_file);
   if (!clumps) return report_error(kCommand, clumps.error());
   auto clump = select_clump(std::move(*clumps), args.clump_name, args.clump_file);
@@ -253,7 +264,7 @@ int run_calibrate(const CalibrateArgs& args) {
   // Under mpirun or srun the ranks share the DEM runs (a sweep's levels, an evaluation's tests).
   auto team = Team::join({.threads_per_rank = args.threads});
   if (!team) return report_error(kCommand, team.error());
-  if (args.method == "joint") return run_joint(args, *clump, recordings, *table, *team);
+  if (args.method == "joint") return run_joint(args, *clump, recordings, unread, *table, *team);
   PaperOptions options;
   options.trials_per_level = args.trials_per_level;
   options.lab.seed = args.seed;
@@ -269,6 +280,7 @@ int run_calibrate(const CalibrateArgs& args) {
                         {"trials_per_level", args.trials_per_level},
                         {"seed", args.seed},
                         {"conventions", args.conventions},
+                        {"keys_not_read", unread},
                         {"steps", nlohmann::json::array()},
                         {"results", nlohmann::json::object()},
                         {"notes", calibration->notes}};
@@ -284,11 +296,10 @@ int run_calibrate(const CalibrateArgs& args) {
     auto materials = materials_out(args, *clump, *table, {calibration->results.begin(), calibration->results.end()});
     if (!materials) return report_error(kCommand, materials.error());
     std::vector<std::pair<fs::path, std::string>> files = std::move(*materials);
-    files.insert(
-        files.end(),
-        {{fs::path(args.out) / "calibration.json", report_json_text(report) + "\n"},
-         {fs::path(args.out) / "calibration.md",
-          fmt::format("# Calibration by the study's method ({})\n\n{}\n", clump->name, markdown(*calibration))}});
+    files.insert(files.end(), {{fs::path(args.out) / "calibration.json", report_json_text(report) + "\n"},
+                               {fs::path(args.out) / "calibration.md",
+                                fmt::format("# Calibration by the study's method ({})\n\n{}\n{}", clump->name,
+                                            markdown(*calibration), unread_notes(unread))}});
     if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
     draw_figures(kCommand, "calibration", args.out);
   }
@@ -298,6 +309,7 @@ int run_calibrate(const CalibrateArgs& args) {
     std::string shown = fmt::format("calibration of clump '{}' by the study's method ({} trials per level)\n\n{}\n",
                                     clump->name, args.trials_per_level, markdown(*calibration));
     for (const auto& note : calibration->notes) shown += fmt::format("note: {}\n", note);
+    shown += unread_notes(unread);
     print_report_text(shown);
     if (!args.out.empty()) fmt::print("report, sweeps and plots written to {}/\n", args.out);
   }

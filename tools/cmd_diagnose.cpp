@@ -114,7 +114,7 @@ void write_text(std::ostream& out, const DiagnoseResult& r) {
 }
 
 /// The particle diagnosed (report.json's `particle`): which model, its density and where each came from.
-void write_particle(std::ostream& out, const nlohmann::json& particle) {
+void write_particle(std::ostream& out, const nlohmann::json& particle, const nlohmann::json& keys_not_read) {
   const auto from = [](const nlohmann::json& where) {
     return where == "command_line" ? std::string("as given") : fmt::format("from the {}", where.get<std::string>());
   };
@@ -122,9 +122,18 @@ void write_particle(std::ostream& out, const nlohmann::json& particle) {
                                 ? fmt::format("library {}", particle["library"].get<std::string>())
                                 : fmt::format("mesh {} ({}, {})", particle["mesh"].get<std::string>(),
                                               particle["mesh_units"].get<std::string>(), from(particle["mesh_from"]));
+  const auto unread_density = std::ranges::find(keys_not_read, nlohmann::json("density_kg_m3"),
+                                                [](const nlohmann::json& k) { return k["spec_key"]; });
+  const std::string unread = unread_density == keys_not_read.end()
+                                 ? std::string()
+                                 : fmt::format(
+                                       "; the recordings' '{}' is not read: name it 'density_kg_m3' or give "
+                                       "--density",
+                                       (*unread_density)["key"].get<std::string>());
   out << fmt::format("particle: {}; density {:g} kg/m^3 ({})\n", model, particle["density_kg_m3"].get<double>(),
-                     particle["density_from"] == "default" ? std::string("not stated or given: the Corydalis tuber's")
+                     particle["density_from"] == "default" ? "not stated or given: the Corydalis tuber's" + unread
                                                            : from(particle["density_from"]));
+  for (const auto& k : keys_not_read) out << "note: " << key_not_read_note(k) << "\n";
 }
 
 int run_diagnose(const DiagnoseArgs& args) {
@@ -190,7 +199,7 @@ int run_diagnose(const DiagnoseArgs& args) {
   else {
     std::ostringstream text;
     write_text(text, *result);
-    write_particle(text, report["particle"]);
+    write_particle(text, report["particle"], report["keys_not_read"]);
     print_report_text(text.str());
   }
   return kExitOk;

@@ -633,6 +633,7 @@ Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& c
       {"library", job.library.empty() ? nlohmann::json() : nlohmann::json(job.library)},
       {"density_kg_m3", choice->density},
       {"density_from", std::string(density_from_name(choice->density_from))}};
+  run.report["keys_not_read"] = keys_not_read_json(recordings, set->manifests);
   return run;
 }
 

@@ -103,7 +103,19 @@ void bind_recordings(py::module_& m) {
                     "The particle's mesh as the manifest names it, relative to the manifest (None: not named)")
       .def_readonly("particle_mesh_units", &Recording::particle_mesh_units)
       .def_readonly("trials", &Recording::trials)
-      .def_property_readonly("summaries", [](const Recording& r) { return column(r.summaries()); });
+      .def_property_readonly("summaries", [](const Recording& r) { return column(r.summaries()); })
+      .def_property_readonly(
+          "keys_not_read",
+          [](const Recording& r) {
+            py::list out;
+            for (const auto& k : keys_not_read(r))
+              out.append(py::dict(py::arg("section") = k.section, py::arg("key") = k.key, py::arg("value") = k.value,
+                                  py::arg("spec_key") = k.spec_key));
+            return out;
+          },
+          "Keys of setup, particle or camera the spec does not name but that look like a spec key the recording "
+          "does not state ({'section': 'particle', 'key': 'density', 'value': '1200', 'spec_key': "
+          "'density_kg_m3'}): kept, not read; the tool takes its default for what they seem to say");
   m.def(
       "read_recording", [](const std::filesystem::path& p) { return unwrap(read_recording(p)); }, py::arg("path"),
       "A recording directory (or its recording.json), checked against the spec.");

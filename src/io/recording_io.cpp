@@ -36,19 +36,86 @@ std::size_t line_of(const std::string& text, const std::string& key, std::size_t
   return 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<long>(end), '\n'));
 }
 
+/// A key the spec names inside `setup`, `particle` or `camera`: its section, whether it holds a
+/// number (else a string), whether a recording states it or does not need it, and the stems a lab
+/// may spell it with (its name without its unit, and other names for the same thing).
+struct SpecKey {
+  std::string_view section;
+  std::string_view key;
+  bool numeric;
+  bool (*stated)(const Recording&);
+  std::array<std::string_view, 3> stems;
+};
+
+// The longer stem of two keys first (mesh_units before mesh), so a key takes the nearest name.
+constexpr std::array kSpecKeys{
+    SpecKey{"setup",
+            "release_height_m",
+            true,
+            [](const Recording&) { return true; },
+            {"release_height", "drop_height", "height"}},
+    SpecKey{"setup", "incline_deg", true, [](const Recording&) { return true; }, {"incline", "slope", ""}},
+    SpecKey{"setup", "start_distance_m", true, [](const Recording&) { return true; }, {"start_distance", "", ""}},
+    SpecKey{"setup",
+            "tilt_rate_deg_per_s",
+            true,
+            [](const Recording& r) { return r.test != LabTest::Tilt || r.tilt_rate_deg_per_s.has_value(); },
+            {"tilt_rate", "rate", ""}},
+    SpecKey{"setup",
+            "composite",
+            false,
+            [](const Recording& r) { return r.test != LabTest::Tilt || r.composite == Composite::FourSquare; },
+            {"composite", "", ""}},
+    SpecKey{"particle",
+            "mesh_units",
+            false,
+            [](const Recording& r) { return r.particle_mesh_units.has_value(); },
+            {"mesh_unit", "unit", "length_unit"}},
+    SpecKey{"particle",
+            "mesh",
+            false,
+            [](const Recording& r) { return r.particle_mesh.has_value(); },
+            {"mesh", "stl", "scan"}},
+    SpecKey{"particle",
+            "density_kg_m3",
+            true,
+            [](const Recording& r) { return r.particle_density.has_value(); },
+            {"density", "rho", ""}},
+    SpecKey{"camera",
+            "frame_rate_hz",
+            true,
+            [](const Recording& r) { return r.frame_rate_hz.has_value(); },
+            {"frame_rate", "framerate", "fps"}},
+    SpecKey{"camera",
+            "position_noise_m",
+            true,
+            [](const Recording& r) { return r.position_noise_m.has_value(); },
+            {"position_noise", "noise", ""}},
+};
+
+/// The spec's keys of one section, for telling the extra keys from them.
+std::vector<std::string_view> spec_keys_of(std::string_view section) {
+  std::vector<std::string_view> keys;
+  for (const auto& k : kSpecKeys)
+    if (k.section == section) keys.push_back(k.key);
+  return keys;
+}
+
+/// Whether `name` (any case) begins with one of `spec`'s stems.
+bool spelled_like(std::string_view name, const SpecKey& spec) {
+  std::string lower(name);
+  std::ranges::transform(lower, lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  return std::ranges::any_of(spec.stems,
+                             [&](std::string_view stem) { return !stem.empty() && lower.starts_with(stem); });
+}
+
 /// Which key of `object` names what the missing `key` does, in words: one spelled with another
 /// unit or none ('release_height_mm' or 'release_height' for 'release_height_m').
 std::string near_key(const json& object, std::string_view key) {
-  if (!object.is_object()) return {};
-  std::string_view stem = key;
-  for (std::string_view unit : {"_kg_m3", "_deg_per_s", "_deg", "_hz", "_m"}) {
-    if (key.ends_with(unit)) {
-      stem = key.substr(0, key.size() - unit.size());
-      break;
-    }
-  }
+  const auto spec = std::ranges::find(kSpecKeys, key, &SpecKey::key);
+  if (!object.is_object() || spec == kSpecKeys.end()) return {};
   for (const auto& [name, value] : object.items()) {
-    if (name.starts_with(stem))
+    if (spelled_like(name, *spec))
       return fmt::format(" (it has '{}': the spec's key is '{}', its unit in the name)", name, key);
   }
   return {};
@@ -99,8 +166,8 @@ class ManifestReader {
 /// The keys of `object` the spec does not name (`known`), and of each object the spec nests in it
 /// (`nested`), that one under its own key: kept when the tool rewrites the recording, as the spec
 /// asks of extra keys anywhere (a camera's "model", a set-up's "operator", a summary's "notes").
-json extra_keys(const json& object, std::initializer_list<std::string_view> known,
-                std::initializer_list<std::pair<const char*, std::initializer_list<std::string_view>>> nested = {}) {
+json extra_keys(const json& object, const std::vector<std::string_view>& known,
+                std::initializer_list<std::pair<const char*, std::vector<std::string_view>>> nested = {}) {
   json rest = json::object();
   for (const auto& [key, value] : object.items()) {
     if (std::ranges::find(known, std::string_view(key)) == known.end()) rest[key] = value;
@@ -878,13 +945,11 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
         extra_keys(entry, {"id", "summary", "track", "orientation_wxyz"}, {{"summary", {summary_key(r.test)}}}).dump();
     r.trials.push_back(std::move(trial));
   }
-  r.extra_json =
-      extra_keys(
-          manifest, {"format", "test", "surface", "setup", "particle", "camera", "trials"},
-          {{"setup", {"release_height_m", "incline_deg", "start_distance_m", "tilt_rate_deg_per_s", "composite"}},
-           {"particle", {"mesh", "mesh_units", "density_kg_m3"}},
-           {"camera", {"frame_rate_hz", "position_noise_m"}}})
-          .dump();
+  r.extra_json = extra_keys(manifest, {"format", "test", "surface", "setup", "particle", "camera", "trials"},
+                            {{"setup", spec_keys_of("setup")},
+                             {"particle", spec_keys_of("particle")},
+                             {"camera", spec_keys_of("camera")}})
+                     .dump();
   return r;
 }
 
@@ -937,6 +1002,35 @@ Result<Recording> read_recording(const fs::path& path) {
   } catch (const json::exception& e) {
     return fail(ErrorCode::ParseError, fmt::format("{}: {}", manifest_path.string(), e.what()));
   }
+}
+
+namespace {
+/// Whether `value` could be what a key of `spec`'s kind holds: a number (or a number written as
+/// text, "1085 kg/m^3") for a numeric key, text for the others.
+bool holds_like(const json& value, const SpecKey& spec) {
+  if (!spec.numeric) return value.is_string();
+  if (value.is_number()) return true;
+  if (!value.is_string() || value.get_ref<const std::string&>().empty()) return false;
+  const char first = value.get_ref<const std::string&>().front();
+  return std::isdigit(static_cast<unsigned char>(first)) || first == '.' || first == '-' || first == '+';
+}
+}  // namespace
+
+std::vector<KeyNotRead> keys_not_read(const Recording& r) {
+  std::vector<KeyNotRead> out;
+  const json extras = json::parse(r.extra_json, nullptr, false);
+  if (!extras.is_object()) return out;
+  for (std::string_view section : {"setup", "particle", "camera"}) {
+    const auto at = extras.find(std::string(section));
+    if (at == extras.end() || !at->is_object()) continue;
+    for (const auto& [name, value] : at->items()) {
+      const auto spec = std::ranges::find_if(kSpecKeys, [&](const SpecKey& k) {
+        return k.section == section && !k.stated(r) && spelled_like(name, k) && holds_like(value, k);
+      });
+      if (spec != kSpecKeys.end()) out.push_back({std::string(section), name, value.dump(), std::string(spec->key)});
+    }
+  }
+  return out;
 }
 
 namespace {

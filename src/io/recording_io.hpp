@@ -17,6 +17,20 @@ Result<Recording> read_recording(const std::filesystem::path& path);
 /// trial-<id>.csv per trial with a track. Extra keys are kept. All files appear together.
 Result<void> write_recording(const std::filesystem::path& dir, const Recording& recording);
 
+/// A key inside a manifest's `setup`, `particle` or `camera` that the spec does not name but whose
+/// name and value look like a spec key the recording does not state ("density": 1200 where
+/// "density_kg_m3" is absent, "fps": 240, "tilt_rate_deg_s": 5). It is kept as an extra key, not
+/// read: the tool takes its default for what it would say, and reports say so.
+struct KeyNotRead {
+  std::string section;   ///< "setup", "particle" or "camera"
+  std::string key;       ///< as the manifest writes it
+  std::string value;     ///< its JSON text
+  std::string spec_key;  ///< the spec's key for what it seems to say
+};
+
+/// The keys of `recording`'s extra keys that look like spec keys it does not state.
+std::vector<KeyNotRead> keys_not_read(const Recording& recording);
+
 /// Recordings with the names reports give them.
 struct RecordingSet {
   std::vector<Recording> recordings;

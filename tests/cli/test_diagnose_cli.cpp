@@ -242,7 +242,8 @@ TEST(DiagnoseCli, TheParticleTheRecordingsStateIsTheOneDiagnosed) {
   // The recording names the mesh beside it and a density of 1300 kg/m^3: neither --mesh nor
   // --density is needed, and the density is the recording's, not the default tuber's 1085.
   sphere_drop_stating(dir / "stated", R"({"mesh": "sphere.stl", "mesh_units": "mm", "density_kg_m3": 1300})");
-  sphere_drop_stating(dir / "unstated", R"({})");
+  // A density under a name of the lab's own: kept, not read, and said so (a note beside it is not).
+  sphere_drop_stating(dir / "unstated", R"({"density": 1300, "density_note": "pycnometer"})");
   sphere_drop_stating(dir / "tuber-density", R"({"mesh": "sphere.stl", "density_kg_m3": 1085})");
   auto diagnosed = [&](const std::string& recording, const std::string& more) {
     const auto run = test::run_clumpforge(
@@ -263,6 +264,23 @@ TEST(DiagnoseCli, TheParticleTheRecordingsStateIsTheOneDiagnosed) {
   EXPECT_EQ(given["particle"]["density_from"], "command_line");
   EXPECT_EQ(given["baseline"], stated["baseline"]);
   EXPECT_EQ(given["hypotheses"], stated["hypotheses"]);
+  EXPECT_TRUE(stated["keys_not_read"].empty());
+  ASSERT_EQ(given["keys_not_read"].size(), 1u) << given["keys_not_read"];
+  EXPECT_EQ(given["keys_not_read"][0]["key"], "density");
+  EXPECT_EQ(given["keys_not_read"][0]["spec_key"], "density_kg_m3");
+  EXPECT_EQ(given["keys_not_read"][0]["value"], 1300);
+  // Not given either, the default is taken, and the particle's line says which key was not read.
+  const auto unread =
+      test::run_clumpforge(fmt::format("diagnose --recordings '{}' --mesh '{}' --effects air_drag",
+                                       (dir / "unstated").string(), (dir / "unstated" / "sphere.stl").string()));
+  ASSERT_EQ(unread.exit_code, 0) << unread.err;
+  EXPECT_NE(unread.out.find("density 1085 kg/m^3 (not stated or given: the Corydalis tuber's; the recordings' "
+                            "'density' is not read: name it 'density_kg_m3' or give --density)"),
+            std::string::npos)
+      << unread.out;
+  EXPECT_NE(unread.out.find("note: particle 'density' (1300) is kept but not read: the spec's key is 'density_kg_m3'"),
+            std::string::npos)
+      << unread.out;
   // At the tuber's density the same sphere is another body: its air drag's rejection moves.
   // Printed as text, the report ends by saying which particle it diagnosed.
   const auto text = test::run_clumpforge(fmt::format("diagnose --recordings '{}' --effects air_drag --output '{}'",

@@ -87,6 +87,46 @@ TEST(Recording, RoundTripKeepsTracksAndExtraKeys) {
   EXPECT_FALSE(kept["trials"][0].contains("summary"));
   EXPECT_EQ(again->extra_json, r->extra_json);
   EXPECT_EQ(again->trials[1].extra_json, r->trials[1].extra_json);
+  EXPECT_TRUE(keys_not_read(*r).empty());  // a camera's model, a particle's batch: nothing like a spec key
+}
+
+TEST(Recording, AKeySpelledLikeASpecKeyItDoesNotStateIsNamedNotRead) {
+  test::ScratchDir dir("rec-unread");
+  // A lab's manifest as written by hand: the density, the frame rate, the noise and the tilt rate
+  // under their own names. The spec allows extra keys, so each is kept; none is read, and the
+  // tool would take its default for each: keys_not_read names them with the spec's key.
+  test::write_text(dir / "recording.json", R"({
+  "format": "recording/1", "test": "tilt", "surface": "Q235",
+  "setup": {"tilt_rate_deg_s": 5, "operator": "AB", "composite": "single"},
+  "camera": {"FPS": 240, "model": "Phantom", "noise_mm": "0.5 mm"},
+  "particle": {"density": 1300, "density_note": "pycnometer", "batch": 7, "stl": "tuber.stl"},
+  "trials": [{"id": "01", "summary": {"slip_angle_deg": 31}}]})");
+  const auto r = read_recording(dir.path());
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_FALSE(r->particle_density);
+  EXPECT_FALSE(r->frame_rate_hz);
+  std::vector<std::string> seen;
+  for (const auto& k : keys_not_read(*r)) seen.push_back(k.section + " " + k.key + " " + k.value + " " + k.spec_key);
+  EXPECT_EQ(seen,
+            (std::vector<std::string>{"setup tilt_rate_deg_s 5 tilt_rate_deg_per_s",
+                                      "particle density 1300 density_kg_m3", "particle stl \"tuber.stl\" mesh",
+                                      "camera FPS 240 frame_rate_hz", "camera noise_mm \"0.5 mm\" position_noise_m"}));
+  // Written back, they are still there, and still not read.
+  ASSERT_TRUE(write_recording(dir / "copy", *r));
+  const auto again = read_recording(dir / "copy");
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_EQ(keys_not_read(*again).size(), 5u);
+  // Where the spec's key is stated, a key like it is only an extra (a second note, a copy).
+  fs::create_directories(dir / "stated");
+  test::write_text(dir / "stated" / "recording.json", R"({
+  "format": "recording/1", "test": "drop", "surface": "Q235",
+  "setup": {"release_height_m": 0.2, "height_mm": 200, "tilt_rate": 5},
+  "camera": {"frame_rate_hz": 240, "fps": 240},
+  "particle": {"density_kg_m3": 1300, "density": 1300},
+  "trials": [{"id": "01", "summary": {"rebound_height_m": 0.03}}]})");
+  const auto stated = read_recording(dir / "stated");
+  ASSERT_TRUE(stated) << stated.error().message;
+  EXPECT_TRUE(keys_not_read(*stated).empty());  // a drop needs no tilt rate
 }
 
 TEST(Recording, ANameThatIsNotUtf8IsRefusedWritingNothing) {

@@ -160,6 +160,17 @@ def test_recordings_read_and_absurd_ones_are_refused(tmp_path):
                                         '"release_height_m": 1e9, "trials": []}')
     with pytest.raises(cf.Error, match="recording.json"):
         cf.read_recording(str(bad))
+    assert drop.keys_not_read == []
+    unread = tmp_path / "unread"
+    shutil.copytree(ROOT / "clumps/tuber-default-diagnosis/recordings/drop-1m", unread)
+    manifest = json.loads((unread / "recording.json").read_text())
+    manifest.setdefault("particle", {}).pop("density_kg_m3", None)
+    manifest["particle"]["density"] = 1300  # the lab's own name: kept, not read
+    (unread / "recording.json").write_text(json.dumps(manifest))
+    misnamed = cf.read_recording(str(unread))
+    assert misnamed.particle_density is None
+    assert misnamed.keys_not_read == [
+        {"section": "particle", "key": "density", "value": "1300", "spec_key": "density_kg_m3"}]
 
 
 def test_diagnose_refuses_a_clump_of_another_density_than_the_recordings_state(tmp_path):
