@@ -91,6 +91,11 @@ constexpr std::array kSpecKeys{
             true,
             [](const Recording& r) { return r.position_noise_m.has_value(); },
             {"position_noise", "noise", ""}},
+    // A trial's summary: required where a trial has one, so only ever named in a refusal.
+    SpecKey{"summary", "rebound_height_m", true, [](const Recording&) { return true; }, {"rebound", "height", ""}},
+    SpecKey{
+        "summary", "roll_distance_m", true, [](const Recording&) { return true; }, {"roll_distance", "distance", ""}},
+    SpecKey{"summary", "slip_angle_deg", true, [](const Recording&) { return true; }, {"slip_angle", "angle", "slip"}},
 };
 
 /// The spec's keys of one section, for telling the extra keys from them.
@@ -902,7 +907,8 @@ Recording parse_manifest(const ManifestReader& reader, const json& manifest, con
       const json& summary = entry["summary"];
       if (!summary.is_object() || !summary.contains(key) || !summary[key].is_number()) {
         reader.error("summary",
-                     fmt::format("trial '{}': the summary of a {} test is {{\"{}\": number}}", trial.id, test, key),
+                     fmt::format("trial '{}': the summary of a {} test is {{\"{}\": number}}{}", trial.id, test, key,
+                                 summary.is_object() && !summary.contains(key) ? near_key(summary, key) : ""),
                      search_from);
       }
       const double v = summary[key].get<double>();

@@ -244,6 +244,11 @@ TEST(Recording, BadInputNamesFileAndLine) {
        "",
        "recording.json:1: 'setup' is missing its 'release_height_m' (it has 'release_height_mm': the spec's key is "
        "'release_height_m', its unit in the name)"},
+      // A summary spelled with another unit: the same.
+      {R"({"format": "recording/1", "test": "roll", "surface": "soil", "setup": {"incline_deg": 30, "start_distance_m": 0.07}, "trials": [{"id": "1", "summary": {"roll_distance_mm": 51.2}}]})",
+       "",
+       "recording.json:1: trial '1': the summary of a roll test is {\"roll_distance_m\": number} (it has "
+       "'roll_distance_mm': the spec's key is 'roll_distance_m', its unit in the name)"},
       {drop_t, "t_s,x_m,z_m\n0.0,0,0.2\n0.002,0,0.2\n0.001,0,0.2\n", "t.csv:4: time 0.001 does not increase"},
       {drop_t, "t_s,x_m,z_m\n0.0,0,abc\n", "t.csv:2: 'abc' in column z_m is not a number"},
       // A spreadsheet saved where the decimal mark is a comma: ';' between cells, or commas both
