@@ -47,55 +47,48 @@ struct SpecKey {
   std::array<std::string_view, 3> stems;
 };
 
+// Whether a recording states each optional key, or does not need it (a drop needs no tilt rate).
+bool always_stated(const Recording&) {
+  return true;
+}
+bool states_tilt_rate(const Recording& r) {
+  return r.test != LabTest::Tilt || r.tilt_rate_deg_per_s.has_value();
+}
+bool states_composite(const Recording& r) {
+  return r.test != LabTest::Tilt || r.composite == Composite::FourSquare;
+}
+bool states_mesh_units(const Recording& r) {
+  return r.particle_mesh_units.has_value();
+}
+bool states_mesh(const Recording& r) {
+  return r.particle_mesh.has_value();
+}
+bool states_density(const Recording& r) {
+  return r.particle_density.has_value();
+}
+bool states_frame_rate(const Recording& r) {
+  return r.frame_rate_hz.has_value();
+}
+bool states_noise(const Recording& r) {
+  return r.position_noise_m.has_value();
+}
+
 // The longer stem of two keys first (mesh_units before mesh), so a key takes the nearest name.
+// A trial's summary is required where a trial has one: only ever named in a refusal.
 constexpr std::array kSpecKeys{
-    SpecKey{"setup",
-            "release_height_m",
-            true,
-            [](const Recording&) { return true; },
-            {"release_height", "drop_height", "height"}},
-    SpecKey{"setup", "incline_deg", true, [](const Recording&) { return true; }, {"incline", "slope", ""}},
-    SpecKey{"setup", "start_distance_m", true, [](const Recording&) { return true; }, {"start_distance", "", ""}},
-    SpecKey{"setup",
-            "tilt_rate_deg_per_s",
-            true,
-            [](const Recording& r) { return r.test != LabTest::Tilt || r.tilt_rate_deg_per_s.has_value(); },
-            {"tilt_rate", "rate", ""}},
-    SpecKey{"setup",
-            "composite",
-            false,
-            [](const Recording& r) { return r.test != LabTest::Tilt || r.composite == Composite::FourSquare; },
-            {"composite", "", ""}},
-    SpecKey{"particle",
-            "mesh_units",
-            false,
-            [](const Recording& r) { return r.particle_mesh_units.has_value(); },
-            {"mesh_unit", "unit", "length_unit"}},
-    SpecKey{"particle",
-            "mesh",
-            false,
-            [](const Recording& r) { return r.particle_mesh.has_value(); },
-            {"mesh", "stl", "scan"}},
-    SpecKey{"particle",
-            "density_kg_m3",
-            true,
-            [](const Recording& r) { return r.particle_density.has_value(); },
-            {"density", "rho", ""}},
-    SpecKey{"camera",
-            "frame_rate_hz",
-            true,
-            [](const Recording& r) { return r.frame_rate_hz.has_value(); },
-            {"frame_rate", "framerate", "fps"}},
-    SpecKey{"camera",
-            "position_noise_m",
-            true,
-            [](const Recording& r) { return r.position_noise_m.has_value(); },
-            {"position_noise", "noise", ""}},
-    // A trial's summary: required where a trial has one, so only ever named in a refusal.
-    SpecKey{"summary", "rebound_height_m", true, [](const Recording&) { return true; }, {"rebound", "height", ""}},
-    SpecKey{
-        "summary", "roll_distance_m", true, [](const Recording&) { return true; }, {"roll_distance", "distance", ""}},
-    SpecKey{"summary", "slip_angle_deg", true, [](const Recording&) { return true; }, {"slip_angle", "angle", "slip"}},
+    SpecKey{"setup", "release_height_m", true, always_stated, {"release_height", "drop_height", "height"}},
+    SpecKey{"setup", "incline_deg", true, always_stated, {"incline", "slope", ""}},
+    SpecKey{"setup", "start_distance_m", true, always_stated, {"start_distance", "", ""}},
+    SpecKey{"setup", "tilt_rate_deg_per_s", true, states_tilt_rate, {"tilt_rate", "rate", ""}},
+    SpecKey{"setup", "composite", false, states_composite, {"composite", "", ""}},
+    SpecKey{"particle", "mesh_units", false, states_mesh_units, {"mesh_unit", "unit", "length_unit"}},
+    SpecKey{"particle", "mesh", false, states_mesh, {"mesh", "stl", "scan"}},
+    SpecKey{"particle", "density_kg_m3", true, states_density, {"density", "rho", ""}},
+    SpecKey{"camera", "frame_rate_hz", true, states_frame_rate, {"frame_rate", "framerate", "fps"}},
+    SpecKey{"camera", "position_noise_m", true, states_noise, {"position_noise", "noise", ""}},
+    SpecKey{"summary", "rebound_height_m", true, always_stated, {"rebound", "height", ""}},
+    SpecKey{"summary", "roll_distance_m", true, always_stated, {"roll_distance", "distance", ""}},
+    SpecKey{"summary", "slip_angle_deg", true, always_stated, {"slip_angle", "angle", "slip"}},
 };
 
 /// The spec's keys of one section, for telling the extra keys from them.
