@@ -239,6 +239,18 @@ std::string density_source(bool given) {
   return given ? "given" : "not given: the study's Corydalis tuber density (--density to set)";
 }
 
+Result<RecordingSet> read_recording_paths(const std::vector<std::string>& paths) {
+  RecordingSet all;
+  for (const auto& path : paths) {
+    auto set = read_recordings(path);
+    if (!set) return std::unexpected(set.error());
+    std::ranges::move(set->recordings, std::back_inserter(all.recordings));
+    std::ranges::move(set->names, std::back_inserter(all.names));
+    std::ranges::move(set->manifests, std::back_inserter(all.manifests));
+  }
+  return all;
+}
+
 nlohmann::json keys_not_read_json(const std::vector<Recording>& recordings,
                                   const std::vector<std::filesystem::path>& manifests) {
   nlohmann::json out = nlohmann::json::array();

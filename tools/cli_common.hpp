@@ -11,6 +11,7 @@
 #include "core/recording.hpp"
 #include "dem/world.hpp"
 #include "fill/body.hpp"
+#include "io/recording_io.hpp"
 #include "mesh/mass_properties.hpp"
 #include "mesh/topology.hpp"
 
@@ -89,6 +90,9 @@ inline constexpr double kStudyDensity = 1085.0;
 /// How a density came to be used, for the output and the report: "given" or the default said
 /// in full, never silent.
 std::string density_source(bool given);
+
+/// Each recording directory, or directory of recording directories (sorted by name), in one set.
+Result<RecordingSet> read_recording_paths(const std::vector<std::string>& paths);
 
 /// The recordings' keys that look like spec keys they do not state (keys_not_read), once per key:
 /// section, key, its first value, the spec's key, how many of the recordings hold it and the first

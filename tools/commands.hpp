@@ -20,5 +20,6 @@ Command add_calibrate_command(CLI::App& app);
 Command add_materials_command(CLI::App& app);
 Command add_diagnose_command(CLI::App& app);
 Command add_batch_command(CLI::App& app);
+Command add_recordings_command(CLI::App& app);
 
 }  // namespace clumpforge::cli

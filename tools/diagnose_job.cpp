@@ -19,19 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Each recording directory, or directory of recording directories (sorted by name), in one set.
-Result<RecordingSet> collect(const std::vector<std::string>& paths) {
-  RecordingSet all;
-  for (const auto& path : paths) {
-    auto set = read_recordings(path);
-    if (!set) return std::unexpected(set.error());
-    std::ranges::move(set->recordings, std::back_inserter(all.recordings));
-    std::ranges::move(set->names, std::back_inserter(all.names));
-    std::ranges::move(set->manifests, std::back_inserter(all.manifests));
-  }
-  return all;
-}
-
 // Where the particle's density came from.
 enum class DensityFrom { CommandLine, Recordings, Library, Default };
 
@@ -580,7 +567,7 @@ std::string diagnosis_tracks_json(const DiagnoseResult& r) {
 Result<DiagnoseRun> run_diagnose_job(const DiagnoseJob& job, const RunContext& context) {
   if (!job.mesh.empty() && !job.library.empty())
     return fail(ErrorCode::InvalidArgument, "give exactly one of --mesh and --library, not both");
-  auto set = collect(job.recordings);
+  auto set = read_recording_paths(job.recordings);
   if (!set) return std::unexpected(set.error());
   const std::vector<Recording>& recordings = set->recordings;
   const std::vector<std::string>& names = set->names;

@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
   const std::vector<Command> commands{add_repair_command(app),    add_props_command(app),     add_fill_command(app),
                                       add_export_command(app),    add_study_command(app),     add_validate_command(app),
                                       add_calibrate_command(app), add_materials_command(app), add_diagnose_command(app),
-                                      add_batch_command(app)};
+                                      add_batch_command(app),     add_recordings_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1032,6 +1032,31 @@ std::vector<KeyNotRead> keys_not_read(const Recording& r) {
   return out;
 }
 
+RecordingDigest digest(const Recording& r) {
+  RecordingDigest d;
+  d.trials = r.trials.size();
+  std::vector<double> steps, durations;
+  for (const auto& trial : r.trials) {
+    if (trial.summary) ++d.summarised;
+    if (!trial.track) continue;
+    const Track& track = *trial.track;
+    ++d.tracked;
+    d.rows += track.size();
+    for (std::size_t i = 0; i < track.size(); ++i)
+      if (std::isnan(track.x[i]) || std::isnan(track.z[i])) ++d.lost;
+    if (track.size() >= 2) steps.push_back(median_step(track.t));
+    durations.push_back(track.t.back() - track.t.front());
+  }
+  if (!steps.empty()) d.frame_step_s = median(std::move(steps));
+  if (!durations.empty()) d.track_s = median(std::move(durations));
+  const std::vector<double> values = r.summaries();
+  const SampleSpread spread = sample_spread(values);
+  if (!values.empty()) d.summary_mean = spread.mean;
+  if (values.size() >= 2) d.summary_sd = spread.sd;
+  d.keys_not_read = keys_not_read(r);
+  return d;
+}
+
 namespace {
 /// The names a manifest holds must be UTF-8 text (JSON cannot hold other bytes); a recording
 /// made in code may carry any bytes, one read from a file cannot.

@@ -1,6 +1,7 @@
 #pragma once
 /// Reading and writing recording directories (manifest recording.json + track CSVs).
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,23 @@ struct KeyNotRead {
 
 /// The keys of `recording`'s extra keys that look like spec keys it does not state.
 std::vector<KeyNotRead> keys_not_read(const Recording& recording);
+
+/// What a recording holds, as read (`clumpforge recordings`): to check a lab's files before a
+/// diagnosis or a calibration spends minutes on them.
+struct RecordingDigest {
+  std::size_t trials = 0;
+  std::size_t tracked = 0;             ///< trials with a track
+  std::size_t summarised = 0;          ///< trials with a summary
+  std::size_t rows = 0;                ///< tracked frames, all tracks
+  std::size_t lost = 0;                ///< of them, rows with x or z empty (tracking lost)
+  double frame_step_s = 0.0;           ///< the median over the tracks of each one's median time step; 0 without tracks
+  double track_s = 0.0;                ///< the median duration of a track; 0 without tracks
+  std::optional<double> summary_mean;  ///< of the summaries (SI; degrees for a tilt)
+  std::optional<double> summary_sd;    ///< with two summaries or more
+  std::vector<KeyNotRead> keys_not_read;
+};
+
+RecordingDigest digest(const Recording& recording);
 
 /// Recordings with the names reports give them.
 struct RecordingSet {

@@ -298,6 +298,59 @@ TEST(DiagnoseCli, TheParticleTheRecordingsStateIsTheOneDiagnosed) {
   EXPECT_NE(tuber["hypotheses"][0]["strong_delta_chi2"], stated["hypotheses"][0]["strong_delta_chi2"]);
 }
 
+// `clumpforge recordings`: what each recording holds, read as diagnose reads it, before minutes
+// are spent on a diagnosis. Its figures checked against the files themselves, counted here.
+TEST(RecordingsCli, WhatEachRecordingHoldsIsSaidAsDiagnoseReadsIt) {
+  test::ScratchDir dir("recordings-cli");
+  const auto case13 = test::shared_dir() / "data" / "lab-like" / "case-13";
+  const auto run = test::run_clumpforge(fmt::format("recordings '{}' --json", case13.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto report = nlohmann::json::parse(run.out);
+  ASSERT_EQ(report["recordings"].size(), 9u);
+  const auto& drop = report["recordings"][1];
+  ASSERT_EQ(drop["name"], "drop-Q235-0.5");
+  const auto manifest = nlohmann::json::parse(std::ifstream(case13 / "drop-Q235-0.5" / "recording.json"));
+  double sum = 0.0;
+  std::size_t rows = 0;
+  for (const auto& trial : manifest["trials"]) {
+    sum += trial["summary"]["rebound_height_m"].get<double>();
+    std::ifstream track(case13 / "drop-Q235-0.5" / trial["track"].get<std::string>());
+    std::string line;
+    std::getline(track, line);  // the header
+    while (std::getline(track, line)) rows += line.empty() ? 0 : 1;
+  }
+  EXPECT_EQ(drop["trials"], manifest["trials"].size());
+  EXPECT_EQ(drop["tracked"], manifest["trials"].size());
+  EXPECT_EQ(drop["rows"], rows);
+  EXPECT_NEAR(drop["summary_mean"].get<double>(), sum / static_cast<double>(manifest["trials"].size()), 1e-12);
+  EXPECT_NEAR(drop["frame_rate_hz"].get<double>(), manifest["camera"]["frame_rate_hz"].get<double>(), 1e-6);
+  EXPECT_EQ(drop["setup"]["release_height_m"], manifest["setup"]["release_height_m"]);
+  EXPECT_EQ(report["recordings"][8]["test"], "tilt");
+  EXPECT_EQ(report["particle"]["mesh"], "../../meshes/sphere.stl");
+  EXPECT_EQ(report["particle"]["density_kg_m3"], 1085.0);
+  EXPECT_TRUE(report["keys_not_read"].empty());
+  // A density under the lab's own name: the table says none is stated, and the note says why.
+  sphere_drop_stating(dir / "own", R"({"density": 1300})");
+  const auto text = test::run_clumpforge(fmt::format("recordings '{}'", (dir / "own").string()));
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("| own | drop | Q235 | from 0.5 m | 6 / 6 / 6 | 1000 Hz (1000 Hz) | 0.1 mm |"),
+            std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("particle: density not stated"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("note: particle 'density' (1300) is kept but not read: the spec's key is 'density_kg_m3'"),
+            std::string::npos)
+      << text.out;
+  // Refused as diagnose refuses it: the file and the problem, nothing on stdout.
+  sphere_drop_stating(dir / "bad", R"({})");
+  auto bad = nlohmann::json::parse(std::ifstream(dir / "bad" / "recording.json"));
+  bad["trials"][0]["track"] = "../../etc/passwd";
+  std::ofstream(dir / "bad" / "recording.json") << bad.dump(1);
+  const auto refused = test::run_clumpforge(fmt::format("recordings '{}'", (dir / "bad").string()));
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find((dir / "bad" / "recording.json").string()), std::string::npos) << refused.err;
+  EXPECT_TRUE(refused.out.empty()) << refused.out;
+}
+
 TEST(DiagnoseCli, AParticleTheCommandLineOrTheRecordingsContradictIsRefusedAndNothingIsWritten) {
   test::ScratchDir dir("diagnose-particle-refused");
   const auto lab_like = test::shared_dir() / "data" / "lab-like";
