@@ -115,7 +115,20 @@ void bind_recordings(py::module_& m) {
           },
           "Keys of setup, particle or camera the spec does not name but that look like a spec key the recording "
           "does not state ({'section': 'particle', 'key': 'density', 'value': '1200', 'spec_key': "
-          "'density_kg_m3'}): kept, not read; the tool takes its default for what they seem to say");
+          "'density_kg_m3'}): kept, not read; the tool takes its default for what they seem to say")
+      .def(
+          "digest",
+          [](const Recording& r) {
+            const RecordingDigest d = digest(r);
+            return py::dict(py::arg("trials") = d.trials, py::arg("tracked") = d.tracked,
+                            py::arg("summarised") = d.summarised, py::arg("rows") = d.rows,
+                            py::arg("lost_rows") = d.lost, py::arg("frame_step_s") = d.frame_step_s,
+                            py::arg("track_s") = d.track_s, py::arg("summary_mean") = d.summary_mean,
+                            py::arg("summary_sd") = d.summary_sd);
+          },
+          "What the recording holds, as `clumpforge recordings` says it: trials, tracked, summarised, rows, lost_rows, "
+          "frame_step_s (the median over the tracks of each one's median step; 0 without tracks), track_s (the median "
+          "duration), summary_mean and summary_sd (SI; degrees for a tilt; None where there are too few)");
   m.def(
       "read_recording", [](const std::filesystem::path& p) { return unwrap(read_recording(p)); }, py::arg("path"),
       "A recording directory (or its recording.json), checked against the spec.");

@@ -161,6 +161,9 @@ def test_recordings_read_and_absurd_ones_are_refused(tmp_path):
     with pytest.raises(cf.Error, match="recording.json"):
         cf.read_recording(str(bad))
     assert drop.keys_not_read == []
+    d = drop.digest()
+    assert d["trials"] == d["tracked"] == len(drop.trials) and d["rows"] == sum(t.t.size for t in drop.trials)
+    assert d["frame_step_s"] == pytest.approx(1e-3) and d["summary_mean"] == pytest.approx(drop.summaries.mean())
     unread = tmp_path / "unread"
     shutil.copytree(ROOT / "clumps/tuber-default-diagnosis/recordings/drop-1m", unread)
     manifest = json.loads((unread / "recording.json").read_text())
