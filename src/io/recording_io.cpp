@@ -1145,6 +1145,28 @@ Result<void> write_recording(const fs::path& dir, const Recording& r) {
   return write_files_atomically(files);
 }
 
+namespace {
+/// Where `dir` holds folders of recording folders (a benchmark's cases, a lab's sessions), which
+/// ones, in words: one set is read at a time.
+std::string sets_hint(const fs::path& dir) {
+  std::vector<std::string> sets;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (!entry.is_directory(ec)) continue;
+    for (const auto& inner : fs::directory_iterator(entry.path(), ec)) {
+      if (inner.is_directory(ec) && fs::is_regular_file(inner.path() / "recording.json", ec)) {
+        sets.push_back(entry.path().filename().string());
+        break;
+      }
+    }
+  }
+  if (sets.empty()) return {};
+  std::ranges::sort(sets);
+  return fmt::format(" (it holds {} sets of recordings, {}{}: give one, or several, as {})", sets.size(), sets.front(),
+                     sets.size() > 1 ? fmt::format(" to {}", sets.back()) : "", (dir / sets.front()).string());
+}
+}  // namespace
+
 Result<RecordingSet> read_recordings(const fs::path& path) {
   RecordingSet set;
   std::error_code ec;
@@ -1166,8 +1188,9 @@ Result<RecordingSet> read_recordings(const fs::path& path) {
     if (entry.is_directory() && fs::is_regular_file(entry.path() / "recording.json")) children.push_back(entry.path());
   }
   if (children.empty())
-    return fail(ErrorCode::NotFound,
-                fmt::format("{}: neither a recording (recording.json) nor a directory of recordings", path.string()));
+    return fail(ErrorCode::NotFound, fmt::format("{}: neither a recording (recording.json) nor a directory of "
+                                                 "recordings{}",
+                                                 path.string(), sets_hint(path)));
   std::sort(children.begin(), children.end());
   for (const auto& child : children) {
     auto r = read_recording(child);

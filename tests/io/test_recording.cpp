@@ -1135,6 +1135,28 @@ void summary_drop(const fs::path& dir, const std::string& particle) {
 }
 }  // namespace
 
+// A folder of sets (a benchmark's cases, a lab's sessions) is one level too high: the refusal
+// says which sets it holds and how to give one.
+TEST(Recording, AFolderOfSetsIsRefusedNamingTheSetsItHolds) {
+  test::ScratchDir dir("rec-sets");
+  summary_drop(dir / "sets" / "case-01" / "drop", "");
+  summary_drop(dir / "sets" / "case-02" / "drop", "");
+  fs::create_directories(dir / "sets" / "notes");
+  const auto set = read_recordings(dir / "sets");
+  ASSERT_FALSE(set);
+  EXPECT_NE(set.error().message.find(fmt::format("neither a recording (recording.json) nor a directory of recordings "
+                                                 "(it holds 2 sets of recordings, case-01 to case-02: give one, or "
+                                                 "several, as {})",
+                                                 (dir / "sets" / "case-01").string())),
+            std::string::npos)
+      << set.error().message;
+  EXPECT_TRUE(read_recordings(dir / "sets" / "case-01"));
+  fs::create_directories(dir / "empty");
+  const auto empty = read_recordings(dir / "empty");
+  ASSERT_FALSE(empty);
+  EXPECT_EQ(empty.error().message.find("sets of recordings"), std::string::npos) << empty.error().message;
+}
+
 TEST(StatedParticle, TwoDensitiesAreOneParticlesWithinOnePercentNeverAtInfinity) {
   EXPECT_TRUE(same_density(1085.0, 1084.6));
   EXPECT_TRUE(same_density(1085.0, 1095.0));
