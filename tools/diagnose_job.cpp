@@ -41,7 +41,7 @@ struct ParticleChoice {
   std::string mesh;
   bool mesh_from_recordings = false;
   std::string units = "mm";
-  double density = kDefaultDensity;
+  double density = kStudyDensity;
   DensityFrom density_from = DensityFrom::Default;
 };
 
@@ -98,7 +98,7 @@ Result<ParticleChoice> particle_choice(const DiagnoseJob& job, const StatedParti
     if (!mesh) return std::unexpected(mesh.error());
     c = std::move(*mesh);
   }
-  c.density = job.density ? *job.density : stated.density.value_or(kDefaultDensity);
+  c.density = job.density ? *job.density : stated.density.value_or(kStudyDensity);
   c.density_from = job.density      ? DensityFrom::CommandLine
                    : stated.density ? DensityFrom::Recordings
                                     : DensityFrom::Default;

@@ -14,9 +14,6 @@
 
 namespace clumpforge::cli {
 
-/// The density a mesh is filled at when neither the command line nor the recordings give one: the
-/// Corydalis tuber's [kg/m^3].
-inline constexpr double kDefaultDensity = 1085.0;
 /// The largest adaptive clump the convergence ladder tries.
 inline constexpr int kMaxAutoSpheres = 256;
 /// The largest finer clump made to check the particle model against.
@@ -30,7 +27,7 @@ struct DiagnoseJob {
   std::string library, clump_name;
   /// Of the mesh; unset: the recordings' `mesh_units` when the mesh is the one they name, else mm.
   std::optional<std::string> units;
-  /// [kg/m^3] unset: the recordings' `density_kg_m3`, else kDefaultDensity. Given and stated, the
+  /// [kg/m^3] unset: the recordings' `density_kg_m3`, else kStudyDensity (cli_common.hpp). Given and stated, the
   /// two must agree within kStatedDensityTolerance; a library's clump must agree with both.
   std::optional<double> density;
   int spheres = 0;  ///< adaptive budget for the mesh; 0: by convergence to the scan
