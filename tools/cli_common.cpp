@@ -291,6 +291,12 @@ std::string without(std::string_view spec_key) {
 }
 }  // namespace
 
+std::string keys_not_read_notes(const nlohmann::json& keys_not_read) {
+  std::string text;
+  for (const auto& k : keys_not_read) text += fmt::format("note: {}\n", key_not_read_note(k));
+  return text;
+}
+
 std::string key_not_read_note(const nlohmann::json& entry) {
   const auto n = entry["recordings"].get<std::size_t>(), of = entry["of"].get<std::size_t>();
   const std::string spec_key = entry["spec_key"].get<std::string>();

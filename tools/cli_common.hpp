@@ -101,6 +101,8 @@ nlohmann::json keys_not_read_json(const std::vector<Recording>& recordings,
                                   const std::vector<std::filesystem::path>& manifests);
 /// One entry of keys_not_read_json in words, for a report's notes.
 std::string key_not_read_note(const nlohmann::json& entry);
+/// Every entry of keys_not_read_json as a "note: ..." line, for a text report.
+std::string keys_not_read_notes(const nlohmann::json& keys_not_read);
 
 /// Progress on stderr after the first second, when stderr is a terminal and not --json.
 RunContext progress_context(bool json);

@@ -153,13 +153,6 @@ std::string joint_markdown(const std::vector<JointSurfaceResult>& results) {
   return text + "\n";
 }
 
-// The recordings' keys that look like spec keys they do not state, as notes below a report.
-std::string unread_notes(const nlohmann::json& keys_not_read) {
-  std::string text;
-  for (const auto& k : keys_not_read) text += fmt::format("note: {}\n", key_not_read_note(k));
-  return text;
-}
-
 int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<Recording>& recordings,
               const nlohmann::json& keys_not_read, const MaterialTable& table, const Team& team) {
   constexpr std::string_view kCommand = "calibrate";
@@ -204,7 +197,7 @@ int run_joint(const CalibrateArgs& args, const Clump& clump, const std::vector<R
                                   {"dem_evaluations", r.evaluations},
                                   {"notes", r.notes}});
   }
-  const std::string text = joint_markdown(*results) + unread_notes(keys_not_read);
+  const std::string text = joint_markdown(*results) + keys_not_read_notes(keys_not_read);
   if (!args.out.empty()) {
     std::error_code ec;
     fs::create_directories(args.out, ec);
@@ -299,7 +292,7 @@ int run_calibrate(const CalibrateArgs& args) {
     files.insert(files.end(), {{fs::path(args.out) / "calibration.json", report_json_text(report) + "\n"},
                                {fs::path(args.out) / "calibration.md",
                                 fmt::format("# Calibration by the study's method ({})\n\n{}\n{}", clump->name,
-                                            markdown(*calibration), unread_notes(unread))}});
+                                            markdown(*calibration), keys_not_read_notes(unread))}});
     if (auto ok = write_files_atomically(files); !ok) return report_error(kCommand, ok.error());
     draw_figures(kCommand, "calibration", args.out);
   }
@@ -309,7 +302,7 @@ int run_calibrate(const CalibrateArgs& args) {
     std::string shown = fmt::format("calibration of clump '{}' by the study's method ({} trials per level)\n\n{}\n",
                                     clump->name, args.trials_per_level, markdown(*calibration));
     for (const auto& note : calibration->notes) shown += fmt::format("note: {}\n", note);
-    shown += unread_notes(unread);
+    shown += keys_not_read_notes(unread);
     print_report_text(shown);
     if (!args.out.empty()) fmt::print("report, sweeps and plots written to {}/\n", args.out);
   }

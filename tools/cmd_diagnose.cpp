@@ -133,7 +133,7 @@ void write_particle(std::ostream& out, const nlohmann::json& particle, const nlo
   out << fmt::format("particle: {}; density {:g} kg/m^3 ({})\n", model, particle["density_kg_m3"].get<double>(),
                      particle["density_from"] == "default" ? "not stated or given: the Corydalis tuber's" + unread
                                                            : from(particle["density_from"]));
-  for (const auto& k : keys_not_read) out << "note: " << key_not_read_note(k) << "\n";
+  out << keys_not_read_notes(keys_not_read);
 }
 
 int run_diagnose(const DiagnoseArgs& args) {

@@ -124,8 +124,7 @@ std::string report_text(const nlohmann::json& report) {
                                                             ? std::string()
                                                             : fmt::format(" in {}", p["mesh_units"].get<std::string>()),
                                                         p["mesh_in"].get<std::string>()));
-  for (const auto& k : report["keys_not_read"]) text += "note: " + key_not_read_note(k) + "\n";
-  return text;
+  return text + keys_not_read_notes(report["keys_not_read"]);
 }
 
 int run_recordings(const RecordingsArgs& args) {

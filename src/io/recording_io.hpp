@@ -44,7 +44,6 @@ struct RecordingDigest {
   double track_s = 0.0;                ///< the median duration of a track; 0 without tracks
   std::optional<double> summary_mean;  ///< of the summaries (SI; degrees for a tilt)
   std::optional<double> summary_sd;    ///< with two summaries or more
-  std::vector<KeyNotRead> keys_not_read;
 };
 
 RecordingDigest digest(const Recording& recording);
